@@ -1,0 +1,229 @@
+"""Input validators in the style of pytransform3d's ``check_*``.
+
+Each validator takes what a user handed in (nested lists from JSON, or arrays), checks it
+and returns a canonical, C-contiguous float64 array (or a tuple of ids). A problem raises
+an :class:`~unstack.errors.InvalidFile` subclass naming the source, the JSON path and the
+shape or value it got, so the same checks serve files and in-process callers.
+
+Examples
+--------
+>>> check_probability_matrix([[0, 0.7], [0.1, 0]], n_objects=2)
+array([[0. , 0.7],
+       [0.1, 0. ]])
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from unstack.errors import InvalidFile, InvalidScene, InvalidSupports
+
+__all__ = [
+    "QUATERNION_NORM_TOLERANCE",
+    "check_ids",
+    "check_points",
+    "check_probability_matrix",
+    "check_quaternion_xyzw",
+    "check_vector",
+]
+
+#: A quaternion whose norm is within this of 1 is normalised; further away it is an error.
+QUATERNION_NORM_TOLERANCE = 1e-3
+
+
+def _matrix(
+    value: Any, n_objects: int, source: str, path: str, error: type[InvalidFile]
+) -> np.ndarray:
+    """Turn nested lists or an array into an ``n x n`` float64 array, naming bad cells."""
+    if isinstance(value, np.ndarray):
+        if value.ndim != 2 or value.shape != (n_objects, n_objects):
+            raise error(source, path, f"expected a {n_objects} x {n_objects} matrix, got shape {value.shape}")
+        if not np.issubdtype(value.dtype, np.number) and value.dtype != np.bool_:
+            raise error(source, path, f"expected numbers, got dtype {value.dtype}")
+        return np.ascontiguousarray(value, dtype=np.float64)
+    if not isinstance(value, Sequence) or isinstance(value, str):
+        raise error(source, path, f"expected a {n_objects} x {n_objects} matrix (a list of rows)")
+    if len(value) != n_objects:
+        raise error(source, path, f"expected {n_objects} rows (one per object), got {len(value)}")
+    for i, row in enumerate(value):
+        if not isinstance(row, Sequence) or isinstance(row, str):
+            raise error(source, f"{path}[{i}]", f"expected a row of {n_objects} numbers")
+        if len(row) != n_objects:
+            raise error(source, f"{path}[{i}]", f"expected {n_objects} numbers (one per object), got {len(row)}")
+        for j, cell in enumerate(row):
+            if isinstance(cell, bool) or not isinstance(cell, int | float | np.number):
+                raise error(source, f"{path}[{i}][{j}]", f"expected a number, got {cell!r}")
+    return np.array(value, dtype=np.float64).reshape(n_objects, n_objects)
+
+
+def check_probability_matrix(
+    value: Any,
+    n_objects: int,
+    *,
+    source: str = "<array>",
+    path: str = "$.probabilities",
+    error: type[InvalidFile] = InvalidSupports,
+) -> np.ndarray:
+    """Check a support-probability matrix and return it as float64.
+
+    Parameters
+    ----------
+    value : array-like
+        ``n x n`` matrix with ``value[i][j] = P(SUPP(i, j))``.
+    n_objects : int
+        The number of objects the matrix must cover.
+    source, path : str
+        Where the value came from, for error messages.
+    error : type
+        The error class to raise.
+
+    Returns
+    -------
+    numpy.ndarray
+        The matrix, shape ``(n, n)``, float64, C-contiguous.
+
+    Raises
+    ------
+    InvalidSupports
+        Wrong shape, ragged rows, non-numeric, non-finite or out-of-range entries, or a
+        non-zero diagonal; the message names the first bad cell.
+
+    Examples
+    --------
+    >>> check_probability_matrix([[0, 2], [0, 0]], n_objects=2)
+    Traceback (most recent call last):
+    ...
+    unstack.errors.InvalidSupports: <array>: $.probabilities[0][1]: expected a probability in [0, 1], got 2.0
+    """
+    matrix = _matrix(value, n_objects, source, path, error)
+    bad = np.argwhere(~np.isfinite(matrix))
+    if bad.size:
+        i, j = bad[0]
+        raise error(source, f"{path}[{i}][{j}]", f"expected a finite number, got {matrix[i, j]}")
+    bad = np.argwhere((matrix < 0) | (matrix > 1))
+    if bad.size:
+        i, j = bad[0]
+        raise error(source, f"{path}[{i}][{j}]", f"expected a probability in [0, 1], got {matrix[i, j]}")
+    diagonal = np.flatnonzero(np.diag(matrix))
+    if diagonal.size:
+        i = diagonal[0]
+        raise error(source, f"{path}[{i}][{i}]", f"expected 0 on the diagonal, got {matrix[i, i]}")
+    return matrix
+
+
+def check_ids(
+    value: Any, *, source: str = "<array>", path: str = "$.objects", error: type[InvalidFile] = InvalidSupports
+) -> tuple[str, ...]:
+    """Check a list of object ids: non-empty, strings, unique. Returns them as a tuple.
+
+    Examples
+    --------
+    >>> check_ids(["a", "b"])
+    ('a', 'b')
+    """
+    if isinstance(value, str) or not isinstance(value, Sequence | np.ndarray):
+        raise error(source, path, "expected a list of ids")
+    if len(value) == 0:
+        raise error(source, path, "expected at least one object, got an empty list")
+    seen: dict[str, int] = {}
+    for index, item in enumerate(value):
+        if not isinstance(item, str) or not item:
+            raise error(source, f"{path}[{index}]", f"expected a non-empty string id, got {item!r}")
+        if item in seen:
+            raise error(source, f"{path}[{index}]", f"duplicate id {item!r} (also at index {seen[item]})")
+        seen[item] = index
+    return tuple(value)
+
+
+def check_vector(
+    value: Any,
+    length: int,
+    *,
+    positive: bool = False,
+    source: str = "<array>",
+    path: str = "$",
+    error: type[InvalidFile] = InvalidScene,
+) -> np.ndarray:
+    """Check a fixed-length vector of finite numbers (optionally all positive).
+
+    Examples
+    --------
+    >>> check_vector([0.6, 0.4, 0.4], 3, positive=True)
+    array([0.6, 0.4, 0.4])
+    """
+    array = np.asarray(value, dtype=object if not isinstance(value, np.ndarray) else None)
+    if array.shape != (length,):
+        raise error(source, path, f"expected {length} numbers, got shape {array.shape}")
+    for index, item in enumerate(array):
+        if isinstance(item, bool) or not isinstance(item, int | float | np.number):
+            raise error(source, f"{path}[{index}]", f"expected a number, got {item!r}")
+    vector = np.array(array, dtype=np.float64)
+    for index, item in enumerate(vector):
+        if not np.isfinite(item):
+            raise error(source, f"{path}[{index}]", f"expected a finite number, got {item}")
+        if positive and item <= 0:
+            raise error(source, f"{path}[{index}]", f"expected a positive number, got {item}")
+    return vector
+
+
+def check_quaternion_xyzw(
+    value: Any,
+    *,
+    tolerance: float = QUATERNION_NORM_TOLERANCE,
+    source: str = "<array>",
+    path: str = "$.orientation_xyzw",
+    error: type[InvalidFile] = InvalidScene,
+) -> np.ndarray:
+    """Check a scalar-last quaternion ``[x, y, z, w]`` and return it normalised.
+
+    A norm within ``tolerance`` of 1 is normalised; anything else is an error.
+
+    Examples
+    --------
+    >>> check_quaternion_xyzw([0, 0, 0, 1.0002])
+    array([0., 0., 0., 1.])
+    """
+    quaternion = check_vector(value, 4, source=source, path=path, error=error)
+    norm = float(np.linalg.norm(quaternion))
+    if abs(norm - 1.0) > tolerance:
+        raise error(
+            source, path, f"expected a unit quaternion [x, y, z, w] (norm within {tolerance} of 1), got norm {norm:.6g}"
+        )
+    normalised: np.ndarray = quaternion / norm
+    return normalised
+
+
+def check_points(
+    value: Any, *, source: str = "<array>", path: str = "$.points", error: type[InvalidFile] = InvalidScene
+) -> np.ndarray:
+    """Check a point cloud and return it as an ``(N, 3)`` float64 array (N may be 0).
+
+    Examples
+    --------
+    >>> check_points([[0.0, 1.0, 2.0]]).shape
+    (1, 3)
+    >>> check_points([]).shape
+    (0, 3)
+    """
+    if isinstance(value, np.ndarray):
+        array = value
+    else:
+        if isinstance(value, Sequence) and len(value) == 0:
+            return np.zeros((0, 3))
+        try:
+            array = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise error(source, path, "expected an N x 3 array of numbers") from None
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise error(source, path, f"expected an N x 3 array of points, got shape {array.shape}")
+    if not np.issubdtype(array.dtype, np.number):
+        raise error(source, path, f"expected numbers, got dtype {array.dtype}")
+    points = np.ascontiguousarray(array, dtype=np.float64)
+    bad = np.argwhere(~np.isfinite(points))
+    if bad.size:
+        i, k = bad[0]
+        raise error(source, f"{path}[{i}][{k}]", f"expected a finite coordinate, got {points[i, k]}")
+    return points

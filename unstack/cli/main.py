@@ -1,0 +1,175 @@
+"""``unstack`` commands: ``decide``, ``worlds``, ``validate``.
+
+Each command is a thin layer over the library: read and validate the input, call one
+library function, render the result. ``UnstackError`` (and unwritable outputs) become a
+single ``unstack: error: ...`` line on stderr with exit code 2.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections.abc import Callable
+from typing import Any
+
+import click
+from rich.console import Console
+
+from unstack.errors import ModelRequired, UnstackError
+
+__all__ = ["cli", "main"]
+
+INPUT_HELP = "An unstack.supports/1 or unstack.scene/1 JSON file; '-' reads standard input."
+
+
+def _fail(message: str) -> None:
+    click.echo(f"unstack: error: {message}", err=True)
+    sys.exit(2)
+
+
+class _Group(click.Group):
+    """A click group that turns library errors into one line and exit code 2."""
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except UnstackError as error:
+            _fail(str(error))
+        except OSError as error:
+            _fail(f"{getattr(error, 'filename', None) or ''}: {error.strerror or error}".lstrip(": "))
+        return None
+
+
+def _write_output(path: str | None, document: dict[str, Any]) -> None:
+    if path is None:
+        return
+    from unstack.jsonio import atomic_write_text
+
+    atomic_write_text(path, json.dumps(document, indent=2) + "\n")
+
+
+def _emit(as_json: bool, document: dict[str, Any], render: Callable[[], Any]) -> None:
+    if as_json:
+        click.echo(json.dumps(document, indent=2))
+    else:
+        Console(highlight=False).print(render())
+
+
+def _load_supports(path: str) -> Any:
+    from unstack import load
+    from unstack.scene import Scene
+
+    loaded = load(path)
+    if isinstance(loaded, Scene):
+        raise ModelRequired(
+            f"{loaded.source}: deciding on a scene (unstack.scene/1) needs a learned support model, "
+            "which this release does not include yet; pass an unstack.supports/1 file with the "
+            "support probabilities of the detected boxes"
+        )
+    return loaded
+
+
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="unstack")
+def cli() -> None:
+    """Decide which carton box to unload first from support probabilities."""
+
+
+@cli.command()
+@click.argument("file", type=str)
+@click.option("--json", "as_json", is_flag=True, help="Print the decision as unstack.decision/1 JSON.")
+@click.option("-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON decision to this file (atomically).")
+@click.option(
+    "--method",
+    type=click.Choice(["auto", "exact", "sat"]),
+    default="auto",
+    show_default=True,
+    help="exact: weighted preorder counting (<= 8 boxes); sat: list worlds with CaDiCaL (<= 6 boxes).",
+)
+@click.option(
+    "--cost",
+    type=click.Choice(["count", "mass"]),
+    default="count",
+    show_default=True,
+    help="count: number of supported boxes (Eq. 11); mass: their total mass (needs masses).",
+)
+def decide(file: str, as_json: bool, output: str | None, method: str, cost: str) -> None:
+    """Print which box to unload first, the expected cost of every box and P(support | consistent).
+
+    FILE is an unstack.supports/1 file ('-' reads standard input).
+    """
+    from unstack.cli.render import decision_view
+    from unstack.reasoner.decision import decide as decide_box
+
+    supports = _load_supports(file)
+    decision = decide_box(supports, method=method, cost=cost)
+    document = decision.to_dict()
+    _write_output(output, document)
+    _emit(as_json, document, lambda: decision_view(decision))
+
+
+@cli.command()
+@click.argument("file", type=str)
+@click.option("--json", "as_json", is_flag=True, help="Print every world as JSON (unstack.payoff/1).")
+@click.option("-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON payoff matrix to this file.")
+@click.option("--limit", type=click.IntRange(min=1), default=20, show_default=True, help="Worlds shown in the table.")
+@click.option("--cost", type=click.Choice(["count", "mass"]), default="count", show_default=True)
+def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str) -> None:
+    """Print the payoff matrix (Table II): consistent worlds, their probabilities and action costs.
+
+    Lists worlds with a SAT solver, so it is for small scenes (up to 6 boxes).
+    """
+    from unstack.cli.render import payoff_view
+    from unstack.reasoner.payoff import payoff_matrix
+
+    supports = _load_supports(file)
+    table = payoff_matrix(supports, cost=cost)
+    objects = table.objects
+    document = {
+        "format": "unstack.payoff/1",
+        "objects": list(objects),
+        "cost": cost,
+        "consistent_worlds": len(table.worlds),
+        "expected_costs": table.expected_costs().tolist(),
+        "worlds": [
+            {
+                "probability": float(table.worlds.probabilities[i]),
+                "supports": [[objects[x], objects[y]] for x, y in zip(*table.worlds.worlds[i].nonzero(), strict=True)],
+                "costs": table.costs[i].tolist(),
+            }
+            for i in range(len(table.worlds))
+        ],
+    }
+    _write_output(output, document)
+    _emit(as_json, document, lambda: payoff_view(table, limit))
+
+
+@cli.command()
+@click.argument("files", nargs=-1, required=True, type=str)
+def validate(files: tuple[str, ...]) -> None:
+    """Check files against their schema (unstack.supports/1, unstack.scene/1, unstack.decision/1)."""
+    from unstack.jsonio import read_document, validate_document
+    from unstack.scene import Scene
+    from unstack.supports import Supports
+
+    for file in files:
+        document = read_document(file)
+        tag = validate_document(document)
+        if tag == "unstack.supports/1":
+            supports = Supports.from_document(document)
+            detail = f"{supports.n_objects} objects"
+        elif tag == "unstack.scene/1":
+            scene = Scene.from_document(document)
+            detail = f"{len(scene.boxes)} boxes, {len(scene.detected)} detected, {len(scene.points):,} points"
+        else:
+            detail = f"choice {document.data['choice']!r}"
+        click.echo(f"{document.source}: valid {tag} ({detail})")
+
+
+def main() -> None:
+    """Console-script entry point."""
+    cli(prog_name="unstack")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,75 @@
+"""Rich renderings of decisions and payoff matrices for the terminal."""
+
+from __future__ import annotations
+
+from rich.console import Group
+from rich.table import Table
+from rich.text import Text
+
+from unstack.reasoner.decision import Decision
+from unstack.reasoner.payoff import PayoffMatrix
+
+__all__ = ["decision_view", "payoff_view"]
+
+
+def _number(value: float) -> str:
+    return f"{value:.4f}"
+
+
+def decision_view(decision: Decision) -> Group:
+    """The choice, the expected cost of every box and the conditional support matrix."""
+    unit = "boxes" if decision.cost == "count" else "kg"
+    order = sorted(range(len(decision.objects)), key=lambda i: (decision.expected_costs[i], decision.objects[i]))
+    costs = Table(title=f"EC: expected {unit} supported (Eq. 13)", title_justify="left")
+    costs.add_column("rank", justify="right")
+    costs.add_column("box")
+    costs.add_column("EC", justify="right")
+    costs.add_column("")
+    for rank, i in enumerate(order, start=1):
+        box = decision.objects[i]
+        mark = "<- unload first" if box == decision.choice else ("tie" if box in decision.ties else "")
+        costs.add_row(str(rank), box, _number(float(decision.expected_costs[i])), mark)
+    matrix = Table(title="P(row supports column | consistent world)", title_justify="left")
+    matrix.add_column("supports ->")
+    for box in decision.objects:
+        matrix.add_column(box, justify="right")
+    for i, box in enumerate(decision.objects):
+        cells = ["-" if i == j else f"{decision.marginals[i, j]:.3f}" for j in range(len(decision.objects))]
+        matrix.add_row(box, *cells)
+    worlds = "" if decision.consistent_worlds is None else f", {decision.consistent_worlds:,} consistent worlds"
+    evidence = decision.evidence
+    hard = f", hard evidence: {len(evidence.forced)} forced / {len(evidence.forbidden)} forbidden"
+    footer = Text(f"method {decision.method}{worlds}{hard}, {decision.seconds:.3f} s", style="dim")
+    headline = Text.assemble(("Unload first: ", "bold"), (decision.choice, "bold green"))
+    if len(decision.ties) > 1:
+        headline.append(f"  (tied with {', '.join(t for t in decision.ties if t != decision.choice)}; smallest id wins)")
+    return Group(headline, costs, matrix, footer)
+
+
+def payoff_view(table: PayoffMatrix, limit: int) -> Group:
+    """Table II: the most probable consistent worlds with the cost of each action."""
+    objects = table.objects
+    worlds = table.worlds
+    order = sorted(range(len(worlds)), key=lambda i: -worlds.probabilities[i])[:limit]
+    view = Table(title="Payoff matrix (Table II): consistent worlds, P(w), cost of unloading each box", title_justify="left")
+    view.add_column("world", justify="right")
+    view.add_column("P(w)", justify="right")
+    view.add_column("support relations")
+    for box in objects:
+        view.add_column(f"A:{box}", justify="right")
+    for i in order:
+        relations = [f"{objects[x]}>{objects[y]}" for x, y in zip(*worlds.worlds[i].nonzero(), strict=True)]
+        view.add_row(
+            str(i + 1),
+            f"{worlds.probabilities[i]:.4g}",
+            " ".join(relations) or "(none)",
+            *(f"{c:g}" for c in table.costs[i]),
+        )
+    expected = table.expected_costs()
+    view.add_section()
+    view.add_row("EC", "", "", *(f"{c:.4f}" for c in expected))
+    shown = f"showing the {len(order)} most probable of {len(worlds):,} consistent worlds" if len(order) < len(
+        worlds
+    ) else f"{len(worlds):,} consistent worlds"
+    note = Text(f"{shown}; 'x>y' means x supports y", style="dim")
+    return Group(view, note)

@@ -1,0 +1,283 @@
+"""Reading, validating and atomically writing unstack's versioned JSON documents.
+
+Every document carries a ``format`` tag such as ``"unstack.supports/1"`` and is checked
+against the JSON Schema shipped for that tag (``unstack/schemas/``). Problems become
+:class:`~unstack.errors.InvalidFile` errors that name the file, the JSON path and what
+was expected.
+
+Examples
+--------
+>>> from unstack.jsonio import format_json_path
+>>> format_json_path(["probabilities", 2, 1])
+'$.probabilities[2][1]'
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import sys
+import tempfile
+from collections.abc import Iterable, Iterator
+from functools import cache
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from unstack.errors import InvalidFile, UnknownFormat
+
+__all__ = [
+    "FORMATS",
+    "Document",
+    "atomic_write_text",
+    "format_json_path",
+    "load_schema",
+    "read_document",
+    "validate_document",
+]
+
+#: Format tag -> schema file shipped in ``unstack/schemas``.
+FORMATS: dict[str, str] = {
+    "unstack.supports/1": "supports-1.schema.json",
+    "unstack.scene/1": "scene-1.schema.json",
+    "unstack.decision/1": "decision-1.schema.json",
+}
+
+STDIN_NAME = "<stdin>"
+
+
+class Document:
+    """A parsed JSON document with where it came from.
+
+    Attributes
+    ----------
+    data : dict
+        The parsed JSON object.
+    source : str
+        The file name as the user gave it, or ``<stdin>``.
+    base_dir : pathlib.Path
+        The folder that relative references (``points_file``) are resolved against.
+    """
+
+    def __init__(self, data: dict[str, Any], source: str, base_dir: Path) -> None:
+        self.data = data
+        self.source = source
+        self.base_dir = base_dir
+
+    @property
+    def format(self) -> str:
+        """The document's ``format`` tag."""
+        return str(self.data["format"])
+
+
+def format_json_path(parts: Iterable[str | int]) -> str:
+    """Render a sequence of keys and indices as a JSONPath such as ``$.boxes[0].size``."""
+    text = "$"
+    for part in parts:
+        text += f"[{part}]" if isinstance(part, int) else f".{part}"
+    return text
+
+
+def _short(value: Any, limit: int = 40) -> str:
+    """A short, one-line rendering of a JSON value for error messages."""
+    text = json.dumps(value, allow_nan=True) if not isinstance(value, str) else repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _find_non_finite(value: Any, path: list[str | int]) -> Iterator[list[str | int]]:
+    if isinstance(value, float) and not math.isfinite(value):
+        yield path
+    elif isinstance(value, dict):
+        for key, item in value.items():
+            yield from _find_non_finite(item, [*path, key])
+    elif isinstance(value, list):
+        for index, item in enumerate(value):
+            yield from _find_non_finite(item, [*path, index])
+
+
+def _get(data: Any, path: list[str | int]) -> Any:
+    for part in path:
+        data = data[part]
+    return data
+
+
+def read_document(path: str | os.PathLike[str]) -> Document:
+    """Read a JSON document from a file (``"-"`` reads standard input).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file to read, or ``"-"`` for standard input.
+
+    Returns
+    -------
+    Document
+        The parsed object with its source name and base folder.
+
+    Raises
+    ------
+    InvalidFile
+        The file is missing, a directory, unreadable, not JSON, not a JSON object, or
+        holds a non-finite number (``NaN``, ``Infinity``).
+    """
+    source = str(path)
+    if source == "-":
+        text = sys.stdin.read()
+        source, base_dir = STDIN_NAME, Path.cwd()
+    else:
+        file = Path(path)
+        if file.is_dir():
+            raise InvalidFile(source, "$", "expected a JSON file, got a directory")
+        try:
+            text = file.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise InvalidFile(source, "$", "no such file") from None
+        except (OSError, UnicodeDecodeError) as error:
+            raise InvalidFile(source, "$", f"cannot read the file: {error}") from None
+        base_dir = file.resolve().parent
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as error:
+        raise InvalidFile(
+            source, "$", f"invalid JSON at line {error.lineno} column {error.colno}: {error.msg}"
+        ) from None
+    if not isinstance(data, dict):
+        raise InvalidFile(source, "$", f"expected a JSON object, got {type(data).__name__}")
+    for bad in _find_non_finite(data, []):
+        raise InvalidFile(
+            source, format_json_path(bad), f"expected a finite number, got {_get(data, bad)}"
+        )
+    return Document(data, source, base_dir)
+
+
+@cache
+def load_schema(format_tag: str) -> dict[str, Any]:
+    """Return the JSON Schema shipped for a format tag such as ``unstack.scene/1``."""
+    text = resources.files("unstack.schemas").joinpath(FORMATS[format_tag]).read_text("utf-8")
+    schema: dict[str, Any] = json.loads(text)
+    return schema
+
+
+def _describe(error: Any) -> str:
+    """Turn a jsonschema ValidationError into 'expected ..., got ...'."""
+    validator, expected, instance = error.validator, error.validator_value, error.instance
+    if validator == "type":
+        kinds = expected if isinstance(expected, str) else " or ".join(expected)
+        return f"expected {kinds}, got {_short(instance)}"
+    if validator == "required":
+        missing = [key for key in expected if key not in instance]
+        return f"missing required key {missing[0]!r}"
+    if validator == "additionalProperties":
+        allowed = set(error.schema.get("properties", {}))
+        extra = sorted(key for key in instance if key not in allowed)
+        return f"unexpected key {extra[0]!r} (allowed: {', '.join(sorted(allowed))})"
+    if validator in {"minimum", "exclusiveMinimum", "maximum", "exclusiveMaximum"}:
+        words = {
+            "minimum": ">=",
+            "exclusiveMinimum": ">",
+            "maximum": "<=",
+            "exclusiveMaximum": "<",
+        }
+        return f"expected a number {words[validator]} {expected}, got {_short(instance)}"
+    if validator in {"minItems", "maxItems"}:
+        word = "at least" if validator == "minItems" else "at most"
+        return f"expected {word} {expected} items, got {len(instance)}"
+    if validator == "uniqueItems":
+        seen: set[str] = set()
+        for item in instance:
+            key = json.dumps(item, sort_keys=True)
+            if key in seen:
+                return f"expected unique items, {_short(item)} appears twice"
+            seen.add(key)
+    if validator == "const":
+        return f"expected {_short(expected)}, got {_short(instance)}"
+    if validator == "enum":
+        return f"expected one of {', '.join(_short(e) for e in expected)}, got {_short(instance)}"
+    if validator == "oneOf" and isinstance(instance, dict):
+        options = [sorted(option.get("required", [])) for option in expected]
+        return "expected exactly one of " + " or ".join(
+            "/".join(option) for option in options if option
+        )
+    return str(error.message if len(error.message) < 120 else error.message[:117] + "...")
+
+
+def validate_document(
+    document: Document, expected: Iterable[str] | None = None, error_class: type[InvalidFile] = InvalidFile
+) -> str:
+    """Check a document's ``format`` tag and validate it against that format's schema.
+
+    Parameters
+    ----------
+    document : Document
+        The parsed document.
+    expected : iterable of str, optional
+        The format tags acceptable here (default: every format this release reads).
+    error_class : type, optional
+        The :class:`InvalidFile` subclass to raise for schema violations.
+
+    Returns
+    -------
+    str
+        The document's format tag.
+
+    Raises
+    ------
+    UnknownFormat
+        The tag is missing, unknown, or names a version this release cannot read.
+    InvalidFile
+        The document violates its schema (the first problem, by JSON path).
+    """
+    from jsonschema import Draft202012Validator
+
+    accepted = list(expected) if expected is not None else list(FORMATS)
+    tag = document.data.get("format")
+    if tag is None:
+        raise UnknownFormat(
+            document.source, "$", f"missing required key 'format' (expected {', '.join(accepted)})"
+        )
+    if tag not in accepted:
+        family = str(tag).rsplit("/", 1)[0]
+        same_family = [known for known in FORMATS if known.rsplit("/", 1)[0] == family]
+        why = "unsupported version" if same_family else "unknown format"
+        raise UnknownFormat(
+            document.source,
+            "$.format",
+            f"{why} {_short(tag)}; expected {' or '.join(accepted)}",
+        )
+    validator = Draft202012Validator(load_schema(tag))
+    errors = sorted(validator.iter_errors(document.data), key=lambda e: list(e.absolute_path))
+    if errors:
+        first = errors[0]
+        if first.validator in {"oneOf", "anyOf"} and first.context:
+            deepest = max(first.context, key=lambda e: len(e.absolute_path))
+            if len(deepest.absolute_path) > len(first.absolute_path):
+                first = deepest
+        raise error_class(document.source, format_json_path(first.absolute_path), _describe(first))
+    return str(tag)
+
+
+def atomic_write_text(path: str | os.PathLike[str], text: str) -> None:
+    """Write ``text`` to ``path`` atomically: a temporary file in the same folder, then a rename.
+
+    A reader never sees a half-written file, and a failure leaves no file behind.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "out.json"
+    >>> atomic_write_text(target, "{}")
+    >>> target.read_text()
+    '{}'
+    """
+    target = Path(path)
+    handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    try:
+        with os.fdopen(handle, "w", encoding="utf-8") as stream:
+            stream.write(text)
+            stream.flush()
+            os.fsync(stream.fileno())
+        os.replace(temporary, target)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise

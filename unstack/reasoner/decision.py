@@ -1,0 +1,222 @@
+"""Decision making (§IV): unload the box of minimum expected cost (Eqs. 11-13).
+
+``EC(A_j) = sum_i P(w_i^c) c_ij`` (Eq. 13) with the additive cost of Eq. 11 equals
+``sum_Y w_Y P(S_jY = 1 | consistent)``, so the decision needs only the conditional
+marginals, which the exact engine computes without listing worlds; the SAT method lists
+the worlds (Table II) and sums them.
+
+Ties. Boxes whose EC is within ``1e-12 * max(1, min EC)`` of the minimum are tied; the
+choice among them is the smallest id in Unicode code-point order. The rule depends on the
+ids only, so reordering the boxes in the input never changes the choice.
+
+Examples
+--------
+>>> from unstack.supports import Supports
+>>> supports = Supports(["top", "bottom"], [[0.0, 0.1], [0.9, 0.0]])
+>>> decision = decide(supports)
+>>> decision.choice
+'top'
+>>> decision.expected_costs.round(3).tolist()
+[0.1, 0.9]
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from unstack.errors import UnstackError
+from unstack.reasoner.consistency import PREORDER_COUNTS
+from unstack.reasoner.costs import cost_weights, expected_costs
+from unstack.reasoner.marginals import EXACT_MAX_BOXES
+from unstack.reasoner.pruning import Evidence, propagate_evidence
+from unstack.reasoner.worlds import SAT_MAX_BOXES
+from unstack.supports import Supports
+
+__all__ = [
+    "AUTO_SAT_MAX_BOXES",
+    "DECISION_FORMAT",
+    "METHODS",
+    "TIE_TOLERANCE",
+    "Decision",
+    "choose",
+    "decide",
+]
+
+DECISION_FORMAT = "unstack.decision/1"
+#: Reasoning methods: ``exact`` (weighted preorder counting), ``sat`` (list worlds).
+METHODS = ("auto", "exact", "sat")
+#: ``auto`` lists worlds with SAT up to this size (faster than loading the compiled
+#: engine there) and uses the exact engine above it; see docs/benchmarks.md.
+AUTO_SAT_MAX_BOXES = 4
+#: Relative tolerance under which two expected costs count as tied.
+TIE_TOLERANCE = 1e-12
+
+
+@dataclass(frozen=True, eq=False)
+class Decision:
+    """Which box to unload first, and why.
+
+    Attributes
+    ----------
+    objects : tuple of str
+        Box ids (the order of every array).
+    choice : str
+        The box to unload first.
+    expected_costs : numpy.ndarray, shape (n,)
+        ``EC(A_j)`` for each box.
+    marginals : numpy.ndarray, shape (n, n)
+        ``P(SUPP(objects[i], objects[j]) | consistent)``.
+    method : str
+        ``"exact"`` or ``"sat"``.
+    cost : str
+        ``"count"`` or ``"mass"``.
+    consistent_worlds : int or None
+        Number of consistent worlds of non-zero probability, when the method counted them.
+    ties : tuple of str
+        Every box whose EC equals the minimum (the choice is the smallest id).
+    evidence : Evidence
+        Hard evidence after propagation.
+    seconds : float
+        Wall time of the reasoning.
+    """
+
+    objects: tuple[str, ...]
+    choice: str
+    expected_costs: np.ndarray
+    marginals: np.ndarray
+    method: str
+    cost: str
+    consistent_worlds: int | None
+    ties: tuple[str, ...]
+    evidence: Evidence
+    seconds: float = field(default=0.0)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``unstack.decision/1`` JSON object."""
+        data: dict[str, Any] = {
+            "format": DECISION_FORMAT,
+            "objects": list(self.objects),
+            "choice": self.choice,
+            "expected_costs": self.expected_costs.tolist(),
+            "marginals": self.marginals.tolist(),
+            "method": self.method,
+            "cost": self.cost,
+        }
+        if self.consistent_worlds is not None:
+            data["consistent_worlds"] = self.consistent_worlds
+        data["ties"] = list(self.ties)
+        data["evidence"] = {
+            "forced": [list(pair) for pair in self.evidence.forced],
+            "forbidden": [list(pair) for pair in self.evidence.forbidden],
+        }
+        data["seconds"] = round(self.seconds, 6)
+        return data
+
+
+def choose(objects: tuple[str, ...], costs: np.ndarray) -> tuple[str, tuple[str, ...]]:
+    """Pick the minimum-EC box; ties (within :data:`TIE_TOLERANCE`) go to the smallest id.
+
+    Examples
+    --------
+    >>> choose(("b", "a", "c"), np.array([0.5, 0.5, 0.7]))
+    ('a', ('a', 'b'))
+    """
+    lowest = float(np.min(costs))
+    tolerance = TIE_TOLERANCE * max(1.0, abs(lowest))
+    tied = tuple(sorted(objects[i] for i in np.flatnonzero(costs <= lowest + tolerance)))
+    return tied[0], tied
+
+
+def _resolve_method(method: str, n: int) -> str:
+    if method not in METHODS:
+        raise UnstackError(f"unknown method {method!r}; expected one of {', '.join(METHODS)}")
+    if method == "auto":
+        if n <= AUTO_SAT_MAX_BOXES:
+            return "sat"
+        if n > EXACT_MAX_BOXES:
+            raise _too_large_for_all(n)
+        return "exact"
+    return method
+
+
+def _too_large_for_all(n: int) -> UnstackError:
+    from unstack.errors import TooLarge
+
+    return TooLarge(
+        f"{n} detected boxes: exact reasoning is limited to {EXACT_MAX_BOXES} boxes "
+        f"({n} boxes have {PREORDER_COUNTS[n] if n < len(PREORDER_COUNTS) else 'over 1e13'} "
+        "consistent worlds); decide on a subset of the detected boxes"
+    )
+
+
+def decide(
+    supports: Supports,
+    *,
+    method: str = "auto",
+    cost: str = "count",
+    max_boxes: int | None = None,
+) -> Decision:
+    """Choose the box to unload first (Eq. 12) from pairwise support probabilities.
+
+    Parameters
+    ----------
+    supports : Supports
+        Detected boxes and ``P(SUPP(X, Y))`` for every ordered pair.
+    method : {"auto", "exact", "sat"}
+        ``exact``: weighted counting of preorders (no world list, up to 8 boxes by
+        default); ``sat``: list the consistent worlds with CaDiCaL (up to 6 boxes);
+        ``auto``: the faster of the two for the size.
+    cost : {"count", "mass"}
+        Eq. 11 (number of supported boxes) or their total mass (needs masses).
+    max_boxes : int, optional
+        Override the method's size limit.
+
+    Returns
+    -------
+    Decision
+
+    Raises
+    ------
+    NoConsistentWorld
+        Hard evidence contradicts transitivity (the message names the relations).
+    TooLarge
+        The scene is beyond the method's limit.
+    """
+    start = time.perf_counter()
+    n = supports.n_objects
+    weights = cost_weights(supports, cost)
+    chosen_method = _resolve_method(method, n)
+    evidence = propagate_evidence(supports.objects, supports.probabilities)
+    if n == 1:
+        marginals = np.zeros((1, 1))
+        worlds: int | None = 1
+    elif chosen_method == "sat":
+        from unstack.reasoner.worlds import enumerate_worlds
+
+        world_set = enumerate_worlds(supports, max_boxes=max_boxes or SAT_MAX_BOXES)
+        marginals = world_set.marginals()
+        worlds = len(world_set)
+    else:
+        from unstack.reasoner.marginals import exact_marginals
+
+        result = exact_marginals(evidence.probabilities, max_boxes=max_boxes or EXACT_MAX_BOXES)
+        marginals = result.marginals
+        worlds = result.consistent_worlds
+    costs = expected_costs(marginals, weights)
+    choice, ties = choose(supports.objects, costs)
+    return Decision(
+        objects=supports.objects,
+        choice=choice,
+        expected_costs=costs,
+        marginals=marginals,
+        method=chosen_method,
+        cost=cost,
+        consistent_worlds=worlds,
+        ties=ties,
+        evidence=evidence,
+        seconds=time.perf_counter() - start,
+    )

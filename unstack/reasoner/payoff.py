@@ -1,0 +1,73 @@
+"""The payoff matrix of Table II: consistent worlds, their probabilities, action costs.
+
+``c_ij`` is the cost of unloading box ``j`` first in world ``i`` (Eq. 11: the number of
+boxes it supports, or their total mass), and ``EC(A_j) = sum_i P(w_i^c) c_ij`` (Eq. 13).
+Only small scenes: the matrix has one row per consistent world.
+
+Examples
+--------
+>>> from unstack.supports import Supports
+>>> table = payoff_matrix(Supports(["a", "b"], [[0, 0.9], [0.0, 0]]))
+>>> table.costs.tolist()
+[[0.0, 0.0], [1.0, 0.0]]
+>>> table.expected_costs().round(3).tolist()
+[0.9, 0.0]
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from unstack.reasoner.costs import cost_weights
+from unstack.reasoner.worlds import SAT_MAX_BOXES, WorldSet, enumerate_worlds
+from unstack.supports import Supports
+
+__all__ = ["PayoffMatrix", "payoff_matrix"]
+
+
+@dataclass(frozen=True, eq=False)
+class PayoffMatrix:
+    """Table II for one scene.
+
+    Attributes
+    ----------
+    worlds : WorldSet
+        The consistent worlds and their probabilities ``pw_i``.
+    costs : numpy.ndarray, shape (q', n)
+        ``costs[i, j]`` = cost of unloading box ``j`` first in world ``i``.
+    cost : str
+        ``"count"`` (Eq. 11) or ``"mass"``.
+    """
+
+    worlds: WorldSet
+    costs: np.ndarray
+    cost: str
+
+    @property
+    def objects(self) -> tuple[str, ...]:
+        """Box ids (the actions, in order)."""
+        return self.worlds.objects
+
+    def expected_costs(self) -> np.ndarray:
+        """``EC(A_j)`` of every box (Eq. 13)."""
+        return np.asarray(self.worlds.probabilities @ self.costs)
+
+
+def payoff_matrix(supports: Supports, *, cost: str = "count", max_boxes: int = SAT_MAX_BOXES) -> PayoffMatrix:
+    """Build Table II by listing the consistent worlds with the SAT solver.
+
+    Parameters
+    ----------
+    supports : Supports
+        The detected boxes and their support probabilities.
+    cost : {"count", "mass"}
+        Eq. 11 (number of supported boxes) or the total supported mass.
+    max_boxes : int
+        Largest scene accepted.
+    """
+    weights = cost_weights(supports, cost)
+    worlds = enumerate_worlds(supports, max_boxes=max_boxes)
+    costs = worlds.worlds.astype(np.float64) @ weights
+    return PayoffMatrix(worlds, costs, cost)

@@ -1,0 +1,295 @@
+"""Boxes and scenes: the data model of a pile in a container (``unstack.scene/1``).
+
+Units are metres and kilograms; the world frame has z up and x pointing from the
+container door into the container; quaternions are scalar-last ``[x, y, z, w]``.
+
+Examples
+--------
+>>> from unstack.scene import Box, Scene
+>>> floor_box = Box("b1", size=[0.6, 0.4, 0.4], position=[1.0, 0.0, 0.2])
+>>> top_box = Box("b2", size=[0.4, 0.3, 0.3], position=[1.0, 0.0, 0.55])
+>>> scene = Scene([floor_box, top_box], points=[[0.7, 0.0, 0.5]], detected=["b2", "b1"])
+>>> scene.detected
+('b2', 'b1')
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from unstack.checks import check_ids, check_points, check_quaternion_xyzw, check_vector
+from unstack.errors import InvalidScene
+from unstack.jsonio import Document, atomic_write_text, read_document, validate_document
+
+__all__ = ["SCENE_FORMAT", "Box", "Scene", "load_points", "load_scene"]
+
+SCENE_FORMAT = "unstack.scene/1"
+
+
+@dataclass(frozen=True, eq=False)
+class Box:
+    """A carton box: a cuboid with a pose.
+
+    Parameters
+    ----------
+    id : str
+        Unique in its scene.
+    size : array-like, shape (3,)
+        Full edge lengths along the box's own axes, metres, all positive.
+    position : array-like, shape (3,)
+        Centroid in the world frame, metres.
+    orientation_xyzw : array-like, shape (4,), optional
+        Unit quaternion, scalar last; identity by default. Normalised if within
+        :data:`unstack.checks.QUATERNION_NORM_TOLERANCE` of unit norm.
+    mass : float, optional
+        Kilograms.
+
+    Examples
+    --------
+    >>> Box("b1", [0.6, 0.4, 0.4], [1.0, 0.0, 0.2]).orientation_xyzw
+    array([0., 0., 0., 1.])
+    """
+
+    id: str
+    size: np.ndarray
+    position: np.ndarray
+    orientation_xyzw: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 0.0, 1.0]))
+    mass: float | None = None
+
+    def __init__(
+        self,
+        id: str,  # noqa: A002 - the JSON key
+        size: Any,
+        position: Any,
+        orientation_xyzw: Any = (0.0, 0.0, 0.0, 1.0),
+        mass: float | None = None,
+        *,
+        source: str = "<array>",
+        path: str = "$",
+    ) -> None:
+        if not isinstance(id, str) or not id:
+            raise InvalidScene(source, f"{path}.id", f"expected a non-empty string id, got {id!r}")
+        object.__setattr__(self, "id", id)
+        object.__setattr__(
+            self, "size", check_vector(size, 3, positive=True, source=source, path=f"{path}.size")
+        )
+        object.__setattr__(self, "position", check_vector(position, 3, source=source, path=f"{path}.position"))
+        object.__setattr__(
+            self,
+            "orientation_xyzw",
+            check_quaternion_xyzw(orientation_xyzw, source=source, path=f"{path}.orientation_xyzw"),
+        )
+        if mass is not None:
+            mass = float(check_vector([mass], 1, positive=True, source=source, path=f"{path}.mass")[0])
+        object.__setattr__(self, "mass", mass)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The box as a JSON object of ``unstack.scene/1``."""
+        data: dict[str, Any] = {
+            "id": self.id,
+            "size": self.size.tolist(),
+            "position": self.position.tolist(),
+            "orientation_xyzw": self.orientation_xyzw.tolist(),
+        }
+        if self.mass is not None:
+            data["mass"] = self.mass
+        return data
+
+
+def load_points(path: str | os.PathLike[str], *, source: str = "<file>", json_path: str = "$.points_file") -> np.ndarray:
+    """Read a point cloud from ``.npy`` (N x 3 numbers) or ``.ply`` (vertex x, y, z).
+
+    ``.npy`` files are read with ``allow_pickle=False``: loading never runs code.
+
+    Raises
+    ------
+    InvalidScene
+        The file is missing, a directory, unreadable or not an N x 3 cloud.
+    """
+    file = Path(path)
+    if file.is_dir():
+        raise InvalidScene(source, json_path, f"expected a point cloud file, got the directory {str(file)!r}")
+    if not file.exists():
+        raise InvalidScene(source, json_path, f"point cloud file {str(file)!r} does not exist")
+    try:
+        if file.suffix.lower() == ".npy":
+            array = np.load(file, allow_pickle=False)
+        elif file.suffix.lower() == ".ply":
+            from plyfile import PlyData
+
+            vertices = PlyData.read(str(file))["vertex"]
+            array = np.column_stack([vertices["x"], vertices["y"], vertices["z"]])
+        else:
+            raise InvalidScene(source, json_path, f"expected a .npy or .ply file, got {file.name!r}")
+    except InvalidScene:
+        raise
+    except Exception as error:  # noqa: BLE001 - any reader failure is the file's fault
+        raise InvalidScene(source, json_path, f"cannot read point cloud {file.name!r}: {error}") from None
+    return check_points(array, source=source, path=json_path)
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """A pile of boxes, its point cloud, the detected boxes and optional ground truth.
+
+    Parameters
+    ----------
+    boxes : sequence of Box
+        Every box of the scene; ids unique.
+    points : array-like, shape (N, 3)
+        The scene's point cloud, world frame (may be empty).
+    detected : sequence of str
+        Ids of the detected boxes (the ISet), in the reasoner's order.
+    ground_truth : array-like, shape (n_boxes, n_boxes), optional
+        0/1 support matrix aligned with ``boxes``: ``[i, j] = 1`` iff box i supports box j.
+    metadata : dict, optional
+        Free-form information kept when saving.
+    source : str, optional
+        Where the scene came from, for error messages.
+    """
+
+    boxes: tuple[Box, ...]
+    points: np.ndarray
+    detected: tuple[str, ...]
+    ground_truth: np.ndarray | None = None
+    metadata: dict[str, Any] = field(default_factory=dict)
+    source: str = "<array>"
+
+    def __init__(
+        self,
+        boxes: Sequence[Box],
+        points: Any,
+        detected: Sequence[str],
+        ground_truth: Any = None,
+        metadata: dict[str, Any] | None = None,
+        source: str = "<array>",
+        *,
+        points_path: str = "$.points",
+    ) -> None:
+        boxes = tuple(boxes)
+        if not boxes:
+            raise InvalidScene(source, "$.boxes", "expected at least one box, got an empty list")
+        ids: dict[str, int] = {}
+        for index, box in enumerate(boxes):
+            if box.id in ids:
+                raise InvalidScene(
+                    source, f"$.boxes[{index}].id", f"duplicate id {box.id!r} (also at index {ids[box.id]})"
+                )
+            ids[box.id] = index
+        detected_ids = check_ids(detected, source=source, path="$.detected", error=InvalidScene)
+        for index, object_id in enumerate(detected_ids):
+            if object_id not in ids:
+                raise InvalidScene(source, f"$.detected[{index}]", f"expected the id of a box, got unknown id {object_id!r}")
+        truth = None
+        if ground_truth is not None:
+            from unstack.checks import check_probability_matrix
+
+            truth = check_probability_matrix(
+                ground_truth, len(boxes), source=source, path="$.ground_truth.support", error=InvalidScene
+            )
+            bad = np.argwhere((truth != 0) & (truth != 1))
+            if bad.size:
+                i, j = bad[0]
+                raise InvalidScene(source, f"$.ground_truth.support[{i}][{j}]", f"expected 0 or 1, got {truth[i, j]}")
+            truth.setflags(write=False)
+        cloud = check_points(points, source=source, path=points_path)
+        cloud.setflags(write=False)
+        object.__setattr__(self, "boxes", boxes)
+        object.__setattr__(self, "points", cloud)
+        object.__setattr__(self, "detected", detected_ids)
+        object.__setattr__(self, "ground_truth", truth)
+        object.__setattr__(self, "metadata", dict(metadata or {}))
+        object.__setattr__(self, "source", source)
+
+    @property
+    def box_ids(self) -> tuple[str, ...]:
+        """Ids of all boxes, in order."""
+        return tuple(box.id for box in self.boxes)
+
+    def box(self, box_id: str) -> Box:
+        """The box with this id."""
+        for box in self.boxes:
+            if box.id == box_id:
+                return box
+        raise KeyError(f"unknown box id {box_id!r}")
+
+    def detected_ground_truth(self) -> np.ndarray | None:
+        """The ground-truth support matrix restricted to the detected boxes, in their order."""
+        if self.ground_truth is None:
+            return None
+        order = [self.box_ids.index(object_id) for object_id in self.detected]
+        return self.ground_truth[np.ix_(order, order)]
+
+    def to_dict(self, points_file: str | None = None) -> dict[str, Any]:
+        """The ``unstack.scene/1`` JSON object (points inline unless ``points_file`` is given)."""
+        data: dict[str, Any] = {"format": SCENE_FORMAT, "boxes": [box.to_dict() for box in self.boxes]}
+        if points_file is None:
+            data["points"] = self.points.tolist()
+        else:
+            data["points_file"] = points_file
+        data["detected"] = list(self.detected)
+        if self.ground_truth is not None:
+            data["ground_truth"] = {"support": self.ground_truth.astype(int).tolist()}
+        if self.metadata:
+            data["metadata"] = self.metadata
+        return data
+
+    def save(self, path: str | os.PathLike[str], *, points_file: str | None = None) -> None:
+        """Write the scene atomically; with ``points_file`` the cloud goes to that ``.npy`` beside it."""
+        target = Path(path)
+        if points_file is not None:
+            cloud_path = target.parent / points_file
+            temporary = cloud_path.with_name(f".{cloud_path.name}.tmp.npy")
+            np.save(temporary, self.points)
+            os.replace(temporary, cloud_path)
+        atomic_write_text(target, json.dumps(self.to_dict(points_file), indent=2) + "\n")
+
+    @classmethod
+    def from_document(cls, document: Document) -> Scene:
+        """Build from a parsed document: schema first, then the semantic checks."""
+        validate_document(document, [SCENE_FORMAT], InvalidScene)
+        data = document.data
+        source = document.source
+        boxes = [
+            Box(
+                item["id"],
+                item["size"],
+                item["position"],
+                item["orientation_xyzw"],
+                item.get("mass"),
+                source=source,
+                path=f"$.boxes[{index}]",
+            )
+            for index, item in enumerate(data["boxes"])
+        ]
+        if "points_file" in data:
+            points = load_points(document.base_dir / data["points_file"], source=source)
+            points_path = "$.points_file"
+        else:
+            points = check_points(data["points"], source=source)
+            points_path = "$.points"
+        truth = data.get("ground_truth", {}).get("support")
+        return cls(
+            boxes, points, data["detected"], truth, data.get("metadata"), source, points_path=points_path
+        )
+
+
+def load_scene(path: str | os.PathLike[str]) -> Scene:
+    """Read an ``unstack.scene/1`` file (``"-"`` reads standard input).
+
+    A ``points_file`` is resolved relative to the JSON file (to the working folder for
+    standard input).
+
+    Raises
+    ------
+    InvalidFile
+        With the file name, the JSON path and what was expected.
+    """
+    return Scene.from_document(read_document(path))

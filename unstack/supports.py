@@ -1,0 +1,163 @@
+"""Support probabilities between detected boxes: the ``unstack.supports/1`` format.
+
+This is what the reasoner consumes and what a planner with its own classifier hands in:
+``probabilities[i, j] = P(SUPP(objects[i], objects[j]))``, row supports column, diagonal 0.
+
+Examples
+--------
+>>> from unstack.supports import Supports
+>>> supports = Supports(["a", "b"], [[0, 0.9], [0.05, 0]])
+>>> supports.probability("a", "b")
+0.9
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from unstack.checks import check_ids, check_probability_matrix, check_vector
+from unstack.errors import InvalidSupports
+from unstack.jsonio import Document, atomic_write_text, read_document, validate_document
+
+__all__ = ["SUPPORTS_FORMAT", "Supports", "load_supports"]
+
+SUPPORTS_FORMAT = "unstack.supports/1"
+
+
+@dataclass(frozen=True, eq=False)
+class Supports:
+    """Pairwise support probabilities of ``n`` detected boxes.
+
+    Parameters
+    ----------
+    objects : sequence of str
+        Unique box ids; the order of the matrix rows and columns.
+    probabilities : array-like, shape (n, n)
+        ``P(SUPP(objects[i], objects[j]))``; 0 and 1 are hard evidence; diagonal 0.
+    masses : array-like, shape (n,), optional
+        Box masses in kg, for the mass-weighted cost.
+    metadata : dict, optional
+        Free-form provenance, kept when saving.
+    source : str, optional
+        Where the values came from (a file name), used in error messages.
+
+    Examples
+    --------
+    >>> Supports(["top", "bottom"], [[0, 0.1], [0.8, 0]]).n_objects
+    2
+    """
+
+    objects: tuple[str, ...]
+    probabilities: np.ndarray
+    masses: np.ndarray | None = None
+    metadata: dict[str, Any] = field(default_factory=dict)
+    source: str = "<array>"
+
+    def __init__(
+        self,
+        objects: Sequence[str],
+        probabilities: Any,
+        masses: Any = None,
+        metadata: dict[str, Any] | None = None,
+        source: str = "<array>",
+    ) -> None:
+        ids = check_ids(objects, source=source)
+        matrix = check_probability_matrix(probabilities, len(ids), source=source)
+        matrix.setflags(write=False)
+        mass_vector = None
+        if masses is not None:
+            mass_vector = check_vector(
+                masses, len(ids), positive=True, source=source, path="$.masses", error=InvalidSupports
+            )
+            mass_vector.setflags(write=False)
+        object.__setattr__(self, "objects", ids)
+        object.__setattr__(self, "probabilities", matrix)
+        object.__setattr__(self, "masses", mass_vector)
+        object.__setattr__(self, "metadata", dict(metadata or {}))
+        object.__setattr__(self, "source", source)
+
+    @property
+    def n_objects(self) -> int:
+        """Number of boxes."""
+        return len(self.objects)
+
+    def index(self, object_id: str) -> int:
+        """Position of a box id in :attr:`objects`."""
+        try:
+            return self.objects.index(object_id)
+        except ValueError:
+            raise KeyError(f"unknown object id {object_id!r}") from None
+
+    def probability(self, supporter: str, supported: str) -> float:
+        """``P(SUPP(supporter, supported))`` as given (before the consistency step)."""
+        return float(self.probabilities[self.index(supporter), self.index(supported)])
+
+    def subset(self, object_ids: Sequence[str]) -> Supports:
+        """The same probabilities restricted to (and reordered as) ``object_ids``.
+
+        Examples
+        --------
+        >>> s = Supports(["a", "b", "c"], [[0, .5, .2], [.1, 0, .3], [.4, .6, 0]])
+        >>> s.subset(["c", "a"]).probabilities.tolist()
+        [[0.0, 0.4], [0.2, 0.0]]
+        """
+        order = [self.index(object_id) for object_id in object_ids]
+        masses = None if self.masses is None else self.masses[order]
+        return Supports(
+            list(object_ids), self.probabilities[np.ix_(order, order)], masses, self.metadata, self.source
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``unstack.supports/1`` JSON object."""
+        data: dict[str, Any] = {
+            "format": SUPPORTS_FORMAT,
+            "objects": list(self.objects),
+            "probabilities": self.probabilities.tolist(),
+        }
+        if self.masses is not None:
+            data["masses"] = self.masses.tolist()
+        if self.metadata:
+            data["metadata"] = self.metadata
+        return data
+
+    def save(self, path: str | os.PathLike[str]) -> None:
+        """Write the ``unstack.supports/1`` file atomically."""
+        atomic_write_text(path, json.dumps(self.to_dict(), indent=2) + "\n")
+
+    @classmethod
+    def from_document(cls, document: Document) -> Supports:
+        """Build from a parsed, schema-checked document (semantic checks happen here)."""
+        validate_document(document, [SUPPORTS_FORMAT], InvalidSupports)
+        data = document.data
+        return cls(
+            data["objects"],
+            data["probabilities"],
+            data.get("masses"),
+            data.get("metadata"),
+            source=document.source,
+        )
+
+
+def load_supports(path: str | os.PathLike[str]) -> Supports:
+    """Read an ``unstack.supports/1`` file (``"-"`` reads standard input).
+
+    Raises
+    ------
+    InvalidFile
+        With the file name, the JSON path and what was expected.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> file = pathlib.Path(tempfile.mkdtemp()) / "pair.json"
+    >>> Supports(["a", "b"], [[0, 0.9], [0.2, 0]]).save(file)
+    >>> load_supports(file).objects
+    ('a', 'b')
+    """
+    return Supports.from_document(read_document(path))
