@@ -88,6 +88,8 @@ def _last_level(
     n_ups: int,
     down_weights: np.ndarray,
     up_weights: np.ndarray,
+    down_allowed: np.ndarray,
+    up_allowed: np.ndarray,
     down_table: np.ndarray,
     up_table: np.ndarray,
     scratch_ups: np.ndarray,
@@ -98,19 +100,18 @@ def _last_level(
     """Sum the last box's admissible ``(D, U)`` pairs without expanding leaves."""
     n_live = 0
     for b in range(n_ups):
-        g = up_weights[j, ups[b]]
-        if g != 0.0:
+        if up_allowed[j, ups[b]]:
             scratch_ups[n_live] = ups[b]
-            scratch_weights[n_live] = g
+            scratch_weights[n_live] = up_weights[j, ups[b]]
             scratch_sums[n_live] = 0.0
             n_live += 1
     total = 0.0
     count = 0
     for a in range(n_downs):
         d = downs[a]
-        f = down_weights[j, d]
-        if f == 0.0:
+        if not down_allowed[j, d]:
             continue
+        f = down_weights[j, d]
         outside = ~above[a]
         up_sum = 0.0
         for b in range(n_live):
@@ -121,7 +122,7 @@ def _last_level(
         down_table[j, d] += path_weight * f * up_sum
         total += f * up_sum
     for b in range(n_live):
-        if scratch_sums[b] != 0.0:
+        if scratch_sums[b] > 0.0:
             up_table[j, scratch_ups[b]] += path_weight * scratch_weights[b] * scratch_sums[b]
     world_count[0] += count
     return total
@@ -139,17 +140,19 @@ def _next_pair(
     n_ups: int,
     down_weights: np.ndarray,
     up_weights: np.ndarray,
+    down_allowed: np.ndarray,
+    up_allowed: np.ndarray,
 ) -> tuple[int, int]:
     """Return the next admissible non-zero ``(D, U)`` index pair at or after ``(a, b)``.
 
     Returns ``(n_downs, 0)`` when the node's pairs are exhausted.
     """
     while a < n_downs:
-        if down_weights[j, downs[j, a]] != 0.0:
+        if down_allowed[j, downs[j, a]]:
             outside = ~above[j, a]
             while b < n_ups:
                 u = ups[j, b]
-                if u & outside == 0 and up_weights[j, u] != 0.0:
+                if u & outside == 0 and up_allowed[j, u]:
                     return a, b
                 b += 1
         a += 1
@@ -169,6 +172,8 @@ def _subtree(
     n_ups: np.ndarray,
     down_weights: np.ndarray,
     up_weights: np.ndarray,
+    down_allowed: np.ndarray,
+    up_allowed: np.ndarray,
     down_table: np.ndarray,
     up_table: np.ndarray,
     scratch_ups: np.ndarray,
@@ -185,7 +190,7 @@ def _subtree(
     if start == n - 1:
         return _last_level(
             start, start_weight, downs[start], above[start], n_downs[start], ups[start],
-            n_ups[start], down_weights, up_weights, down_table, up_table,
+            n_ups[start], down_weights, up_weights, down_allowed, up_allowed, down_table, up_table,
             scratch_ups, scratch_weights, scratch_sums, world_count,
         )
     cursor_down = np.zeros(n, dtype=np.int64)
@@ -199,7 +204,7 @@ def _subtree(
         j = level
         a, b = _next_pair(
             j, cursor_down[j], cursor_up[j], downs, above, ups, n_downs[j], n_ups[j],
-            down_weights, up_weights,
+            down_weights, up_weights, down_allowed, up_allowed,
         )
         if a < n_downs[j]:
             d = downs[j, a]
@@ -221,7 +226,7 @@ def _subtree(
                 continue
             sub = _last_level(
                 j + 1, path_weight[j] * w, downs[j + 1], above[j + 1], n_downs[j + 1],
-                ups[j + 1], n_ups[j + 1], down_weights, up_weights, down_table, up_table,
+                ups[j + 1], n_ups[j + 1], down_weights, up_weights, down_allowed, up_allowed, down_table, up_table,
                 scratch_ups, scratch_weights, scratch_sums, world_count,
             )
         else:
@@ -240,7 +245,13 @@ def _subtree(
 
 @njit(cache=True, nogil=True)
 def collect_tasks(
-    n: int, depth: int, max_tasks: int, down_weights: np.ndarray, up_weights: np.ndarray
+    n: int,
+    depth: int,
+    max_tasks: int,
+    down_weights: np.ndarray,
+    up_weights: np.ndarray,
+    down_allowed: np.ndarray,
+    up_allowed: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Split the insertion tree at level ``depth`` into independent subtrees.
 
@@ -289,7 +300,7 @@ def collect_tasks(
             continue
         a, b = _next_pair(
             j, cursor_down[j], cursor_up[j], downs, above, ups, n_downs[j], n_ups[j],
-            down_weights, up_weights,
+            down_weights, up_weights, down_allowed, up_allowed,
         )
         if a == n_downs[j]:
             if j == 0:
@@ -325,6 +336,8 @@ def run_tasks(
     task_sizes: np.ndarray,
     down_weights: np.ndarray,
     up_weights: np.ndarray,
+    down_allowed: np.ndarray,
+    up_allowed: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
     """Expand every task's subtree in parallel.
 
@@ -357,7 +370,7 @@ def run_tasks(
             ups[depth, b] = task_ups[t, b]
         subtree_sums[t] = _subtree(
             depth, n, task_weight[t], downs, above, ups, n_downs, n_ups,
-            down_weights, up_weights, down_tables[t], up_tables[t],
+            down_weights, up_weights, down_allowed, up_allowed, down_tables[t], up_tables[t],
             scratch_ups, scratch_weights, scratch_sums, world_counts[t],
         )
     return subtree_sums, down_tables.sum(axis=0), up_tables.sum(axis=0), world_counts.sum()

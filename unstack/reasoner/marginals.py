@@ -63,8 +63,13 @@ class ExactMarginals:
     log_partition: float
 
 
-def _level_weights(probabilities: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Tables ``f[j, D]`` and ``g[j, U]``: the weight of box j's relations to boxes < j."""
+def _level_weights(probabilities: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Tables ``f[j, D]`` and ``g[j, U]`` (the weight of box j's relations to boxes < j)
+    and whether each is allowed at all (no relation of probability exactly 0 or 1 broken).
+
+    The allowed tables keep pruning and counting structural: a product of tiny but
+    non-zero factors may underflow to 0.0 without making its worlds impossible.
+    """
     n = probabilities.shape[0]
     scale = np.maximum(probabilities, 1.0 - probabilities)
     present = probabilities / scale
@@ -72,18 +77,26 @@ def _level_weights(probabilities: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     width = 1 << max(n - 1, 0)
     down_weights = np.zeros((n, width))
     up_weights = np.zeros((n, width))
+    down_allowed = np.zeros((n, width), dtype=np.bool_)
+    up_allowed = np.zeros((n, width), dtype=np.bool_)
     masks = np.arange(width)
     for j in range(n):
         members = masks[: 1 << j]
         f = np.ones(1 << j)
         g = np.ones(1 << j)
+        f_allowed = np.ones(1 << j, dtype=bool)
+        g_allowed = np.ones(1 << j, dtype=bool)
         for x in range(j):
             has_x = ((members >> x) & 1).astype(bool)
             f *= np.where(has_x, present[x, j], absent[x, j])
             g *= np.where(has_x, present[j, x], absent[j, x])
+            f_allowed &= np.where(has_x, probabilities[x, j] > 0, probabilities[x, j] < 1)
+            g_allowed &= np.where(has_x, probabilities[j, x] > 0, probabilities[j, x] < 1)
         down_weights[j, : 1 << j] = f
         up_weights[j, : 1 << j] = g
-    return down_weights, up_weights
+        down_allowed[j, : 1 << j] = f_allowed
+        up_allowed[j, : 1 << j] = g_allowed
+    return down_weights, up_weights, down_allowed, up_allowed
 
 
 def _split_depth(n: int) -> int:
@@ -129,13 +142,13 @@ def exact_marginals(probabilities: np.ndarray, *, max_boxes: int = EXACT_MAX_BOX
             f"(n = {max_boxes + 1} has {PREORDER_COUNTS[max_boxes + 1]:.2g} consistent worlds; "
             f"n = 8 takes seconds, each further box about 100 times longer)"
         )
-    down_weights, up_weights = _level_weights(np.ascontiguousarray(probabilities, dtype=np.float64))
+    tables = _level_weights(np.ascontiguousarray(probabilities, dtype=np.float64))
     depth = min(_split_depth(n), n - 1)
-    tasks = kernels.collect_tasks(n, depth, PREORDER_COUNTS[depth], down_weights, up_weights)
+    tasks = kernels.collect_tasks(n, depth, PREORDER_COUNTS[depth], *tables)
     task_weight, task_downs, task_above, task_ups, task_sizes, path_downs, path_ups = tasks
     with parallel_chunksize(1):
         subtree_sums, down_table, up_table, world_count = kernels.run_tasks(
-            n, depth, task_weight, task_downs, task_above, task_ups, task_sizes, down_weights, up_weights
+            n, depth, task_weight, task_downs, task_above, task_ups, task_sizes, *tables
         )
     contributions = task_weight * subtree_sums
     for level in range(depth):

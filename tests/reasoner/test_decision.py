@@ -1,0 +1,134 @@
+"""Decisions (Eqs. 11-13): properties that hold for any input, ties, costs, methods."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from unstack.errors import NoConsistentWorld, TooLarge, UnstackError
+from unstack.reasoner import decide
+from unstack.supports import Supports
+
+probability_values = st.one_of(
+    st.floats(0.0, 1.0, allow_nan=False),
+    st.sampled_from([0.0, 1.0, 0.5, 0.01, 0.99]),
+)
+
+
+@st.composite
+def support_matrices(draw: st.DrawFn, max_n: int = 5) -> np.ndarray:
+    n = draw(st.integers(1, max_n))
+    values = draw(arrays(np.float64, (n, n), elements=st.floats(0.0, 1.0, allow_nan=False)))
+    np.fill_diagonal(values, 0.0)
+    return values
+
+
+def ids(n: int) -> list[str]:
+    return [f"box{i}" for i in range(n)]
+
+
+FAST = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+@FAST
+@given(support_matrices())
+def test_marginals_are_probabilities_and_costs_are_row_sums(probabilities: np.ndarray) -> None:
+    try:
+        decision = decide(Supports(ids(len(probabilities)), probabilities), method="exact")
+    except NoConsistentWorld:
+        return
+    assert np.all((decision.marginals >= 0) & (decision.marginals <= 1))
+    assert np.all(np.diag(decision.marginals) == 0)
+    np.testing.assert_allclose(decision.expected_costs, decision.marginals.sum(axis=1), atol=1e-12)
+    assert decision.choice in decision.ties
+    assert decision.expected_costs[decision.objects.index(decision.choice)] == pytest.approx(
+        decision.expected_costs.min(), abs=1e-12
+    )
+
+
+@FAST
+@given(support_matrices(), st.randoms(use_true_random=False))
+def test_permuting_the_boxes_permutes_every_output(probabilities: np.ndarray, random: object) -> None:
+    n = len(probabilities)
+    order = list(range(n))
+    random.shuffle(order)  # type: ignore[attr-defined]
+    names = ids(n)
+    try:
+        original = decide(Supports(names, probabilities), method="exact")
+    except NoConsistentWorld:
+        return
+    permuted = decide(Supports([names[i] for i in order], probabilities[np.ix_(order, order)]), method="exact")
+    np.testing.assert_allclose(permuted.marginals, original.marginals[np.ix_(order, order)], atol=1e-12)
+    np.testing.assert_allclose(permuted.expected_costs, original.expected_costs[order], atol=1e-12)
+    assert permuted.choice == original.choice
+    assert permuted.consistent_worlds == original.consistent_worlds
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(2, 7), st.integers(0, 2**32 - 1))
+def test_certain_chain_yields_its_transitive_closure(n: int, seed: int) -> None:
+    order = np.random.default_rng(seed).permutation(n)
+    closure = np.zeros((n, n))
+    for i, below in enumerate(order):
+        closure[below, order[i + 1 :]] = 1.0
+    # Certain links of the chain; the implied relations are uncertain (0.5), the rest 0.
+    probabilities = 0.5 * closure
+    for below, above in zip(order, order[1:], strict=False):
+        probabilities[below, above] = 1.0
+    decision = decide(Supports(ids(n), probabilities), method="exact")
+    np.testing.assert_array_equal(decision.marginals, closure)
+    assert decision.consistent_worlds == 1
+    assert decision.choice == f"box{order[-1]}"
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 4, 5, 6])
+def test_methods_agree(n: int, rng: np.random.Generator) -> None:
+    probabilities = rng.uniform(0.05, 0.95, (n, n))
+    np.fill_diagonal(probabilities, 0.0)
+    supports = Supports(ids(n), probabilities)
+    exact, sat = decide(supports, method="exact"), decide(supports, method="sat")
+    np.testing.assert_allclose(exact.marginals, sat.marginals, atol=1e-12)
+    assert exact.choice == sat.choice
+    assert exact.consistent_worlds == sat.consistent_worlds
+
+
+def test_one_box_costs_nothing() -> None:
+    decision = decide(Supports(["only"], [[0.0]]))
+    assert decision.choice == "only"
+    assert decision.expected_costs.tolist() == [0.0]
+    assert decision.consistent_worlds == 1
+
+
+def test_ties_go_to_the_smallest_id() -> None:
+    decision = decide(Supports(["zeta", "alpha", "mid"], np.zeros((3, 3))))
+    assert decision.ties == ("alpha", "mid", "zeta")
+    assert decision.choice == "alpha"
+
+
+def test_mass_cost_weights_supported_boxes() -> None:
+    # x supports y (light), z supports w (heavy): both have EC 0.9 boxes, masses decide.
+    probabilities = np.zeros((4, 4))
+    probabilities[0, 1] = 0.9
+    probabilities[2, 3] = 0.9
+    supports = Supports(["x", "y", "z", "w"], probabilities, masses=[1.0, 2.0, 1.0, 30.0])
+    decision = decide(supports, cost="mass")
+    np.testing.assert_allclose(decision.expected_costs, [1.8, 0.0, 27.0, 0.0])
+    assert decision.choice == "w"
+
+
+def test_mass_cost_without_masses_says_what_is_missing() -> None:
+    with pytest.raises(UnstackError, match=r"\$\.masses: the mass-weighted cost needs box masses"):
+        decide(Supports(["a", "b"], [[0, 0.5], [0.5, 0]]), cost="mass")
+
+
+def test_auto_refuses_scenes_beyond_exact_reach() -> None:
+    with pytest.raises(TooLarge, match="limited to 8 boxes"):
+        decide(Supports(ids(9), np.zeros((9, 9))))
+
+
+def test_unknown_method_is_rejected() -> None:
+    with pytest.raises(UnstackError, match="unknown method 'fast'"):
+        decide(Supports(["a"], [[0.0]]), method="fast")
