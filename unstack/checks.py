@@ -34,9 +34,7 @@ __all__ = [
 QUATERNION_NORM_TOLERANCE = 1e-3
 
 
-def _matrix(
-    value: Any, n_objects: int, source: str, path: str, error: type[InvalidFile]
-) -> np.ndarray:
+def _matrix(value: Any, n_objects: int, source: str, path: str, error: type[InvalidFile]) -> np.ndarray:
     """Turn nested lists or an array into an ``n x n`` float64 array, naming bad cells."""
     if isinstance(value, np.ndarray):
         if value.ndim != 2 or value.shape != (n_objects, n_objects):

@@ -145,9 +145,7 @@ def read_document(path: str | os.PathLike[str]) -> Document:
     if not isinstance(data, dict):
         raise InvalidFile(source, "$", f"expected a JSON object, got {type(data).__name__}")
     for bad in _find_non_finite(data, []):
-        raise InvalidFile(
-            source, format_json_path(bad), f"expected a finite number, got {_get(data, bad)}"
-        )
+        raise InvalidFile(source, format_json_path(bad), f"expected a finite number, got {_get(data, bad)}")
     return Document(data, source, base_dir)
 
 
@@ -196,9 +194,7 @@ def _describe(error: Any) -> str:
         return f"expected one of {', '.join(_short(e) for e in expected)}, got {_short(instance)}"
     if validator == "oneOf" and isinstance(instance, dict):
         options = [sorted(option.get("required", [])) for option in expected]
-        return "expected exactly one of " + " or ".join(
-            "/".join(option) for option in options if option
-        )
+        return "expected exactly one of " + " or ".join("/".join(option) for option in options if option)
     return str(error.message if len(error.message) < 120 else error.message[:117] + "...")
 
 
@@ -233,9 +229,7 @@ def validate_document(
     accepted = list(expected) if expected is not None else list(FORMATS)
     tag = document.data.get("format")
     if tag is None:
-        raise UnknownFormat(
-            document.source, "$", f"missing required key 'format' (expected {', '.join(accepted)})"
-        )
+        raise UnknownFormat(document.source, "$", f"missing required key 'format' (expected {', '.join(accepted)})")
     if tag not in accepted:
         family = str(tag).rsplit("/", 1)[0]
         same_family = [known for known in FORMATS if known.rsplit("/", 1)[0] == family]

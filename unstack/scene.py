@@ -77,9 +77,7 @@ class Box:
         if not isinstance(id, str) or not id:
             raise InvalidScene(source, f"{path}.id", f"expected a non-empty string id, got {id!r}")
         object.__setattr__(self, "id", id)
-        object.__setattr__(
-            self, "size", check_vector(size, 3, positive=True, source=source, path=f"{path}.size")
-        )
+        object.__setattr__(self, "size", check_vector(size, 3, positive=True, source=source, path=f"{path}.size"))
         object.__setattr__(self, "position", check_vector(position, 3, source=source, path=f"{path}.position"))
         object.__setattr__(
             self,
@@ -103,7 +101,9 @@ class Box:
         return data
 
 
-def load_points(path: str | os.PathLike[str], *, source: str = "<file>", json_path: str = "$.points_file") -> np.ndarray:
+def load_points(
+    path: str | os.PathLike[str], *, source: str = "<file>", json_path: str = "$.points_file"
+) -> np.ndarray:
     """Read a point cloud from ``.npy`` (N x 3 numbers) or ``.ply`` (vertex x, y, z).
 
     ``.npy`` files are read with ``allow_pickle=False``: loading never runs code.
@@ -186,7 +186,9 @@ class Scene:
         detected_ids = check_ids(detected, source=source, path="$.detected", error=InvalidScene)
         for index, object_id in enumerate(detected_ids):
             if object_id not in ids:
-                raise InvalidScene(source, f"$.detected[{index}]", f"expected the id of a box, got unknown id {object_id!r}")
+                raise InvalidScene(
+                    source, f"$.detected[{index}]", f"expected the id of a box, got unknown id {object_id!r}"
+                )
         truth = None
         if ground_truth is not None:
             from unstack.checks import check_probability_matrix
@@ -276,9 +278,7 @@ class Scene:
             points = check_points(data["points"], source=source)
             points_path = "$.points"
         truth = data.get("ground_truth", {}).get("support")
-        return cls(
-            boxes, points, data["detected"], truth, data.get("metadata"), source, points_path=points_path
-        )
+        return cls(boxes, points, data["detected"], truth, data.get("metadata"), source, points_path=points_path)
 
 
 def load_scene(path: str | os.PathLike[str]) -> Scene:

@@ -109,9 +109,7 @@ class Supports:
         """
         order = [self.index(object_id) for object_id in object_ids]
         masses = None if self.masses is None else self.masses[order]
-        return Supports(
-            list(object_ids), self.probabilities[np.ix_(order, order)], masses, self.metadata, self.source
-        )
+        return Supports(list(object_ids), self.probabilities[np.ix_(order, order)], masses, self.metadata, self.source)
 
     def to_dict(self) -> dict[str, Any]:
         """The ``unstack.supports/1`` JSON object."""

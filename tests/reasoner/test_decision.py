@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -76,7 +78,7 @@ def test_certain_chain_yields_its_transitive_closure(n: int, seed: int) -> None:
         closure[below, order[i + 1 :]] = 1.0
     # Certain links of the chain; the implied relations are uncertain (0.5), the rest 0.
     probabilities = 0.5 * closure
-    for below, above in zip(order, order[1:], strict=False):
+    for below, above in itertools.pairwise(order):
         probabilities[below, above] = 1.0
     decision = decide(Supports(ids(n), probabilities), method="exact")
     np.testing.assert_array_equal(decision.marginals, closure)

@@ -69,7 +69,7 @@ def test_partition_below_the_guard_is_a_clear_error(monkeypatch: pytest.MonkeyPa
     probabilities[0, 1] = probabilities[1, 2] = 1 - 1e-16
     np.fill_diagonal(probabilities, 0.0)
     monkeypatch.setattr(marginals_module, "SMALLEST_PARTITION", 1e-10)  # the real guard is 1e-280
-    with pytest.raises(NumericalRangeError, match="too extreme for float64.*--method sat"):
+    with pytest.raises(NumericalRangeError, match=r"too extreme for float64.*--method sat"):
         exact_marginals(probabilities)
 
 
@@ -79,5 +79,5 @@ def test_size_limit_is_a_clear_error() -> None:
 
 
 def test_sat_size_limit_is_a_clear_error() -> None:
-    with pytest.raises(TooLarge, match="limited to 6 boxes .* use the exact marginals engine"):
+    with pytest.raises(TooLarge, match=r"limited to 6 boxes .* use the exact marginals engine"):
         enumerate_worlds(supports_of(np.zeros((7, 7))))

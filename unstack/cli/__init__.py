@@ -1,8 +1,8 @@
 """The ``unstack`` command line: thin click commands over the library.
 
-Every user mistake becomes one line on standard error and exit code 2.
+The commands live in :mod:`unstack.cli.main` (entry point ``unstack``, or
+``python -m unstack``). Every user mistake becomes one line on standard error and exit
+code 2.
 """
 
-from unstack.cli.main import cli, main
-
-__all__ = ["cli", "main"]
+__all__: list[str] = []

@@ -78,7 +78,9 @@ def cli() -> None:
 @cli.command()
 @click.argument("file", type=str)
 @click.option("--json", "as_json", is_flag=True, help="Print the decision as unstack.decision/1 JSON.")
-@click.option("-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON decision to this file (atomically).")
+@click.option(
+    "-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON decision to this file (atomically)."
+)
 @click.option(
     "--method",
     type=click.Choice(["auto", "exact", "sat"]),

@@ -42,7 +42,9 @@ def decision_view(decision: Decision) -> Group:
     footer = Text(f"method {decision.method}{worlds}{hard}, {decision.seconds:.3f} s", style="dim")
     headline = Text.assemble(("Unload first: ", "bold"), (decision.choice, "bold green"))
     if len(decision.ties) > 1:
-        headline.append(f"  (tied with {', '.join(t for t in decision.ties if t != decision.choice)}; smallest id wins)")
+        headline.append(
+            f"  (tied with {', '.join(t for t in decision.ties if t != decision.choice)}; smallest id wins)"
+        )
     return Group(headline, costs, matrix, footer)
 
 
@@ -51,7 +53,9 @@ def payoff_view(table: PayoffMatrix, limit: int) -> Group:
     objects = table.objects
     worlds = table.worlds
     order = sorted(range(len(worlds)), key=lambda i: -worlds.probabilities[i])[:limit]
-    view = Table(title="Payoff matrix (Table II): consistent worlds, P(w), cost of unloading each box", title_justify="left")
+    view = Table(
+        title="Payoff matrix (Table II): consistent worlds, P(w), cost of unloading each box", title_justify="left"
+    )
     view.add_column("world", justify="right")
     view.add_column("P(w)", justify="right")
     view.add_column("support relations")
@@ -68,8 +72,10 @@ def payoff_view(table: PayoffMatrix, limit: int) -> Group:
     expected = table.expected_costs()
     view.add_section()
     view.add_row("EC", "", "", *(f"{c:.4f}" for c in expected))
-    shown = f"showing the {len(order)} most probable of {len(worlds):,} consistent worlds" if len(order) < len(
-        worlds
-    ) else f"{len(worlds):,} consistent worlds"
+    shown = (
+        f"showing the {len(order)} most probable of {len(worlds):,} consistent worlds"
+        if len(order) < len(worlds)
+        else f"{len(worlds):,} consistent worlds"
+    )
     note = Text(f"{shown}; 'x>y' means x supports y", style="dim")
     return Group(view, note)

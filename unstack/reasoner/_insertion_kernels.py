@@ -106,7 +106,7 @@ def _last_level(
             scratch_sums[n_live] = 0.0
             n_live += 1
     total = 0.0
-    count = 0
+    count = np.int64(0)
     for a in range(n_downs):
         d = downs[a]
         if not down_allowed[j, d]:
@@ -189,9 +189,23 @@ def _subtree(
     """
     if start == n - 1:
         return _last_level(
-            start, start_weight, downs[start], above[start], n_downs[start], ups[start],
-            n_ups[start], down_weights, up_weights, down_allowed, up_allowed, down_table, up_table,
-            scratch_ups, scratch_weights, scratch_sums, world_count,
+            start,
+            start_weight,
+            downs[start],
+            above[start],
+            n_downs[start],
+            ups[start],
+            n_ups[start],
+            down_weights,
+            up_weights,
+            down_allowed,
+            up_allowed,
+            down_table,
+            up_table,
+            scratch_ups,
+            scratch_weights,
+            scratch_sums,
+            world_count,
         )
     cursor_down = np.zeros(n, dtype=np.int64)
     cursor_up = np.zeros(n, dtype=np.int64)
@@ -203,8 +217,18 @@ def _subtree(
     while True:
         j = level
         a, b = _next_pair(
-            j, cursor_down[j], cursor_up[j], downs, above, ups, n_downs[j], n_ups[j],
-            down_weights, up_weights, down_allowed, up_allowed,
+            j,
+            cursor_down[j],
+            cursor_up[j],
+            downs,
+            above,
+            ups,
+            n_downs[j],
+            n_ups[j],
+            down_weights,
+            up_weights,
+            down_allowed,
+            up_allowed,
         )
         if a < n_downs[j]:
             d = downs[j, a]
@@ -214,8 +238,17 @@ def _subtree(
             cursor_up[j] = b + 1
             chosen_weight[j] = w
             n_downs[j + 1], n_ups[j + 1] = _child_lists(
-                j, d, u, downs[j], above[j], n_downs[j], ups[j], n_ups[j],
-                downs[j + 1], above[j + 1], ups[j + 1],
+                j,
+                d,
+                u,
+                downs[j],
+                above[j],
+                n_downs[j],
+                ups[j],
+                n_ups[j],
+                downs[j + 1],
+                above[j + 1],
+                ups[j + 1],
             )
             if j + 1 < n - 1:
                 level = j + 1
@@ -225,13 +258,27 @@ def _subtree(
                 subtotal[level] = 0.0
                 continue
             sub = _last_level(
-                j + 1, path_weight[j] * w, downs[j + 1], above[j + 1], n_downs[j + 1],
-                ups[j + 1], n_ups[j + 1], down_weights, up_weights, down_allowed, up_allowed, down_table, up_table,
-                scratch_ups, scratch_weights, scratch_sums, world_count,
+                j + 1,
+                path_weight[j] * w,
+                downs[j + 1],
+                above[j + 1],
+                n_downs[j + 1],
+                ups[j + 1],
+                n_ups[j + 1],
+                down_weights,
+                up_weights,
+                down_allowed,
+                up_allowed,
+                down_table,
+                up_table,
+                scratch_ups,
+                scratch_weights,
+                scratch_sums,
+                world_count,
             )
         else:
             if j == start:
-                return subtotal[j]
+                return float(subtotal[j])
             sub = subtotal[j]
             j -= 1
             level = j
@@ -299,8 +346,18 @@ def collect_tasks(
             level = j - 1
             continue
         a, b = _next_pair(
-            j, cursor_down[j], cursor_up[j], downs, above, ups, n_downs[j], n_ups[j],
-            down_weights, up_weights, down_allowed, up_allowed,
+            j,
+            cursor_down[j],
+            cursor_up[j],
+            downs,
+            above,
+            ups,
+            n_downs[j],
+            n_ups[j],
+            down_weights,
+            up_weights,
+            down_allowed,
+            up_allowed,
         )
         if a == n_downs[j]:
             if j == 0:
@@ -312,16 +369,30 @@ def collect_tasks(
         cursor_down[j] = a
         cursor_up[j] = b + 1
         n_downs[j + 1], n_ups[j + 1] = _child_lists(
-            j, d, u, downs[j], above[j], n_downs[j], ups[j], n_ups[j],
-            downs[j + 1], above[j + 1], ups[j + 1],
+            j,
+            d,
+            u,
+            downs[j],
+            above[j],
+            n_downs[j],
+            ups[j],
+            n_ups[j],
+            downs[j + 1],
+            above[j + 1],
+            ups[j + 1],
         )
         level = j + 1
         cursor_down[level] = 0
         cursor_up[level] = 0
         path_weight[level] = path_weight[j] * down_weights[j, d] * up_weights[j, u]
     return (
-        task_weight[:t], task_downs[:t], task_above[:t], task_ups[:t], task_sizes[:t],
-        task_path_downs[:t], task_path_ups[:t],
+        task_weight[:t],
+        task_downs[:t],
+        task_above[:t],
+        task_ups[:t],
+        task_sizes[:t],
+        task_path_downs[:t],
+        task_path_ups[:t],
     )
 
 
@@ -369,8 +440,23 @@ def run_tasks(
         for b in range(n_ups[depth]):
             ups[depth, b] = task_ups[t, b]
         subtree_sums[t] = _subtree(
-            depth, n, task_weight[t], downs, above, ups, n_downs, n_ups,
-            down_weights, up_weights, down_allowed, up_allowed, down_tables[t], up_tables[t],
-            scratch_ups, scratch_weights, scratch_sums, world_counts[t],
+            depth,
+            n,
+            task_weight[t],
+            downs,
+            above,
+            ups,
+            n_downs,
+            n_ups,
+            down_weights,
+            up_weights,
+            down_allowed,
+            up_allowed,
+            down_tables[t],
+            up_tables[t],
+            scratch_ups,
+            scratch_weights,
+            scratch_sums,
+            world_counts[t],
         )
     return subtree_sums, down_tables.sum(axis=0), up_tables.sum(axis=0), world_counts.sum()

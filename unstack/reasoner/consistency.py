@@ -25,7 +25,17 @@ __all__ = ["PREORDER_COUNTS", "is_transitive", "transitivity_clauses"]
 
 #: Number of consistent worlds (preorders) on n = 0, 1, 2, ... labelled boxes, OEIS A000798.
 PREORDER_COUNTS: tuple[int, ...] = (
-    1, 1, 4, 29, 355, 6942, 209527, 9535241, 642779354, 63260289423, 8977053873043,
+    1,
+    1,
+    4,
+    29,
+    355,
+    6942,
+    209527,
+    9535241,
+    642779354,
+    63260289423,
+    8977053873043,
 )
 
 
@@ -38,8 +48,7 @@ def transitivity_clauses(variables: SupportVariables) -> list[list[int]]:
     6
     """
     return [
-        [-variables.id(x, y), -variables.id(y, z), variables.id(x, z)]
-        for x, y, z in permutations(variables.objects, 3)
+        [-variables.id(x, y), -variables.id(y, z), variables.id(x, z)] for x, y, z in permutations(variables.objects, 3)
     ]
 
 

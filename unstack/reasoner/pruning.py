@@ -27,6 +27,7 @@ np.float64(1.0)
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -96,7 +97,7 @@ def propagate_evidence(objects: Sequence[str], probabilities: np.ndarray) -> Evi
     if conflicts.size:
         a, b = (int(v) for v in conflicts[0])
         chain = nx.shortest_path(forced_graph, a, b)
-        links = [(objects[u], objects[v]) for u, v in zip(chain, chain[1:], strict=False)]
+        links = [(objects[u], objects[v]) for u, v in itertools.pairwise(chain)]
         reason = " and ".join(f"P({_name(u, v)}) = 1" for u, v in links)
         raise NoConsistentWorld(
             f"no consistent world: {reason} force {_name(objects[a], objects[b])} by transitivity, "

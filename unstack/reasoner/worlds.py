@@ -67,7 +67,8 @@ class WorldSet:
 
     def marginals(self) -> np.ndarray:
         """``P(S_xy = 1 | consistent)`` as an ``n x n`` matrix."""
-        return np.einsum("i,ixy->xy", self.probabilities, self.worlds.astype(np.float64))
+        marginals: np.ndarray = np.einsum("i,ixy->xy", self.probabilities, self.worlds.astype(np.float64))
+        return marginals
 
 
 def log_world_weights(worlds: np.ndarray, probabilities: np.ndarray) -> np.ndarray:

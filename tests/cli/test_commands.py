@@ -1,0 +1,156 @@
+"""The ``unstack`` commands, run as a user runs them (a subprocess per call)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import jsonschema
+import numpy as np
+import pytest
+
+from unstack.jsonio import load_schema
+
+PILE5 = "examples/pile5.supports.json"
+
+
+def unstack(*args: str, stdin: str | None = None, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "unstack", *args],
+        input=stdin,
+        capture_output=True,
+        text=True,
+        cwd=cwd or Path(__file__).resolve().parents[2],
+        timeout=300,
+    )
+
+
+def test_decide_prints_a_table() -> None:
+    result = unstack("decide", PILE5)
+    assert result.returncode == 0, result.stderr
+    assert "Unload first: top_left" in result.stdout
+    assert "P(row supports column | consistent world)" in result.stdout
+    assert "6,942 consistent worlds" in result.stdout
+
+
+def test_decide_json_follows_the_decision_schema() -> None:
+    result = unstack("decide", PILE5, "--json")
+    document = json.loads(result.stdout)
+    jsonschema.validate(document, load_schema("unstack.decision/1"))
+    assert document["choice"] == "top_left"
+    assert document["consistent_worlds"] == 6942
+    costs = np.array(document["expected_costs"])
+    np.testing.assert_allclose(costs, np.array(document["marginals"]).sum(axis=1), atol=1e-12)
+
+
+def test_decide_reads_stdin_and_writes_output_atomically(tmp_path: Path, repo: Path) -> None:
+    output = tmp_path / "decision.json"
+    text = (repo / PILE5).read_text()
+    result = unstack("decide", "-", "--output", str(output), stdin=text)
+    assert result.returncode == 0, result.stderr
+    assert json.loads(output.read_text())["choice"] == "top_left"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["decision.json"]
+
+
+@pytest.mark.parametrize("method", ["exact", "sat"])
+def test_methods_give_the_same_choice(method: str) -> None:
+    document = json.loads(unstack("decide", PILE5, "--json", "--method", method).stdout)
+    assert document["method"] == method
+    assert document["choice"] == "top_left"
+
+
+def test_mass_cost() -> None:
+    document = json.loads(unstack("decide", PILE5, "--json", "--cost", "mass").stdout)
+    assert document["cost"] == "mass"
+    assert max(document["expected_costs"]) > 10
+
+
+def test_worlds_shows_table_ii() -> None:
+    result = unstack("worlds", "examples/evidence3.supports.json")
+    assert result.returncode == 0, result.stderr
+    assert "Payoff matrix (Table II)" in result.stdout
+    assert "2 consistent worlds" in result.stdout
+    document = json.loads(unstack("worlds", "examples/evidence3.supports.json", "--json").stdout)
+    assert document["consistent_worlds"] == 2
+    assert sum(world["probability"] for world in document["worlds"]) == pytest.approx(1.0)
+
+
+def test_worlds_refuses_large_scenes() -> None:
+    result = unstack("worlds", "examples/pile7.supports.json")
+    assert result.returncode == 2
+    assert "limited to 6 boxes" in result.stderr
+
+
+def test_validate_reports_each_file(tmp_path: Path, repo: Path) -> None:
+    decision = tmp_path / "d.json"
+    unstack("decide", PILE5, "-o", str(decision))
+    result = unstack("validate", *sorted(str(p) for p in (repo / "examples").glob("*.json")), str(decision))
+    assert result.returncode == 0, result.stderr
+    assert "valid unstack.scene/1 (3 boxes, 3 detected, 900 points)" in result.stdout
+    assert "valid unstack.decision/1" in result.stdout
+
+
+BAD = [
+    pytest.param("{oops", "invalid JSON at line 1 column 2", id="malformed"),
+    pytest.param(
+        '{"format": "unstack.supports/7", "objects": ["a"], "probabilities": [[0]]}',
+        "unsupported version",
+        id="version",
+    ),
+    pytest.param(
+        '{"format": "unstack.supports/1", "objects": ["a", "b"], "probabilities": [[0, 1], [0.5]]}',
+        r"$.probabilities[1]: expected 2 numbers",
+        id="ragged",
+    ),
+    pytest.param(
+        '{"format": "unstack.supports/1", "objects": ["a", "b", "c"], "probabilities": [[0, 1, 0], [0, 0, 1], [0.5, 0.5, 0]]}',
+        "no consistent world: P(SUPP(a, b)) = 1 and P(SUPP(b, c)) = 1 force SUPP(a, c)",
+        id="contradiction",
+    ),
+]
+
+
+@pytest.mark.parametrize(("text", "message"), BAD)
+@pytest.mark.parametrize("command", ["decide", "worlds"])
+def test_bad_input_is_one_line_exit_2_and_no_output(tmp_path: Path, text: str, message: str, command: str) -> None:
+    source = tmp_path / "bad.json"
+    source.write_text(text)
+    output = tmp_path / "out.json"
+    result = unstack(command, str(source), "--output", str(output))
+    assert result.returncode == 2
+    assert result.stderr.count("\n") == 1, result.stderr
+    assert result.stderr.startswith(f"unstack: error: {source}: ") or "no consistent world" in result.stderr
+    assert message in result.stderr
+    assert "Traceback" not in result.stderr
+    assert not output.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.json"]
+
+
+def test_scene_file_needs_a_model() -> None:
+    result = unstack("decide", "examples/scene3.json")
+    assert result.returncode == 2
+    assert "needs a learned support model" in result.stderr
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["decide", "missing.json"], "missing.json: $: no such file"),
+        (["decide", "examples"], "examples: $: expected a JSON file, got a directory"),
+        (["decide", PILE5, "--output", "no/such/dir/out.json"], "No such file or directory"),
+        (["validate", "examples/scene3.json", "missing.json"], "missing.json: $: no such file"),
+    ],
+)
+def test_file_problems(args: list[str], message: str) -> None:
+    result = unstack(*args)
+    assert result.returncode == 2
+    assert message in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_usage_errors_exit_2() -> None:
+    result = unstack("decide", PILE5, "--method", "magic")
+    assert result.returncode == 2
+    assert "Invalid value for '--method'" in result.stderr

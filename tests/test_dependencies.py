@@ -1,0 +1,49 @@
+"""Dependencies point one way: the reasoner and ``unstack decide`` never load heavy parts."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+HEAVY = ("sklearn", "pybullet", "scipy", "matplotlib", "dask", "torch")
+
+PROBE = """
+import json, sys
+sys.argv = ["unstack", "decide", {file!r}, "--json", "--method", {method!r}]
+from unstack.cli.main import main
+try:
+    main()
+except SystemExit:
+    pass
+sys.stderr.write(json.dumps(sorted(sys.modules)))
+"""
+
+
+@pytest.mark.parametrize("method", ["exact", "sat"])
+def test_decide_on_a_supports_file_imports_nothing_heavy(repo: Path, method: str) -> None:
+    probe = PROBE.format(file=str(repo / "examples" / "pile5.supports.json"), method=method)
+    result = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300, check=True)
+    modules = json.loads(result.stderr)
+    assert json.loads(result.stdout)["choice"] == "top_left"
+    loaded = {name.split(".")[0] for name in modules}
+    assert not loaded & set(HEAVY), sorted(loaded & set(HEAVY))
+
+
+def test_importing_the_reasoner_loads_no_learning_or_simulation(repo: Path) -> None:
+    code = "import sys, unstack.reasoner; print(' '.join(sorted(sys.modules)))"
+    modules = set(
+        subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    )
+    assert not {name.split(".")[0] for name in modules} & set(HEAVY)
+    assert "unstack.learning" not in modules and "unstack.sim" not in modules
+
+
+def test_reasoner_source_does_not_import_learning_or_sim(repo: Path) -> None:
+    for path in (repo / "unstack" / "reasoner").glob("*.py"):
+        text = path.read_text()
+        for forbidden in ("sklearn", "pybullet", "unstack.learning", "unstack.sim", "unstack.cli"):
+            assert f"import {forbidden}" not in text and f"from {forbidden}" not in text, (path.name, forbidden)

@@ -1,0 +1,44 @@
+"""The repository's own rules: ruff and mypy clean, CI runs exactly the README's test command."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+
+def run(repo: Path, *args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", *args], cwd=repo, capture_output=True, text=True, timeout=600)
+
+
+def test_ruff_is_clean(repo: Path) -> None:
+    result = run(repo, "ruff", "check", "unstack", "tests", "benchmarks")
+    assert result.returncode == 0, result.stdout + result.stderr
+
+
+def test_mypy_is_clean(repo: Path) -> None:
+    result = run(repo, "mypy")
+    assert result.returncode == 0, result.stdout + result.stderr
+
+
+def readme_command(repo: Path, marker: str) -> str:
+    lines = (repo / "README.md").read_text().splitlines()
+    for index, line in enumerate(lines):
+        if marker in line:
+            return lines[index + 1].strip()
+    raise AssertionError(f"README has no line after {marker!r}")
+
+
+def test_ci_runs_exactly_the_readme_test_command(repo: Path) -> None:
+    command = readme_command(repo, "<!-- test-command -->")
+    assert command in (repo / ".ci" / "run").read_text().splitlines()
+
+
+@pytest.mark.skipif(shutil.which("git") is None, reason="git not installed")
+def test_readme_main_job_names_a_bundled_example(repo: Path) -> None:
+    command = readme_command(repo, "<!-- main-job -->")
+    example = command.split("unstack decide ", 1)[1].split()[0]
+    assert (repo / example).is_file()
