@@ -22,8 +22,8 @@ Examples
 >>> result = exact_marginals(half)
 >>> result.consistent_worlds
 29
->>> round(float(result.marginals[0, 1]), 6)  # 13 of the 29 preorders on 3 boxes have a -> b
-0.448276
+>>> round(float(result.marginals[0, 1]), 6)  # 12 of the 29 preorders on 3 boxes have a -> b
+0.413793
 """
 
 from __future__ import annotations
