@@ -1,0 +1,48 @@
+"""The docs site builds with ``mkdocs build --strict`` and shows every schema field."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import REPO
+
+SCHEMAS = sorted((REPO / "unstack" / "schemas").glob("*.schema.json"))
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("site")
+    result = subprocess.run(
+        [sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(out)],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert result.returncode == 0, result.stdout + result.stderr
+    return out
+
+
+def test_every_page_is_built(site: Path) -> None:
+    for page in ("quickstart", "formats", "reasoner", "benchmarks", "reference"):
+        assert (site / page / "index.html").is_file(), page
+
+
+@pytest.mark.parametrize("schema_file", SCHEMAS, ids=lambda path: path.name)
+def test_formats_page_lists_every_schema_field(site: Path, schema_file: Path) -> None:
+    html = (site / "formats" / "index.html").read_text()
+    schema = json.loads(schema_file.read_text())
+    assert schema["title"] in html
+    for field in schema["properties"]:
+        assert f"$.{field}" in html, field
+
+
+def test_reference_page_renders_the_docstrings(site: Path) -> None:
+    html = (site / "reference" / "index.html").read_text()
+    assert "Choose the box to unload first" in html
+    assert "NoConsistentWorld" in html
