@@ -42,6 +42,7 @@ FORMATS: dict[str, str] = {
     "unstack.supports/1": "supports-1.schema.json",
     "unstack.scene/1": "scene-1.schema.json",
     "unstack.decision/1": "decision-1.schema.json",
+    "unstack.dataset/1": "dataset-1.schema.json",
 }
 
 STDIN_NAME = "<stdin>"
@@ -251,6 +252,12 @@ def validate_document(
     return str(tag)
 
 
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 def atomic_write_text(path: str | os.PathLike[str], text: str) -> None:
     """Write ``text`` to ``path`` atomically: a temporary file in the same folder, then a rename.
 
@@ -271,6 +278,7 @@ def atomic_write_text(path: str | os.PathLike[str], text: str) -> None:
             stream.write(text)
             stream.flush()
             os.fsync(stream.fileno())
+        os.chmod(temporary, 0o666 & ~_umask())
         os.replace(temporary, target)
     except BaseException:
         Path(temporary).unlink(missing_ok=True)

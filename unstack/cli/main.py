@@ -1,4 +1,4 @@
-"""``unstack`` commands: ``decide``, ``worlds``, ``validate``.
+"""``unstack`` commands: ``decide``, ``worlds``, ``validate``, ``simulate``, ``render``.
 
 Each command is a thin layer over the library: read and validate the input, call one
 library function, render the result. ``UnstackError`` (and unwritable outputs) become a
@@ -163,9 +163,21 @@ def validate(files: tuple[str, ...]) -> None:
         elif tag == "unstack.scene/1":
             scene = Scene.from_document(document)
             detail = f"{len(scene.boxes)} boxes, {len(scene.detected)} detected, {len(scene.points):,} points"
+        elif tag == "unstack.dataset/1":
+            detail = f"{document.data['configs']} configurations, seed {document.data['seed']}"
         else:
             detail = f"choice {document.data['choice']!r}"
         click.echo(f"{document.source}: valid {tag} ({detail})")
+
+
+def _register_simulation_commands() -> None:
+    from unstack.cli.simulation import render, simulate
+
+    cli.add_command(simulate)
+    cli.add_command(render)
+
+
+_register_simulation_commands()
 
 
 def main() -> None:

@@ -1,0 +1,184 @@
+"""One simulated configuration: pile, ground truth, scan, as an ``unstack.scene/1`` scene.
+
+Every configuration of a data set has its own seed, derived from the data set's seed and
+the configuration's index (``SeedSequence(seed, spawn_key=(index,))``), so a
+configuration comes out bit-identical whichever worker makes it and in whatever order.
+
+Examples
+--------
+>>> from unstack.sim.settings import Container, SensorSettings, SimulationSettings
+>>> settings = SimulationSettings(boxes=(3, 3), container=Container(depth=1.0),
+...                               sensor=SensorSettings(width=80, height=60, min_pixels=5))
+>>> result = simulate_configuration(settings, seed=7, index=0)
+>>> len(result.scene.boxes), result.scene.ground_truth.shape
+(3, (3, 3))
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from importlib import metadata as importlib_metadata
+from typing import Any
+
+import numpy as np
+
+from unstack.scene import Box, Scene
+from unstack.sim.ground_truth import RemovalResponse, removal_responses, support_labels, transitivity_violations
+from unstack.sim.piles import Pile, build_pile
+from unstack.sim.sensor import scan_pile
+from unstack.sim.settings import SimulationSettings
+
+__all__ = ["SimulatedConfiguration", "config_name", "configuration_seed", "simulate_configuration"]
+
+#: Re-settling rounds for a pile that creeps before it is rejected and rebuilt.
+CREEP_RESETTLES = 2
+#: Piles built for one configuration before giving up on a creep-free one.
+MAX_PILES = 4
+
+
+@dataclass(frozen=True)
+class SimulatedConfiguration:
+    """A finished configuration.
+
+    Attributes
+    ----------
+    index : int
+        Its index in the data set.
+    scene : Scene
+        Boxes, point cloud, detectable boxes (as ``detected``), ground truth, and in
+        ``metadata["simulation"]`` the raw removal responses and the settings' seed.
+    point_boxes : numpy.ndarray, shape (N,)
+        Box index of every point (-1: container).
+    timings : dict
+        CPU seconds of each phase (not part of the scene: they differ between runs).
+    """
+
+    index: int
+    scene: Scene
+    point_boxes: np.ndarray
+    timings: dict[str, float]
+
+
+def config_name(index: int) -> str:
+    """File stem of configuration ``index`` in a data set folder."""
+    return f"config-{index:04d}"
+
+
+def configuration_seed(seed: int, index: int) -> np.random.SeedSequence:
+    """The seed of configuration ``index`` of a data set seeded with ``seed``."""
+    return np.random.SeedSequence(seed, spawn_key=(index,))
+
+
+def _versions() -> dict[str, str]:
+    versions = {}
+    for package in ("unstack", "pybullet", "numpy"):
+        try:
+            versions[package] = importlib_metadata.version(package)
+        except importlib_metadata.PackageNotFoundError:  # pragma: no cover
+            versions[package] = "unknown"
+    return versions
+
+
+def _creep_free_responses(pile: Pile, settings: SimulationSettings) -> tuple[RemovalResponse, int] | None:
+    truth = settings.ground_truth
+    for resettle in range(CREEP_RESETTLES + 1):
+        if resettle:
+            pile.world.settle()
+        response = removal_responses(pile.world, truth)
+        if (
+            response.baseline_displacement <= truth.creep_displacement
+            and response.baseline_rotation_deg <= truth.creep_rotation_deg
+        ):
+            return response, resettle
+    return None
+
+
+def simulate_configuration(settings: SimulationSettings, *, seed: int, index: int) -> SimulatedConfiguration:
+    """Build, label and scan configuration ``index`` of the data set seeded with ``seed``.
+
+    Raises
+    ------
+    InvalidSettings
+        No creep-free pile in :data:`MAX_PILES` attempts, or the pile cannot be built.
+    """
+    from unstack.sim.settings import InvalidSettings
+
+    count_seed, *pile_seeds = configuration_seed(seed, index).spawn(MAX_PILES + 1)
+    low, high = settings.boxes
+    count = int(np.random.default_rng(count_seed).integers(low, high + 1))
+    timings: dict[str, float] = {"generation": 0.0, "ground_truth": 0.0, "scan": 0.0}
+    for attempt, pile_seed in enumerate(pile_seeds):
+        clock = time.process_time()
+        pile = build_pile(settings, count=count, seed=pile_seed)
+        with pile:
+            timings["generation"] += time.process_time() - clock
+            clock = time.process_time()
+            found = _creep_free_responses(pile, settings)
+            timings["ground_truth"] += time.process_time() - clock
+            if found is None:
+                continue
+            response, resettles = found
+            clock = time.process_time()
+            scan = scan_pile(pile.world, settings.sensor, seed=pile_seed.spawn(1)[0])
+            timings["scan"] = time.process_time() - clock
+            positions, orientations = pile.world.poses([box.body for box in pile.boxes])
+            scene = _scene(settings, seed, index, attempt, resettles, pile, response, scan, positions, orientations)
+            return SimulatedConfiguration(index, scene, scan.point_boxes, timings)
+    raise InvalidSettings(f"configuration {index}: every one of {MAX_PILES} piles kept creeping; settle longer")
+
+
+def _scene(
+    settings: SimulationSettings,
+    seed: int,
+    index: int,
+    attempt: int,
+    resettles: int,
+    pile: Pile,
+    response: RemovalResponse,
+    scan: Any,
+    positions: np.ndarray,
+    orientations: np.ndarray,
+) -> Scene:
+    width = max(2, len(str(len(pile.boxes) - 1)))
+    ids = [f"b{k:0{width}d}" for k in range(len(pile.boxes))]
+    boxes = [
+        Box(ids[k], box.size, positions[k], orientations[k] / np.linalg.norm(orientations[k]), box.mass)
+        for k, box in enumerate(pile.boxes)
+    ]
+    truth_settings = settings.ground_truth
+    labels = support_labels(
+        response.displacement,
+        response.rotation_deg,
+        displacement_threshold=truth_settings.displacement_threshold,
+        rotation_threshold_deg=truth_settings.rotation_threshold_deg,
+    )
+    detectable = [ids[k] for k in np.flatnonzero(scan.pixel_counts >= settings.sensor.min_pixels)]
+    violated, premises = transitivity_violations(labels)
+    simulation = {
+        "seed": seed,
+        "index": index,
+        "pile_attempt": attempt,
+        "creep_resettles": resettles,
+        "refills": pile.refills,
+        "pixel_counts": scan.pixel_counts.tolist(),
+        "removal": {
+            "displacement_m": response.displacement.tolist(),
+            "rotation_deg": response.rotation_deg.tolist(),
+            "baseline_displacement_m": response.baseline_displacement,
+            "baseline_rotation_deg": response.baseline_rotation_deg,
+        },
+        "transitivity": {"violated": violated, "premises": premises},
+        "versions": _versions(),
+    }
+    return Scene(
+        boxes,
+        scan.points,
+        detectable or ids[:1],
+        labels,
+        metadata={
+            "simulation": simulation,
+            "settings": settings.to_dict(),
+            "point_boxes_file": f"{config_name(index)}.point_boxes.npy",
+        },
+    )

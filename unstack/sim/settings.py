@@ -1,0 +1,260 @@
+"""Settings of a simulated data set: container, box sizes, piles, ground truth, sensor.
+
+Every number of the simulator is a field here, with the default measured for it (see
+the docs page on simulation). Settings are plain frozen dataclasses that round-trip
+through JSON, so a data set's manifest records exactly what made it, and a re-run with
+other settings into the same folder is refused.
+
+Examples
+--------
+>>> settings = SimulationSettings(boxes=(10, 20), sizes="four", container=Container(depth=1.0))
+>>> settings.box_sizes().shape
+(4, 3)
+>>> SimulationSettings.from_dict(settings.to_dict()) == settings
+True
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from unstack.errors import UnstackError
+
+__all__ = [
+    "SIZE_SETS",
+    "Container",
+    "GroundTruthSettings",
+    "InvalidSettings",
+    "PileSettings",
+    "SensorSettings",
+    "SimulationSettings",
+]
+
+#: Named box-size sets: full edge lengths in metres. ``paper2`` are the paper's two sizes
+#: (§V-A1); ``four`` adds two more for the paper's "real" setting (§V-A2).
+SIZE_SETS: dict[str, tuple[tuple[float, float, float], ...]] = {
+    "paper2": ((0.6, 0.4, 0.4), (0.4, 0.3, 0.3)),
+    "four": ((0.6, 0.4, 0.4), (0.4, 0.3, 0.3), (0.5, 0.5, 0.3), (0.3, 0.3, 0.2)),
+}
+
+
+class InvalidSettings(UnstackError):
+    """Simulation settings that cannot produce a data set."""
+
+
+@dataclass(frozen=True)
+class Container:
+    """A section of a shipping container; the door is the plane x = 0, x points inward.
+
+    Attributes
+    ----------
+    depth, width, height : float
+        Inner extent along x, y and z in metres.
+    """
+
+    depth: float = 2.0
+    width: float = 2.35
+    height: float = 2.39
+
+    @property
+    def floor_area(self) -> float:
+        """Floor area in square metres."""
+        return self.depth * self.width
+
+
+@dataclass(frozen=True)
+class PileSettings:
+    """How a pile is dropped and when it counts as settled.
+
+    Attributes
+    ----------
+    wave_size : int
+        Boxes dropped together in one wave.
+    max_tilt_deg : float
+        Roll and pitch of a dropped box are uniform in ``±max_tilt_deg``; yaw is uniform.
+    mass_range : tuple of float
+        Box masses are uniform in this range (kg).
+    friction : float
+        Lateral friction of boxes and container.
+    time_step : float
+        Physics step in seconds.
+    settle_window : float
+        Length of one settle window in seconds.
+    settle_displacement : float
+        A window is still if no box moved more than this (metres) ...
+    settle_rotation_deg : float
+        ... nor turned more than this (degrees) during it.
+    settle_windows : int
+        Still windows in a row that make a pile settled.
+    settle_max_time : float
+        Cap on one settling phase (seconds of simulated time).
+    max_refills : int
+        Rounds of "drop, open the door, delete the boxes that fell out" before giving up.
+    """
+
+    wave_size: int = 6
+    max_tilt_deg: float = 25.0
+    mass_range: tuple[float, float] = (5.0, 15.0)
+    friction: float = 0.5
+    time_step: float = 1.0 / 240.0
+    settle_window: float = 0.25
+    settle_displacement: float = 0.0005
+    settle_rotation_deg: float = 0.1
+    settle_windows: int = 2
+    settle_max_time: float = 6.0
+    max_refills: int = 6
+
+
+@dataclass(frozen=True)
+class GroundTruthSettings:
+    """Support by removal: X supports Y when taking X away makes Y move.
+
+    Attributes
+    ----------
+    horizon : float
+        Seconds simulated after a removal.
+    early_exit_after : float
+        Stop early once this much time has passed ...
+    early_exit_speed : float
+        ... and every box is slower than this (m/s).
+    displacement_threshold : float
+        Y is supported by X if it moved more than this (metres) ...
+    rotation_threshold_deg : float
+        ... or turned more than this (degrees).
+    creep_displacement : float
+        A pile whose boxes drift more than this without any removal (metres) ...
+    creep_rotation_deg : float
+        ... or turn more than this (degrees) is settled again.
+    """
+
+    horizon: float = 1.0
+    early_exit_after: float = 0.15
+    early_exit_speed: float = 0.01
+    displacement_threshold: float = 0.02
+    rotation_threshold_deg: float = 5.0
+    creep_displacement: float = 0.002
+    creep_rotation_deg: float = 0.5
+
+
+@dataclass(frozen=True)
+class SensorSettings:
+    """A pinhole range sensor at the door, rendered with pybullet's tiny renderer.
+
+    Attributes
+    ----------
+    position, target : tuple of float
+        Camera centre and the point it looks at (world frame, metres).
+    vertical_fov_deg : float
+        Vertical field of view.
+    width, height : int
+        Image size in pixels.
+    near, far : float
+        Clipping planes (metres).
+    noise : bool
+        Add depth noise with a Kinect-like model: sigma = a + b (z - c)^2 along each ray.
+    noise_coefficients : tuple of float
+        ``(a, b, c)`` of that model (metres), from Nguyen, Izadi and Lovell (2012).
+    min_pixels : int
+        A box is detectable when at least this many pixels see it.
+    """
+
+    position: tuple[float, float, float] = (-2.8, 0.0, 1.3)
+    target: tuple[float, float, float] = (1.0, 0.0, 0.9)
+    vertical_fov_deg: float = 43.0
+    width: int = 640
+    height: int = 480
+    near: float = 0.1
+    far: float = 10.0
+    noise: bool = False
+    noise_coefficients: tuple[float, float, float] = (0.0012, 0.0019, 0.4)
+    min_pixels: int = 50
+
+
+@dataclass(frozen=True)
+class SimulationSettings:
+    """Everything that determines a simulated data set, besides the seed.
+
+    Attributes
+    ----------
+    boxes : tuple of int
+        Inclusive range of the number of boxes per configuration.
+    sizes : str
+        A key of :data:`SIZE_SETS`.
+    container, pile, ground_truth, sensor
+        The parts' settings.
+    """
+
+    boxes: tuple[int, int] = (30, 40)
+    sizes: str = "paper2"
+    container: Container = field(default_factory=Container)
+    pile: PileSettings = field(default_factory=PileSettings)
+    ground_truth: GroundTruthSettings = field(default_factory=GroundTruthSettings)
+    sensor: SensorSettings = field(default_factory=SensorSettings)
+
+    def __post_init__(self) -> None:
+        low, high = self.boxes
+        if low < 1 or high < 1:
+            raise InvalidSettings(f"box counts must be positive, got {low}-{high}")
+        if low > high:
+            raise InvalidSettings(f"box range {low}-{high} is reversed; expected LOW-HIGH with LOW <= HIGH")
+        if self.sizes not in SIZE_SETS:
+            raise InvalidSettings(f"unknown size set {self.sizes!r}; expected one of {', '.join(SIZE_SETS)}")
+        container = self.container
+        if min(container.depth, container.width, container.height) <= 0:
+            raise InvalidSettings(f"container extents must be positive, got {dataclasses.astuple(container)}")
+        sizes = self.box_sizes()
+        if np.any(sizes.min(axis=1) > min(container.depth, container.width)) or np.any(
+            sizes.min(axis=1) > container.height
+        ):
+            raise InvalidSettings(f"boxes of size set {self.sizes!r} do not fit a {container.depth} m container")
+        capacity = self.capacity()
+        if high > capacity:
+            raise InvalidSettings(
+                f"{high} boxes of size set {self.sizes!r} do not fit a {container.depth} x {container.width} x "
+                f"{container.height} m container (about {capacity} fit as a loose pile)"
+            )
+
+    def box_sizes(self) -> np.ndarray:
+        """The size set as a (k, 3) float64 array of full edge lengths."""
+        return np.array(SIZE_SETS[self.sizes], dtype=np.float64)
+
+    def capacity(self) -> int:
+        """A generous upper bound on the boxes a loose pile fits: a third of the volume."""
+        container = self.container
+        volume = container.depth * container.width * container.height
+        mean_box = float(np.prod(self.box_sizes(), axis=1).mean())
+        return int(volume / 3.0 / mean_box)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON-able dict (tuples become lists)."""
+        data: dict[str, Any] = json_ready(dataclasses.asdict(self))
+        return data
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> SimulationSettings:
+        """Inverse of :meth:`to_dict`."""
+        return cls(
+            boxes=(int(data["boxes"][0]), int(data["boxes"][1])),
+            sizes=data["sizes"],
+            container=Container(**data["container"]),
+            pile=PileSettings(**_tuples(data["pile"])),
+            ground_truth=GroundTruthSettings(**data["ground_truth"]),
+            sensor=SensorSettings(**_tuples(data["sensor"])),
+        )
+
+
+def _tuples(data: dict[str, Any]) -> dict[str, Any]:
+    return {key: tuple(value) if isinstance(value, list) else value for key, value in data.items()}
+
+
+def json_ready(value: Any) -> Any:
+    """Tuples to lists, recursively, so that a dict compares equal after a JSON round trip."""
+    if isinstance(value, dict):
+        return {key: json_ready(item) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [json_ready(item) for item in value]
+    return value

@@ -1,0 +1,244 @@
+"""A pybullet world of its own: the container, the boxes, stepping and settling.
+
+Each :class:`PhysicsWorld` opens its own DIRECT client (never pybullet's global one), so
+simulations in one process do not share state and a world's result depends only on the
+calls made on it. Sleeping is disabled on every box: with sleeping on, a box whose
+support is taken away may stay asleep in the air.
+
+Examples
+--------
+>>> from unstack.sim.settings import SimulationSettings
+>>> with PhysicsWorld(SimulationSettings(boxes=(1, 1))) as world:
+...     box = world.add_box([0.4, 0.3, 0.3], [1.0, 0.0, 0.5], [0, 0, 0, 1], mass=5.0)
+...     seconds = world.settle()
+...     round(float(world.poses()[0][0, 2]), 2)   # resting on the floor: z = half its height
+0.15
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+from collections.abc import Iterator
+from types import ModuleType, TracebackType
+from typing import Any
+
+import numpy as np
+
+from unstack.sim.settings import SimulationSettings
+
+__all__ = ["PhysicsWorld", "import_pybullet", "rotation_angles_deg"]
+
+#: Wall thickness of the container's static parts (metres).
+WALL = 0.1
+#: Length of the apron in front of the door that catches boxes falling out (metres).
+APRON = 1.5
+
+
+@contextlib.contextmanager
+def _quiet_c_output() -> Iterator[None]:
+    """Silence C-level stdout and stderr: pybullet prints its build time on import and
+    ``argv[0]=`` when a client connects, which would corrupt JSON on stdout."""
+    import ctypes
+
+    libc = ctypes.CDLL(None)
+    sys.stdout.flush()
+    sys.stderr.flush()
+    libc.fflush(None)
+    saved = [os.dup(1), os.dup(2)]
+    with open(os.devnull, "wb") as devnull:
+        os.dup2(devnull.fileno(), 1)
+        os.dup2(devnull.fileno(), 2)
+    try:
+        yield
+    finally:
+        libc.fflush(None)
+        for fd, copy in zip((1, 2), saved, strict=True):
+            os.dup2(copy, fd)
+            os.close(copy)
+
+
+def import_pybullet() -> tuple[ModuleType, Any]:
+    """Import pybullet (quietly) and its ``BulletClient``; a clear error if it is missing."""
+    try:
+        with _quiet_c_output():
+            import pybullet
+            from pybullet_utils.bullet_client import BulletClient
+    except ImportError as error:  # pragma: no cover - depends on the installation
+        from unstack.errors import UnstackError
+
+        raise UnstackError(
+            "the simulator needs pybullet: pip install 'unstack[sim]' (or pip install pybullet)"
+        ) from error
+    return pybullet, BulletClient
+
+
+def rotation_angles_deg(before_xyzw: np.ndarray, after_xyzw: np.ndarray) -> np.ndarray:
+    """Angle of the rotation between two orientations, per row, in degrees.
+
+    Examples
+    --------
+    >>> half_turn = np.array([[0.0, 0.0, 1.0, 0.0]])
+    >>> rotation_angles_deg(np.array([[0.0, 0.0, 0.0, 1.0]]), half_turn).round(6).tolist()
+    [180.0]
+    """
+    dots = np.abs(np.sum(before_xyzw * after_xyzw, axis=-1))
+    angles: np.ndarray = np.degrees(2.0 * np.arccos(np.clip(dots, 0.0, 1.0)))
+    return angles
+
+
+class PhysicsWorld:
+    """The container with its static walls, a removable door and the boxes in it.
+
+    Parameters
+    ----------
+    settings : SimulationSettings
+        Container extents, friction and time step are read from it.
+    door : bool
+        Start with the temporary door wall at x = 0.
+    """
+
+    def __init__(self, settings: SimulationSettings, *, door: bool = True) -> None:
+        pybullet, bullet_client = import_pybullet()
+        self.settings = settings
+        self.pybullet = pybullet
+        with _quiet_c_output():
+            self.client = bullet_client(connection_mode=pybullet.DIRECT)
+        self.client.setGravity(0.0, 0.0, -9.81)
+        self.client.setTimeStep(settings.pile.time_step)
+        self.client.setPhysicsEngineParameter(deterministicOverlappingPairs=1)
+        self.boxes: list[int] = []
+        self.static: list[int] = []
+        self.door: int | None = None
+        self._build_container()
+        if door:
+            self.close_door()
+
+    # -- construction -------------------------------------------------------------------
+    def _static_box(self, half_extents: list[float], center: list[float]) -> int:
+        client = self.client
+        shape = client.createCollisionShape(client.GEOM_BOX, halfExtents=half_extents)
+        body = int(client.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=shape, basePosition=center))
+        client.changeDynamics(body, -1, lateralFriction=self.settings.pile.friction)
+        return body
+
+    def _build_container(self) -> None:
+        box = self.settings.container
+        depth, width, height = box.depth, box.width, box.height
+        half = WALL / 2.0
+        parts = [
+            # floor (reaching out over the apron in front of the door)
+            ([(depth + APRON) / 2.0 + WALL, width / 2.0 + WALL, half], [(depth - APRON) / 2.0, 0.0, -half]),
+            # ceiling
+            ([depth / 2.0 + WALL, width / 2.0 + WALL, half], [depth / 2.0, 0.0, height + half]),
+            # back wall
+            ([half, width / 2.0 + WALL, height / 2.0], [depth + half, 0.0, height / 2.0]),
+            # side walls
+            ([depth / 2.0, half, height / 2.0], [depth / 2.0, width / 2.0 + half, height / 2.0]),
+            ([depth / 2.0, half, height / 2.0], [depth / 2.0, -width / 2.0 - half, height / 2.0]),
+        ]
+        self.static = [self._static_box(extents, center) for extents, center in parts]
+
+    def close_door(self) -> None:
+        """Put the temporary door wall at x = 0 (boxes are dropped behind it)."""
+        if self.door is None:
+            box = self.settings.container
+            self.door = self._static_box(
+                [WALL / 2.0, box.width / 2.0, box.height / 2.0], [-WALL / 2.0, 0.0, box.height / 2.0]
+            )
+
+    def open_door(self) -> None:
+        """Take the door wall away (before the pile is saved or scanned)."""
+        if self.door is not None:
+            self.client.removeBody(self.door)
+            self.door = None
+
+    def add_box(self, size: Any, position: Any, orientation_xyzw: Any, *, mass: float) -> int:
+        """Add a dynamic box; returns its body id."""
+        client = self.client
+        half = [float(value) / 2.0 for value in size]
+        shape = client.createCollisionShape(client.GEOM_BOX, halfExtents=half)
+        visual = client.createVisualShape(client.GEOM_BOX, halfExtents=half)
+        body = int(
+            client.createMultiBody(
+                baseMass=float(mass),
+                baseCollisionShapeIndex=shape,
+                baseVisualShapeIndex=visual,
+                basePosition=[float(value) for value in position],
+                baseOrientation=[float(value) for value in orientation_xyzw],
+            )
+        )
+        client.changeDynamics(
+            body,
+            -1,
+            lateralFriction=self.settings.pile.friction,
+            activationState=client.ACTIVATION_STATE_DISABLE_SLEEPING,
+        )
+        self.boxes.append(body)
+        return body
+
+    def remove_box(self, body: int) -> None:
+        """Delete a box for good (only while building a pile, never after ``saveState``)."""
+        self.client.removeBody(body)
+        self.boxes.remove(body)
+
+    # -- state --------------------------------------------------------------------------
+    def poses(self, bodies: list[int] | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Positions (k, 3) and orientations ``xyzw`` (k, 4) of the boxes."""
+        bodies = self.boxes if bodies is None else bodies
+        positions = np.empty((len(bodies), 3))
+        orientations = np.empty((len(bodies), 4))
+        for row, body in enumerate(bodies):
+            position, orientation = self.client.getBasePositionAndOrientation(body)
+            positions[row] = position
+            orientations[row] = orientation
+        return positions, orientations
+
+    def speeds(self) -> np.ndarray:
+        """Linear speed of every box (m/s)."""
+        return np.array([np.linalg.norm(self.client.getBaseVelocity(body)[0]) for body in self.boxes])
+
+    def step(self, seconds: float) -> None:
+        """Advance the simulation by (about) ``seconds``."""
+        for _ in range(max(1, round(seconds / self.settings.pile.time_step))):
+            self.client.stepSimulation()
+
+    def settle(self, max_time: float | None = None) -> float:
+        """Step until the pile is still; returns the simulated seconds (capped).
+
+        Still means: over ``settle_windows`` consecutive windows of ``settle_window``
+        seconds, no box moved more than ``settle_displacement`` nor turned more than
+        ``settle_rotation_deg``. Velocity criteria either creep or never end.
+        """
+        pile = self.settings.pile
+        cap = pile.settle_max_time if max_time is None else max_time
+        elapsed = 0.0
+        still = 0
+        positions, orientations = self.poses()
+        while elapsed < cap:
+            self.step(pile.settle_window)
+            elapsed += pile.settle_window
+            new_positions, new_orientations = self.poses()
+            if len(self.boxes) == 0:
+                return elapsed
+            moved = float(np.max(np.linalg.norm(new_positions - positions, axis=1)))
+            turned = float(np.max(rotation_angles_deg(orientations, new_orientations)))
+            positions, orientations = new_positions, new_orientations
+            still = still + 1 if moved < pile.settle_displacement and turned < pile.settle_rotation_deg else 0
+            if still >= pile.settle_windows:
+                break
+        return elapsed
+
+    def close(self) -> None:
+        """Disconnect the client."""
+        with contextlib.suppress(Exception):
+            self.client.disconnect()
+
+    def __enter__(self) -> PhysicsWorld:
+        return self
+
+    def __exit__(
+        self, kind: type[BaseException] | None, value: BaseException | None, traceback: TracebackType | None
+    ) -> None:
+        self.close()
