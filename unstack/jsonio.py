@@ -233,8 +233,13 @@ def validate_document(
         raise UnknownFormat(document.source, "$", f"missing required key 'format' (expected {', '.join(accepted)})")
     if tag not in accepted:
         family = str(tag).rsplit("/", 1)[0]
-        same_family = [known for known in FORMATS if known.rsplit("/", 1)[0] == family]
-        why = "unsupported version" if same_family else "unknown format"
+        same_family = [known for known in accepted if known.rsplit("/", 1)[0] == family]
+        if same_family:
+            why = "unsupported version"
+        elif tag in FORMATS:
+            why = "this command does not take"
+        else:
+            why = "unknown format"
         raise UnknownFormat(
             document.source,
             "$.format",

@@ -223,14 +223,15 @@ def _run_dask(
 ) -> Iterator[SimulatedConfiguration]:
     from distributed import as_completed
 
-    futures = [
-        client.submit(
-            simulate_configuration, settings, seed=seed, index=index, pure=False, key=f"unstack-{seed}-{index}"
-        )
-        for index in todo
-    ]
-    for future in as_completed(futures):  # type: ignore[no-untyped-call]
-        yield future.result()
+    with client.as_current():
+        futures = [
+            client.submit(
+                simulate_configuration, settings, seed=seed, index=index, pure=False, key=f"unstack-{seed}-{i}"
+            )
+            for i, index in enumerate(todo)
+        ]
+        for future in as_completed(futures):  # type: ignore[no-untyped-call]
+            yield future.result()
 
 
 def simulate_dataset(

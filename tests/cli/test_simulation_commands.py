@@ -1,0 +1,84 @@
+"""``unstack simulate`` and ``unstack render`` as a user runs them."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from tests.cli.test_commands import unstack
+
+SMALL = ["--boxes", "3-4", "--sizes", "four", "--depth", "1.0", "--resolution", "96x72", "--min-pixels", "5",
+         "--horizon", "0.5"]  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("cli") / "data"
+    result = unstack("simulate", "--configs", "2", *SMALL, "--seed", "4", "--out", str(folder))
+    assert result.returncode == 0, result.stderr
+    assert "2 configurations (2 made, 0 already there)" in result.stdout
+    assert "break transitivity in" in result.stdout
+    return folder
+
+
+def test_simulate_writes_scene_files_that_validate(dataset: Path) -> None:
+    files = sorted(str(path) for path in dataset.glob("config-*.json"))
+    result = unstack("validate", str(dataset / "manifest.json"), *files)
+    assert result.returncode == 0, result.stderr
+    assert "valid unstack.dataset/1 (2 configurations, seed 4)" in result.stdout
+    assert result.stdout.count("valid unstack.scene/1") == 2
+
+
+def test_render_writes_a_png(dataset: Path, tmp_path: Path) -> None:
+    target = tmp_path / "pile.png"
+    result = unstack("render", str(dataset / "config-0000.json"), "-o", str(target))
+    assert result.returncode == 0, result.stderr
+    assert target.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert [path.name for path in tmp_path.iterdir()] == ["pile.png"]
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (["--sizes", "paper3"], "unknown size set 'paper3'; expected one of paper2, four"),
+        (["--boxes", "40-30"], "box range 40-30 is reversed"),
+        (["--boxes", "many"], "--boxes: expected COUNT or LOW-HIGH (for example 30-40), got 'many'"),
+        (["--boxes", "500-600"], "600 boxes of size set 'paper2' do not fit"),
+        (["--configs", "-3"], "--configs must be a non-negative count, got -3"),
+        (["--jobs", "0"], "--jobs must be at least 1, got 0"),
+        (["--resolution", "big"], "--resolution: expected WIDTHxHEIGHT in pixels"),
+        (["--scheduler", "tcp://127.0.0.1:9"], "dask scheduler tcp://127.0.0.1:9 does not answer within 5 s"),
+        (["--scheduler", "nowhere"], "--scheduler: expected an address like tcp://HOST:PORT, got 'nowhere'"),
+    ],
+)
+def test_simulate_bad_input_is_one_line(tmp_path: Path, arguments: list[str], message: str) -> None:
+    result = unstack("simulate", "--configs", "1", "--out", str(tmp_path / "out"), *arguments)
+    assert result.returncode == 2
+    assert result.stderr == f"unstack: error: {result.stderr.split('error: ', 1)[1]}"
+    assert message in result.stderr and result.stderr.count("\n") == 1, result.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_simulate_refuses_to_mix_data_sets(dataset: Path) -> None:
+    result = unstack("simulate", "--configs", "2", *SMALL, "--seed", "5", "--out", str(dataset))
+    assert result.returncode == 2
+    assert "the folder holds another data set (seed 4, asked for 5)" in result.stderr
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (
+            ["examples/pile5.supports.json", "-o", "{tmp}/x.png"],
+            "$.format: this command does not take 'unstack.supports/1'; expected unstack.scene/1",
+        ),
+        (["examples/scene3.json", "-o", "{tmp}/x.pdf"], "x.pdf: expected a .png output file"),
+        (["examples/missing.json", "-o", "{tmp}/x.png"], "missing.json"),
+    ],
+)
+def test_render_bad_input_is_one_line(tmp_path: Path, arguments: list[str], message: str) -> None:
+    result = unstack("render", *[argument.format(tmp=tmp_path) for argument in arguments])
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert message in result.stderr
+    assert not list(tmp_path.iterdir())
