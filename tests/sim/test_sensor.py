@@ -51,7 +51,7 @@ def test_container_points_are_labelled_minus_one(settings: SimulationSettings) -
 
 def test_depth_noise_is_seeded_and_grows_with_depth(settings: SimulationSettings) -> None:
     noisy = replace(settings.sensor, noise=True)
-    clean, labels, _ = scene(settings, settings.sensor)
+    clean, _, _ = scene(settings, settings.sensor)
     first, _, _ = scene(settings, noisy, seed=4)
     again, _, _ = scene(settings, noisy, seed=4)
     other, _, _ = scene(settings, noisy, seed=5)
