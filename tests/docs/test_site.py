@@ -29,7 +29,7 @@ def site(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def test_every_page_is_built(site: Path) -> None:
-    for page in ("quickstart", "formats", "reasoner", "benchmarks", "reference"):
+    for page in ("quickstart", "formats", "reasoner", "simulation", "benchmarks", "reference"):
         assert (site / page / "index.html").is_file(), page
 
 
@@ -40,6 +40,11 @@ def test_formats_page_lists_every_schema_field(site: Path, schema_file: Path) ->
     assert schema["title"] in html
     for field in schema["properties"]:
         assert f"$.{field}" in html, field
+
+
+def test_the_simulation_page_shows_its_picture(site: Path) -> None:
+    assert (site / "images" / "pile-paper2.png").is_file()
+    assert "images/pile-paper2.png" in (site / "simulation" / "index.html").read_text()
 
 
 def test_reference_page_renders_the_docstrings(site: Path) -> None:

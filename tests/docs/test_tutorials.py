@@ -38,20 +38,26 @@ def test_python_block_runs(snippet: Snippet) -> None:
     assert result.returncode == 0, result.stderr
 
 
-@pytest.mark.parametrize("snippet", CONSOLE_SNIPPETS, ids=lambda s: s.name)
-def test_console_command_runs(snippet: Snippet, tmp_path: Path) -> None:
+CONSOLE_PAGES = sorted({snippet.page for snippet in CONSOLE_SNIPPETS})
+
+
+@pytest.mark.parametrize("page", CONSOLE_PAGES)
+def test_console_commands_run_in_order(page: str, tmp_path: Path) -> None:
+    """A page's commands run one after the other in one folder, as a reader types them."""
     (tmp_path / "examples").symlink_to(REPO / "examples")
-    result = subprocess.run(
-        ["bash", "-c", f"set -o pipefail; {snippet.code}"],
-        cwd=tmp_path,
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env=environment(),
-    )
-    assert result.returncode == snippet.expected_exit, result.stdout + result.stderr
-    if snippet.expected_exit:
-        assert result.stderr.startswith("unstack: error: ") and result.stderr.count("\n") == 1
-        assert "Traceback" not in result.stderr
-    else:
-        assert result.stdout or any(tmp_path.iterdir())
+    for snippet in (s for s in CONSOLE_SNIPPETS if s.page == page):
+        before = set(tmp_path.iterdir())
+        result = subprocess.run(
+            ["bash", "-c", f"set -o pipefail; {snippet.code}"],
+            cwd=tmp_path,
+            capture_output=True,
+            text=True,
+            timeout=300,
+            env=environment(),
+        )
+        assert result.returncode == snippet.expected_exit, (snippet.code, result.stdout + result.stderr)
+        if snippet.expected_exit:
+            assert result.stderr.startswith("unstack: error: ") and result.stderr.count("\n") == 1
+            assert "Traceback" not in result.stderr
+        else:
+            assert result.stdout or set(tmp_path.iterdir()) - before, snippet.code

@@ -1,6 +1,53 @@
-"""Simulation (§V): pybullet container piles, ground truth by removal, range sensor.
+"""Simulation (§V): pybullet container piles, ground truth by removal, range sensor, data sets.
 
-Not built yet (issue "Simulation"); nothing is exported.
+Needs the ``sim`` extra (``pip install "unstack[sim]"``): pybullet, dask.distributed and
+matplotlib. Importing this package does not import pybullet; building a world does.
+
+Examples
+--------
+>>> from unstack.sim import Container, SimulationSettings
+>>> SimulationSettings(boxes=(10, 20), sizes="four", container=Container(depth=1.0)).boxes
+(10, 20)
 """
 
-__all__: list[str] = []
+from unstack.sim.configuration import SimulatedConfiguration, configuration_seed, simulate_configuration
+from unstack.sim.dataset import DatasetConflict, SchedulerUnavailable, list_configurations, simulate_dataset
+from unstack.sim.ground_truth import RemovalResponse, removal_responses, support_labels, transitivity_violations
+from unstack.sim.piles import Pile, build_pile
+from unstack.sim.sensor import Scan, scan_pile
+from unstack.sim.settings import (
+    SIZE_SETS,
+    Container,
+    GroundTruthSettings,
+    InvalidSettings,
+    PileSettings,
+    SensorSettings,
+    SimulationSettings,
+)
+from unstack.sim.world import PhysicsWorld
+
+__all__ = [
+    "SIZE_SETS",
+    "Container",
+    "DatasetConflict",
+    "GroundTruthSettings",
+    "InvalidSettings",
+    "PhysicsWorld",
+    "Pile",
+    "PileSettings",
+    "RemovalResponse",
+    "Scan",
+    "SchedulerUnavailable",
+    "SensorSettings",
+    "SimulatedConfiguration",
+    "SimulationSettings",
+    "build_pile",
+    "configuration_seed",
+    "list_configurations",
+    "removal_responses",
+    "scan_pile",
+    "simulate_configuration",
+    "simulate_dataset",
+    "support_labels",
+    "transitivity_violations",
+]
