@@ -110,7 +110,11 @@ def simulate_configuration(settings: SimulationSettings, *, seed: int, index: in
     timings: dict[str, float] = {"generation": 0.0, "ground_truth": 0.0, "scan": 0.0}
     for attempt, pile_seed in enumerate(pile_seeds):
         clock = time.process_time()
-        pile = build_pile(settings, count=count, seed=pile_seed)
+        try:
+            pile = build_pile(settings, count=count, seed=pile_seed)
+        except InvalidSettings:
+            timings["generation"] += time.process_time() - clock
+            continue  # an unlucky pile that would not take all its boxes: try the next seed
         with pile:
             timings["generation"] += time.process_time() - clock
             clock = time.process_time()
@@ -125,7 +129,10 @@ def simulate_configuration(settings: SimulationSettings, *, seed: int, index: in
             positions, orientations = pile.world.poses([box.body for box in pile.boxes])
             scene = _scene(settings, seed, index, attempt, resettles, pile, response, scan, positions, orientations)
             return SimulatedConfiguration(index, scene, scan.point_boxes, timings)
-    raise InvalidSettings(f"configuration {index}: every one of {MAX_PILES} piles kept creeping; settle longer")
+    raise InvalidSettings(
+        f"configuration {index}: none of {MAX_PILES} piles of {count} boxes both took all its boxes and "
+        "stopped creeping; use fewer boxes or a larger container"
+    )
 
 
 def _scene(
