@@ -67,7 +67,9 @@ def main() -> None:
     speedup = float(results[1]["per_minute"]) / float(results[0]["per_minute"])  # type: ignore[arg-type]
     console.print(f"2 workers / 1 worker: {speedup:.2f}x (target >= 1.8x on a quiet machine)")
     if arguments.json:
-        arguments.json.write_text(json.dumps({"results": results, "speedup": speedup, "reference": REFERENCE}, indent=2))
+        arguments.json.write_text(
+            json.dumps({"results": results, "speedup": speedup, "reference": REFERENCE}, indent=2)
+        )
 
 
 if __name__ == "__main__":

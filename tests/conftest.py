@@ -39,3 +39,21 @@ def repo() -> Path:
 @pytest.fixture
 def examples() -> Path:
     return EXAMPLES
+
+
+@pytest.fixture(scope="session")
+def small_dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A simulated data set of six small piles, made once per test session."""
+    from unstack.sim.dataset import simulate_dataset
+    from unstack.sim.settings import Container, GroundTruthSettings, SensorSettings, SimulationSettings
+
+    folder = tmp_path_factory.mktemp("small-dataset")
+    settings = SimulationSettings(
+        boxes=(7, 9),
+        sizes="four",
+        container=Container(depth=1.0),
+        ground_truth=GroundTruthSettings(horizon=0.5),
+        sensor=SensorSettings(width=160, height=120, min_pixels=10),
+    )
+    simulate_dataset(folder, settings, configs=8, seed=5, progress=False)
+    return folder

@@ -128,10 +128,10 @@ def test_bad_input_is_one_line_exit_2_and_no_output(tmp_path: Path, text: str, m
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.json"]
 
 
-def test_scene_file_needs_a_model() -> None:
-    result = unstack("decide", "examples/scene3.json")
-    assert result.returncode == 2
-    assert "needs a learned support model" in result.stderr
+def test_a_scene_file_is_decided_through_the_shipped_model() -> None:
+    result = unstack("decide", "examples/scene3.json", "--json")
+    assert result.returncode == 0, result.stderr
+    assert json.loads(result.stdout)["objects"] == ["top", "floor_a", "floor_b"]
 
 
 @pytest.mark.parametrize(

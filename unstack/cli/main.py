@@ -1,4 +1,5 @@
-"""``unstack`` commands: ``decide``, ``worlds``, ``validate``, ``simulate``, ``render``.
+"""``unstack`` commands: ``decide``, ``worlds``, ``validate``, ``simulate``, ``render``,
+``train``, ``evaluate``, ``probabilities``.
 
 Each command is a thin layer over the library: read and validate the input, call one
 library function, render the result. ``UnstackError`` (and unwritable outputs) become a
@@ -15,7 +16,7 @@ from typing import Any
 import click
 from rich.console import Console
 
-from unstack.errors import ModelRequired, UnstackError
+from unstack.errors import UnstackError
 
 __all__ = ["cli", "main"]
 
@@ -55,17 +56,16 @@ def _emit(as_json: bool, document: dict[str, Any], render: Callable[[], Any]) ->
         Console(highlight=False).print(render())
 
 
-def _load_supports(path: str) -> Any:
+def _load_supports(path: str, model_path: str | None = None) -> Any:
+    """Supports from a supports file, or from a scene file through the learned model."""
     from unstack import load
     from unstack.scene import Scene
 
     loaded = load(path)
     if isinstance(loaded, Scene):
-        raise ModelRequired(
-            f"{loaded.source}: deciding on a scene (unstack.scene/1) needs a learned support model, "
-            "which this release does not include yet; pass an unstack.supports/1 file with the "
-            "support probabilities of the detected boxes"
-        )
+        from unstack.cli.learning import scene_supports
+
+        return scene_supports(loaded, model_path)
     return loaded
 
 
@@ -95,15 +95,17 @@ def cli() -> None:
     show_default=True,
     help="count: number of supported boxes (Eq. 11); mass: their total mass (needs masses).",
 )
-def decide(file: str, as_json: bool, output: str | None, method: str, cost: str) -> None:
+@click.option("--model", "model_path", default=None, help="Model for scene files (default: the one shipped).")
+def decide(file: str, as_json: bool, output: str | None, method: str, cost: str, model_path: str | None) -> None:
     """Print which box to unload first, the expected cost of every box and P(support | consistent).
 
-    FILE is an unstack.supports/1 file ('-' reads standard input).
+    FILE is an unstack.supports/1 file, or an unstack.scene/1 file whose detected boxes get
+    their support probabilities from the learned model ('-' reads standard input).
     """
     from unstack.cli.render import decision_view
     from unstack.reasoner.decision import decide as decide_box
 
-    supports = _load_supports(file)
+    supports = _load_supports(file, model_path)
     decision = decide_box(supports, method=method, cost=cost)
     document = decision.to_dict()
     _write_output(output, document)
@@ -170,14 +172,15 @@ def validate(files: tuple[str, ...]) -> None:
         click.echo(f"{document.source}: valid {tag} ({detail})")
 
 
-def _register_simulation_commands() -> None:
+def _register_commands() -> None:
+    from unstack.cli.learning import evaluate, probabilities, train
     from unstack.cli.simulation import render, simulate
 
-    cli.add_command(simulate)
-    cli.add_command(render)
+    for command in (simulate, render, train, evaluate, probabilities):
+        cli.add_command(command)
 
 
-_register_simulation_commands()
+_register_commands()
 
 
 def main() -> None:

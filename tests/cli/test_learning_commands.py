@@ -1,0 +1,99 @@
+"""``unstack train``, ``evaluate``, ``probabilities`` and ``decide`` on scene files."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import jsonschema
+import numpy as np
+import pytest
+
+from tests.cli.test_commands import unstack
+from unstack.jsonio import load_schema
+from unstack.sim.dataset import list_configurations
+
+SCENE = "examples/pile5.scene.json"
+
+
+@pytest.fixture(scope="module")
+def model(small_dataset: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    target = tmp_path_factory.mktemp("model") / "model.skops"
+    result = unstack("train", str(small_dataset), "-o", str(target), "--r", "4", "--cv", "3", "--seed", "1")
+    assert result.returncode == 0, result.stderr
+    assert "chosen: C = " in result.stdout and "gamma = " in result.stdout
+    assert "validation confusion matrix (Fig. 5 layout)" in result.stdout
+    return target
+
+
+def test_train_json_report(small_dataset: Path, tmp_path: Path) -> None:
+    result = unstack("train", str(small_dataset), "-o", str(tmp_path / "m.skops"), "--r", "4", "--cv", "3",
+                     "--learner", "gradient_boosting", "--json")  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    report = json.loads(result.stdout)
+    assert report["learner"] == "gradient_boosting"
+    assert report["training"]["r"] == 4
+    assert report["validation"]["relations"] == math.ceil(0.3 * report["training"]["relations"])
+    assert len(report["training"]["fingerprint"]) == 64
+
+
+def test_evaluate_prints_the_confusion_matrix_and_a_reliability_diagram(
+    model: Path, small_dataset: Path, tmp_path: Path
+) -> None:
+    result = unstack("evaluate", str(model), str(small_dataset), "--r", "4", "--reliability", str(tmp_path / "r.png"))
+    assert result.returncode == 0, result.stderr
+    assert "balanced error rate (Eq. 16)" in result.stdout and "average entropy (Eq. 15)" in result.stdout
+    assert (tmp_path / "r.png").read_bytes()[:4] == b"\x89PNG"
+    report = json.loads(unstack("evaluate", str(model), str(small_dataset), "--r", "4", "--json").stdout)
+    assert report["relations"] == report["supp"] + report["not_supp"]
+
+
+def test_probabilities_of_a_scene(model: Path, small_dataset: Path, tmp_path: Path) -> None:
+    scene = list_configurations(small_dataset)[0]
+    result = unstack("probabilities", str(scene), "--model", str(model), "-o", str(tmp_path / "p.json"))
+    assert result.returncode == 0, result.stderr
+    document = json.loads((tmp_path / "p.json").read_text())
+    jsonschema.validate(document, load_schema("unstack.supports/1"))
+    matrix = np.array(document["probabilities"])
+    assert matrix.shape == (len(document["objects"]),) * 2 and np.all(np.diag(matrix) == 0)
+    off_diagonal = matrix[~np.eye(len(matrix), dtype=bool)]
+    assert np.all((off_diagonal > 0) & (off_diagonal < 1))  # learned values are never hard evidence
+
+
+def test_decide_on_the_bundled_scene_with_the_default_model() -> None:
+    result = unstack("decide", SCENE, "--json")
+    assert result.returncode == 0, result.stderr
+    decision = json.loads(result.stdout)
+    jsonschema.validate(decision, load_schema("unstack.decision/1"))
+    assert decision["objects"] == ["b03", "b04", "b06", "b13", "b14"]
+
+
+def test_decide_on_a_scene_with_a_given_model(model: Path) -> None:
+    result = unstack("decide", SCENE, "--model", str(model))
+    assert result.returncode == 0, result.stderr
+    assert "Unload first:" in result.stdout
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (
+            ["decide", SCENE, "--model", "examples/pile5.supports.json"],
+            "expected an unstack model file (a skops file), got something else",
+        ),
+        (["decide", SCENE, "--model", "examples"], "examples: $: expected a model file, got a directory"),
+        (["probabilities", SCENE, "--model", "nope.skops"], "nope.skops: $: cannot read the model file"),
+        (
+            ["train", "examples", "-o", "{tmp}/m.skops"],
+            "examples: expected a data set folder with config-NNNN.json scene files",
+        ),
+        (["train", "examples", "-o", "{tmp}/m.skops", "--r", "1"], "expected --r >= 2"),
+        (["evaluate", "nope.skops", "examples"], "nope.skops: $: cannot read the model file"),
+    ],
+)
+def test_bad_input_is_one_line(arguments: list[str], message: str, tmp_path: Path) -> None:
+    result = unstack(*[argument.format(tmp=tmp_path) for argument in arguments])
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert message in result.stderr
+    assert not list(tmp_path.iterdir())

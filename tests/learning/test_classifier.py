@@ -1,0 +1,91 @@
+"""SupportClassifier follows scikit-learn's estimator contract and decides from probabilities."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from sklearn.utils.estimator_checks import parametrize_with_checks
+
+from unstack.learning.classifier import LEARNERS, SupportClassifier
+
+SMALL_GRID = {"svc__estimator__C": [1.0, 10.0], "svc__estimator__gamma": [0.1]}
+
+
+def separable(rng: np.random.Generator, n: int = 160) -> tuple[np.ndarray, np.ndarray]:
+    features = rng.normal(size=(n, 19))
+    labels = (features[:, 0] + 0.5 * features[:, 1] + 0.3 * rng.normal(size=n) > 0.6).astype(int)
+    return features, labels
+
+
+@parametrize_with_checks(
+    [SupportClassifier(cv=3, param_grid=SMALL_GRID, random_state=0)],
+    expected_failed_checks=lambda estimator: {
+        "check_fit2d_1feature": "10 samples with 3 of one class cannot be split 70/30, cross-validated and "
+        "calibrated: fails for the sample size, not the single feature",
+    },
+)
+def test_scikit_learn_estimator_checks(estimator: SupportClassifier, check: object) -> None:
+    check(estimator)  # type: ignore[operator]
+
+
+FAST_GRIDS = {
+    "svm": SMALL_GRID,
+    "calibrated_svm": SMALL_GRID,
+    "gradient_boosting": {"gb__learning_rate": [0.1], "gb__max_leaf_nodes": [7, 15]},
+}
+
+
+@pytest.mark.parametrize("learner", LEARNERS)
+def test_every_learner_fits_and_validates(learner: str, rng: np.random.Generator) -> None:
+    features, labels = separable(rng)
+    model = SupportClassifier(learner=learner, cv=3, param_grid=FAST_GRIDS[learner], random_state=0)
+    model.fit(features, labels)
+    metrics = model.validation_metrics_
+    assert metrics["relations"] == 48  # 30 % of 160
+    assert metrics["success_rate"] > 0.7
+    assert set(model.best_params_) <= set(model.estimator_.get_params())
+
+
+def test_predict_follows_predict_proba(rng: np.random.Generator) -> None:
+    features, labels = separable(rng)
+    model = SupportClassifier(cv=3, param_grid=SMALL_GRID, random_state=0).fit(features, labels)
+    probability = model.predict_proba(features)
+    assert np.allclose(probability.sum(axis=1), 1.0)
+    assert np.array_equal(model.predict(features), (probability[:, 1] >= 0.5).astype(int))
+
+
+def test_same_random_state_same_model(rng: np.random.Generator) -> None:
+    features, labels = separable(rng)
+    first = SupportClassifier(cv=3, param_grid=SMALL_GRID, random_state=3).fit(features, labels)
+    again = SupportClassifier(cv=3, param_grid=SMALL_GRID, random_state=3).fit(features, labels)
+    assert np.array_equal(first.predict_proba(features), again.predict_proba(features))
+    assert first.validation_metrics_["confusion_matrix"] == again.validation_metrics_["confusion_matrix"]
+
+
+def test_init_only_stores_and_fitted_attributes_end_with_underscore(rng: np.random.Generator) -> None:
+    model = SupportClassifier(learner="svm", cv=4, param_grid=SMALL_GRID)
+    assert model.get_params()["cv"] == 4 and not hasattr(model, "estimator_")
+    features, labels = separable(rng)
+    model.fit(features, labels)
+    fitted = [name for name in vars(model) if name.endswith("_") and not name.startswith("_")]
+    assert {"classes_", "estimator_", "best_params_", "cv_score_", "validation_metrics_", "n_features_in_"} <= set(
+        fitted
+    )
+
+
+@pytest.mark.parametrize(
+    ("labels", "message"),
+    [
+        (np.zeros(20, dtype=int), r"needs both classes in y, got only 1 class: \[0\]"),
+        (np.arange(20) % 3, "Only binary classification is supported"),
+    ],
+)
+def test_bad_labels(labels: np.ndarray, message: str, rng: np.random.Generator) -> None:
+    with pytest.raises(ValueError, match=message):
+        SupportClassifier(cv=3, param_grid=SMALL_GRID).fit(rng.normal(size=(20, 19)), labels)
+
+
+def test_unknown_learner(rng: np.random.Generator) -> None:
+    features, labels = separable(rng)
+    with pytest.raises(ValueError, match="unknown learner 'forest'; expected one of svm, gradient_boosting"):
+        SupportClassifier(learner="forest").fit(features, labels)

@@ -1,0 +1,95 @@
+"""Model files: round trip, and a one-line error for anything that is not a model we trust."""
+
+from __future__ import annotations
+
+import json
+import os
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+import skops.io
+
+from unstack.learning.classifier import SupportClassifier
+from unstack.learning.features import FeatureSettings
+from unstack.learning.model_file import MODEL_FORMAT, InvalidModel, SupportModel, load_model, save_model
+
+GRID = {"svc__estimator__C": [1.0], "svc__estimator__gamma": [0.1]}
+
+
+@pytest.fixture(scope="module")
+def fitted() -> tuple[SupportClassifier, np.ndarray]:
+    rng = np.random.default_rng(1)
+    features = rng.normal(size=(120, 19))
+    labels = (features[:, 0] > 0.3).astype(int)
+    return SupportClassifier(cv=3, param_grid=GRID, random_state=0).fit(features, labels), features
+
+
+@pytest.mark.parametrize("learner", ["svm", "gradient_boosting", "calibrated_svm"])
+def test_round_trip(tmp_path: Path, learner: str) -> None:
+    rng = np.random.default_rng(2)
+    features = rng.normal(size=(120, 19))
+    labels = (features[:, 0] > 0.3).astype(int)
+    grid = {"gb__max_leaf_nodes": [7]} if learner == "gradient_boosting" else GRID
+    classifier = SupportClassifier(learner=learner, cv=3, param_grid=grid, random_state=0).fit(features, labels)
+    settings = FeatureSettings(offset=0.8, sigma=0.4)
+    save_model(SupportModel.from_classifier(classifier, settings, training={"seed": 7}), tmp_path / "m.skops")
+    model = load_model(tmp_path / "m.skops")
+    assert model.features == settings
+    assert model.metadata["learner"] == learner and model.metadata["training"] == {"seed": 7}
+    assert model.metadata["validation"]["relations"] == 36
+    assert np.array_equal(model.support_probability(features), classifier.predict_proba(features)[:, 1])
+
+
+def write_payload(path: Path, payload: object) -> Path:
+    path.write_bytes(skops.io.dumps(payload))
+    return path
+
+
+def test_bad_files_are_one_line_errors(tmp_path: Path, fitted: tuple[SupportClassifier, np.ndarray]) -> None:
+    classifier, _ = fitted
+    text = tmp_path / "notes.skops"
+    text.write_text("hello")
+    archive = tmp_path / "other.zip"
+    with zipfile.ZipFile(archive, "w") as handle:
+        handle.writestr("a.txt", "x")
+    metadata = json.dumps({"features": FeatureSettings().to_dict()})
+    cases = {
+        text: r"\$: expected an unstack model file \(a skops file\), got something else",
+        archive: r"\$: expected an unstack model file \(a skops file\)",
+        tmp_path: r"\$: expected a model file, got a directory",
+        tmp_path / "missing.skops": r"\$: cannot read the model file",
+        write_payload(tmp_path / "list.skops", [1, 2]): r"expected an unstack model \(a dict with 'format'\)",
+        write_payload(
+            tmp_path / "v9.skops",
+            {"format": "unstack.model/9", "metadata": metadata, "estimator": classifier.estimator_},
+        ): r"\$.format: unsupported model format 'unstack.model/9'",
+        write_payload(
+            tmp_path / "nometa.skops", {"format": MODEL_FORMAT, "estimator": classifier.estimator_}
+        ): r"\$.metadata: expected the model's metadata and estimator",
+    }
+    for path, message in cases.items():
+        with pytest.raises(InvalidModel, match=message) as caught:
+            load_model(path)
+        assert "\n" not in str(caught.value)
+
+
+def test_a_file_with_untrusted_types_is_refused_without_running_it(tmp_path: Path) -> None:
+    from sklearn.preprocessing import FunctionTransformer
+
+    calls = tmp_path / "called"
+    payload = {"format": MODEL_FORMAT, "metadata": "{}", "estimator": FunctionTransformer(func=os.system)}
+    path = write_payload(tmp_path / "evil.skops", payload)
+    with pytest.raises(InvalidModel, match=r"refusing to load types that are not trusted: posix.system"):
+        load_model(path)
+    assert not calls.exists()
+
+
+def test_the_shipped_default_model_loads() -> None:
+    from unstack.learning.model_file import default_model_path
+
+    model = load_model(default_model_path())
+    assert model.metadata["learner"] == "svm" and model.features == FeatureSettings()
+    validation = model.metadata["validation"]
+    assert validation["relations"] > 500 and 0 <= validation["balanced_error_rate"] <= 0.5

@@ -1,0 +1,48 @@
+"""Training examples: ISets are strict subsets, labels come from the ground truth, seeds are per scene."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from unstack.errors import UnstackError
+from unstack.learning.training_data import dataset_examples, dataset_fingerprint, sample_isets, scene_examples
+from unstack.scene import load_scene
+from unstack.sim.dataset import list_configurations
+
+
+@pytest.mark.parametrize(("detected", "r", "size"), [(10, 5, 5), (5, 5, 4), (3, 5, 2), (2, 5, 0)])
+def test_isets_are_strict_subsets(detected: int, r: int, size: int, rng: np.random.Generator) -> None:
+    ids = [f"b{k}" for k in range(detected)]
+    isets = sample_isets(ids, r=r, isets=4, rng=rng)
+    assert all(len(iset) == size and len(set(iset)) == size and set(iset) < set(ids) for iset in isets)
+    assert len(isets) == (4 if size else 0)
+
+
+def test_labels_are_the_ground_truth(small_dataset: Path) -> None:
+    scene = load_scene(list_configurations(small_dataset)[0])
+    examples = scene_examples(scene, r=4, isets=3, seed=1)
+    index = {box_id: k for k, box_id in enumerate(scene.box_ids)}
+    truth = scene.ground_truth
+    assert truth is not None
+    assert examples.labels.tolist() == [int(truth[index[x], index[y]]) for x, y in examples.pairs]
+    assert examples.features.shape == (3 * 4 * 3, 19)
+
+
+def test_examples_do_not_depend_on_the_number_of_processes(small_dataset: Path) -> None:
+    one = dataset_examples(small_dataset, r=4, isets=2, seed=3, n_jobs=1)
+    two = dataset_examples(small_dataset, r=4, isets=2, seed=3, n_jobs=2)
+    assert np.array_equal(one.features, two.features) and one.pairs == two.pairs
+    assert sorted(set(one.configuration.tolist())) == list(range(len(list_configurations(small_dataset))))
+
+
+def test_fingerprint_changes_with_the_data(small_dataset: Path, tmp_path: Path) -> None:
+    assert dataset_fingerprint(small_dataset) == dataset_fingerprint(small_dataset)
+    assert dataset_fingerprint(small_dataset) != dataset_fingerprint(tmp_path)
+
+
+def test_a_folder_without_scenes(tmp_path: Path) -> None:
+    with pytest.raises(UnstackError, match=r"expected a data set folder with config-NNNN\.json scene files"):
+        dataset_examples(tmp_path)

@@ -1,0 +1,218 @@
+"""``unstack train``, ``unstack evaluate``, ``unstack probabilities``: the learned support model."""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+import click
+from rich.console import Console, Group
+from rich.table import Table
+from rich.text import Text
+
+from unstack.errors import ModelRequired, UnstackError
+
+__all__ = ["evaluate", "load_support_model", "metrics_view", "probabilities", "scene_supports", "train"]
+
+
+def load_support_model(path: str | None) -> tuple[Any, str]:
+    """The model of ``--model``, or the one shipped with the package."""
+    from unstack.learning.model_file import default_model_path, load_model
+
+    if path is None:
+        default = default_model_path()
+        if not default.is_file():
+            raise ModelRequired(
+                f"no model given and the default model {default.name} is not installed; pass --model FILE "
+                "(make one with unstack train)"
+            )
+        return load_model(default), f"default:{default.name}"
+    return load_model(path), path
+
+
+def scene_supports(scene: Any, model_path: str | None) -> Any:
+    """Support probabilities of a scene's detected boxes from the learned model."""
+    from unstack.learning.probabilities import scene_support_probabilities
+
+    model, name = load_support_model(model_path)
+    return scene_support_probabilities(scene, model, model_name=name)
+
+
+def metrics_view(report: dict[str, Any], title: str) -> Group:
+    """The paper's Fig. 5 confusion matrix and the summary metrics."""
+    counts = report["confusion_matrix"]
+    confusion = Table(title=title, title_justify="left")
+    confusion.add_column("actual \\ predicted")
+    confusion.add_column("SUPP", justify="right")
+    confusion.add_column("not SUPP", justify="right")
+    for label, row in (("SUPP", counts[0]), ("not SUPP", counts[1])):
+        total = max(sum(row), 1)
+        confusion.add_row(label, *(f"{value} ({100 * value / total:.1f} %)" for value in row))
+    summary = Table(show_header=False, box=None)
+    for key, label in (
+        ("relations", "relations"),
+        ("success_rate", "success rate"),
+        ("balanced_error_rate", "balanced error rate (Eq. 16)"),
+        ("average_entropy", "average entropy (Eq. 15)"),
+        ("brier_score", "Brier score"),
+    ):
+        value = report[key]
+        summary.add_row(label, f"{value:.4f}" if isinstance(value, float) else str(value))
+    return Group(confusion, summary)
+
+
+def _progress(description: str) -> Any:
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
+
+    return Progress(  # on stderr: stdout is for results (and JSON)
+        f"[progress.description]{description}",
+        BarColumn(),
+        MofNCompleteColumn(),
+        "ETA",
+        TimeRemainingColumn(),
+        console=Console(stderr=True),
+        transient=True,
+    )
+
+
+def _examples(data_dir: str, r: int, isets: int, seed: int, jobs: int, settings: Any) -> Any:
+    from unstack.learning.training_data import dataset_examples
+    from unstack.sim.dataset import list_configurations
+
+    if not list_configurations(data_dir):  # before any progress bar: the error is the only line
+        raise UnstackError(f"{data_dir}: expected a data set folder with config-NNNN.json scene files, found none")
+    with _progress("features") as bar:
+        task = bar.add_task("features", total=None)
+        examples = dataset_examples(
+            data_dir,
+            r=r,
+            isets=isets,
+            seed=seed,
+            settings=settings,
+            n_jobs=jobs,
+            progress=lambda done, total: bar.update(task, completed=done, total=total),
+        )
+    if len(examples.labels) == 0:
+        raise UnstackError(f"{data_dir}: no ISet of at least 2 detected boxes; nothing to learn from")
+    return examples
+
+
+@click.command()
+@click.argument("data_dir", type=click.Path(file_okay=False))
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Model file to write.")
+@click.option("--learner", type=click.Choice(["svm", "gradient_boosting", "calibrated_svm"]), default="svm",
+              show_default=True, help="svm: RBF SVM with LIBSVM probabilities (the paper).")  # fmt: skip
+@click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
+@click.option("--isets", type=int, default=3, show_default=True, help="ISets drawn per configuration.")
+@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets, the split and the folds.")
+@click.option("--cv", type=int, default=10, show_default=True, help="Cross-validation folds on the training part.")
+@click.option("--validation-size", type=float, default=0.3, show_default=True, help="Share held out for validation.")
+@click.option("--offset", type=float, default=1.0, show_default=True, help="d: interest-point offset (m).")
+@click.option("--sigma", type=float, default=0.5, show_default=True, help="Width of the DBAF's Gaussian (m).")
+@click.option("--jobs", type=int, default=1, show_default=True, help="Parallel processes.")
+@click.option("--json", "as_json", is_flag=True, help="Print the training report as JSON.")
+def train(
+    data_dir: str,
+    output: str,
+    learner: str,
+    r: int,
+    isets: int,
+    seed: int,
+    cv: int,
+    validation_size: float,
+    offset: float,
+    sigma: float,
+    jobs: int,
+    as_json: bool,
+) -> None:
+    """Train the support classifier on a simulated data set (unstack simulate) and save it."""
+    from unstack.learning.classifier import SupportClassifier
+    from unstack.learning.features import FeatureSettings
+    from unstack.learning.model_file import SupportModel, save_model
+    from unstack.learning.training_data import dataset_fingerprint
+    from unstack.sim.dataset import read_manifest
+
+    if r < 2 or isets < 1 or cv < 2 or jobs < 1 or not 0.0 <= validation_size < 1.0:
+        raise UnstackError("expected --r >= 2, --isets >= 1, --cv >= 2, --jobs >= 1 and 0 <= --validation-size < 1")
+    settings = FeatureSettings(offset=offset, sigma=sigma)
+    examples = _examples(data_dir, r, isets, seed, jobs, settings)
+    console = Console(stderr=as_json)
+    console.print(
+        f"{len(examples.labels)} relations ({int(examples.labels.sum())} SUPP) from "
+        f"{len(set(examples.configuration.tolist()))} configurations; cross-validating {learner} ({cv} folds) ..."
+    )
+    classifier = SupportClassifier(
+        learner=learner, cv=cv, validation_size=validation_size, n_jobs=jobs, random_state=seed
+    ).fit(examples.features, examples.labels)
+    manifest = read_manifest(data_dir) or {}
+    training = {
+        "data": str(data_dir),
+        "fingerprint": dataset_fingerprint(data_dir),
+        "simulation_seed": manifest.get("seed"),
+        "simulation_settings": manifest.get("settings"),
+        "seed": seed,
+        "r": r,
+        "isets_per_configuration": isets,
+        "relations": len(examples.labels),
+        "supp": int(examples.labels.sum()),
+        "validation_size": validation_size,
+    }
+    model = SupportModel.from_classifier(classifier, settings, training=training)
+    save_model(model, output)
+    report = {"model": output, "learner": learner, **{k: model.metadata[k] for k in ("best_params", "cv_score")},
+              "validation": classifier.validation_metrics_, "training": {k: v for k, v in training.items()
+              if k != "simulation_settings"}}  # fmt: skip
+    if as_json:
+        click.echo(json.dumps(report, indent=2))
+        return
+    params = ", ".join(f"{key.rsplit('__', 1)[-1]} = {value:g}" for key, value in classifier.best_params_.items())
+    console.print(Text.assemble(("chosen: ", "bold"), params, f"  (cross-validated score {classifier.cv_score_:.3f})"))
+    if classifier.validation_metrics_:
+        console.print(metrics_view(classifier.validation_metrics_, "validation confusion matrix (Fig. 5 layout)"))
+    console.print(f"model written to {output}")
+
+
+@click.command()
+@click.argument("model_file", type=str)
+@click.argument("data_dir", type=click.Path(file_okay=False))
+@click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
+@click.option("--isets", type=int, default=3, show_default=True, help="ISets drawn per configuration.")
+@click.option("--seed", type=int, default=1, show_default=True, help="Seed of the ISets.")
+@click.option("--jobs", type=int, default=1, show_default=True, help="Parallel processes.")
+@click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
+@click.option("--reliability", type=click.Path(dir_okay=False), default=None, help="Write a reliability diagram PNG.")
+def evaluate(
+    model_file: str, data_dir: str, r: int, isets: int, seed: int, jobs: int, as_json: bool, reliability: str | None
+) -> None:
+    """Score a model on a data set: confusion matrix, success rate, BER, entropy, calibration."""
+    from unstack.learning.metrics import classification_report, save_reliability_diagram
+    from unstack.learning.model_file import load_model
+
+    if r < 2 or isets < 1 or jobs < 1:
+        raise UnstackError("expected --r >= 2, --isets >= 1 and --jobs >= 1")
+    model = load_model(model_file)
+    examples = _examples(data_dir, r, isets, seed, jobs, model.features)
+    report = classification_report(examples.labels, model.support_probability(examples.features))
+    if reliability:
+        save_reliability_diagram(report, reliability, title=f"{model_file} on {data_dir}")
+    if as_json:
+        click.echo(json.dumps({"model": model_file, "data": data_dir, **report}, indent=2))
+        return
+    Console().print(metrics_view(report, f"{model_file} on {data_dir}: confusion matrix (Fig. 5 layout)"))
+
+
+@click.command()
+@click.argument("scene_file", type=str)
+@click.option("--model", "model_path", default=None, help="Model file (default: the model shipped with unstack).")
+@click.option("-o", "--output", type=click.Path(dir_okay=False), default=None, help="Write the JSON here (atomically).")
+def probabilities(scene_file: str, model_path: str | None, output: str | None) -> None:
+    """Support probabilities of a scene's detected boxes, as unstack.supports/1 JSON."""
+    from unstack.jsonio import atomic_write_text
+    from unstack.scene import load_scene
+
+    supports = scene_supports(load_scene(scene_file), model_path)
+    text = json.dumps(supports.to_dict(), indent=2) + "\n"
+    if output:
+        atomic_write_text(output, text)
+    else:
+        click.echo(text, nl=False)

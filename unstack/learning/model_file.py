@@ -1,0 +1,190 @@
+"""Model files that never run code when loaded (``unstack.model/1``).
+
+A model file is a skops file holding a dict of three entries: ``"format"``
+(``"unstack.model/1"``), ``"metadata"`` (a JSON string: learner, feature settings, hyper-
+parameters, validation metrics, the fingerprint of the training data) and ``"estimator"``
+(the fitted scikit-learn pipeline). Loading checks, before anything is built, that every
+type in the file is one skops trusts by default (scikit-learn and numpy types; no custom
+class, no pickle), then validates the metadata against its schema.
+
+Examples
+--------
+>>> import tempfile, pathlib
+>>> rng = np.random.default_rng(0)
+>>> X = rng.normal(size=(80, 19)); y = (X[:, 0] > 0).astype(int)
+>>> grid = {"svc__estimator__C": [1.0], "svc__estimator__gamma": [0.1]}
+>>> model = SupportClassifier(cv=3, param_grid=grid, random_state=0).fit(X, y)
+>>> path = pathlib.Path(tempfile.mkdtemp()) / "model.skops"
+>>> save_model(SupportModel.from_classifier(model, FeatureSettings(), training={"seed": 0}), path)
+>>> load_model(path).features.sigma
+0.5
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+import zipfile
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from unstack.errors import InvalidFile
+from unstack.learning.classifier import SupportClassifier
+from unstack.learning.features import FeatureSettings
+
+__all__ = [
+    "DEFAULT_MODEL",
+    "MODEL_FORMAT",
+    "InvalidModel",
+    "SupportModel",
+    "default_model_path",
+    "load_model",
+    "save_model",
+]
+
+MODEL_FORMAT = "unstack.model/1"
+#: File name of the model shipped with the package (``unstack/learning/models``).
+DEFAULT_MODEL = "default-paper2.skops"
+
+
+#: scikit-learn types a model may hold beyond those skops trusts by default: the internals
+#: of ``CalibratedClassifierCV`` and of the histogram gradient boosting's trees (plain data
+#: holders, reviewed; no callables). Anything else that skops does not trust is refused.
+EXTRA_TRUSTED_TYPES = (
+    "sklearn.calibration._CalibratedClassifier",
+    "sklearn.calibration._SigmoidCalibration",
+    "sklearn.ensemble._hist_gradient_boosting.predictor.TreePredictor",
+)
+
+
+class InvalidModel(InvalidFile):
+    """A file that is not an unstack model, or a model this version cannot read."""
+
+
+@dataclass(frozen=True)
+class SupportModel:
+    """A fitted support classifier with what made it.
+
+    Attributes
+    ----------
+    estimator : sklearn.pipeline.Pipeline
+        ``predict_proba(F)[:, 1]`` is P(SUPP).
+    features : FeatureSettings
+    metadata : dict
+        ``learner``, ``best_params``, ``cv_score``, ``validation`` metrics, ``training``
+        (data set fingerprint, seed, r, ISets) and versions.
+    """
+
+    estimator: Any
+    features: FeatureSettings
+    metadata: dict[str, Any]
+
+    @classmethod
+    def from_classifier(
+        cls, classifier: SupportClassifier, features: FeatureSettings, *, training: dict[str, Any]
+    ) -> SupportModel:
+        """Wrap a fitted :class:`SupportClassifier`."""
+        from importlib import metadata as importlib_metadata
+
+        versions = {}
+        for package in ("unstack", "scikit-learn", "numpy", "skops"):
+            try:
+                versions[package] = importlib_metadata.version(package)
+            except importlib_metadata.PackageNotFoundError:  # pragma: no cover
+                versions[package] = "unknown"
+        metadata = {
+            "learner": classifier.learner,
+            "best_params": {key: _plain(value) for key, value in classifier.best_params_.items()},
+            "cv_score": classifier.cv_score_,
+            "cv_folds": classifier.cv_folds_,
+            "validation": classifier.validation_metrics_,
+            "training": training,
+            "versions": versions,
+        }
+        return cls(classifier.estimator_, features, metadata)
+
+    def support_probability(self, features: np.ndarray) -> np.ndarray:
+        """P(SUPP) for each row of ``F_XY``."""
+        if len(features) == 0:
+            return np.zeros(0)
+        classes = list(self.estimator.classes_)
+        probability: np.ndarray = self.estimator.predict_proba(features)[:, classes.index(1)]
+        return probability
+
+
+def _plain(value: Any) -> Any:
+    return value.item() if isinstance(value, np.generic) else value
+
+
+def save_model(model: SupportModel, path: str | os.PathLike[str]) -> None:
+    """Write a model file atomically."""
+    import skops.io
+
+    metadata = {"features": model.features.to_dict(), **model.metadata}
+    payload = {"format": MODEL_FORMAT, "metadata": json.dumps(metadata, allow_nan=True), "estimator": model.estimator}
+    target = Path(path)
+    temporary = target.with_name(f".{target.name}.tmp")
+    try:
+        temporary.write_bytes(skops.io.dumps(payload))
+        os.replace(temporary, target)
+    finally:
+        temporary.unlink(missing_ok=True)
+
+
+def load_model(path: str | os.PathLike[str]) -> SupportModel:
+    """Read a model file; a one-line :class:`InvalidModel` for anything else.
+
+    Raises
+    ------
+    InvalidModel
+        Not a readable file, not a skops file, types skops does not trust, not an
+        ``unstack.model/1`` payload, or a model of another version.
+    """
+    import skops.io
+
+    source = str(path)
+    target = Path(path)
+    if target.is_dir():
+        raise InvalidModel(source, "$", "expected a model file, got a directory")
+    try:
+        data = target.read_bytes()
+    except OSError as error:
+        raise InvalidModel(source, "$", f"cannot read the model file ({error.strerror or error})") from error
+    if not zipfile.is_zipfile(io.BytesIO(data)):
+        raise InvalidModel(source, "$", "expected an unstack model file (a skops file), got something else")
+    try:
+        untrusted = skops.io.get_untrusted_types(data=data)
+    except Exception as error:  # any failure to parse means "not a model"
+        raise InvalidModel(source, "$", f"expected an unstack model file (a skops file): {error}") from error
+    refused = sorted(set(untrusted) - set(EXTRA_TRUSTED_TYPES))
+    if refused:
+        raise InvalidModel(source, "$", f"refusing to load types that are not trusted: {', '.join(refused)}")
+    try:
+        payload = skops.io.loads(data, trusted=[name for name in untrusted if name in EXTRA_TRUSTED_TYPES])
+    except Exception as error:  # a broken skops file
+        raise InvalidModel(source, "$", f"the skops file does not load: {error}") from error
+    if not isinstance(payload, dict) or "format" not in payload:
+        raise InvalidModel(source, "$", "expected an unstack model (a dict with 'format'), got another skops object")
+    if payload["format"] != MODEL_FORMAT:
+        raise InvalidModel(
+            source, "$.format", f"unsupported model format {payload['format']!r}; expected {MODEL_FORMAT}"
+        )
+    try:
+        metadata = json.loads(payload["metadata"])
+        features = FeatureSettings(**metadata.pop("features"))
+        estimator = payload["estimator"]
+    except (KeyError, TypeError, ValueError) as error:
+        raise InvalidModel(source, "$.metadata", f"expected the model's metadata and estimator: {error}") from error
+    if not hasattr(estimator, "predict_proba"):
+        raise InvalidModel(source, "$.estimator", "expected a fitted classifier with predict_proba")
+    return SupportModel(estimator, features, metadata)
+
+
+def default_model_path() -> Path:
+    """Where the model shipped with the package lies."""
+    return Path(str(resources.files("unstack.learning") / "models" / DEFAULT_MODEL))

@@ -1,0 +1,76 @@
+"""From a scene to support probabilities: features of every ordered pair of detected boxes,
+then the model's P(SUPP).
+
+A learned probability is never hard evidence: values are clipped into
+``[PROBABILITY_FLOOR, 1 - PROBABILITY_FLOOR]`` so that only a planner's explicit 0 or 1
+constrains the worlds (the clipping is recorded in the output's metadata).
+
+Examples
+--------
+>>> from unstack.learning.model_file import default_model_path, load_model
+>>> from unstack.scene import load_scene
+>>> supports = scene_support_probabilities(load_scene("examples/pile5.scene.json"), load_model(default_model_path()))
+>>> supports.n_objects
+5
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+from unstack.learning.features import pair_features
+from unstack.learning.model_file import SupportModel
+from unstack.scene import Scene
+from unstack.supports import Supports
+
+__all__ = ["PROBABILITY_FLOOR", "scene_support_probabilities"]
+
+#: Learned probabilities are kept at least this far from 0 and 1.
+PROBABILITY_FLOOR = 1e-6
+
+
+def scene_support_probabilities(scene: Scene, model: SupportModel, *, model_name: str = "") -> Supports:
+    """``P(SUPP(X, Y))`` for every ordered pair of the scene's detected boxes.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its ``detected`` boxes become the objects, in that order.
+    model : SupportModel
+    model_name : str
+        Recorded in the metadata (for example the model file's path).
+
+    Returns
+    -------
+    Supports
+        With masses when every detected box has one.
+    """
+    if len(scene.points) == 0:
+        warnings.warn(f"{scene.source}: the point cloud is empty; the DBAF features are 0", stacklevel=2)
+    index = {box_id: k for k, box_id in enumerate(scene.box_ids)}
+    detected = [index[box_id] for box_id in scene.detected]
+    n = len(detected)
+    pairs = [(detected[i], detected[j]) for i in range(n) for j in range(n) if i != j]
+    probabilities = np.zeros((n, n))
+    if pairs:
+        features = pair_features(scene.boxes, scene.points, pairs, model.features)
+        values = np.clip(model.support_probability(features), PROBABILITY_FLOOR, 1.0 - PROBABILITY_FLOOR)
+        rows, columns = np.nonzero(~np.eye(n, dtype=bool))
+        probabilities[rows, columns] = values
+    masses = [scene.boxes[k].mass for k in detected]
+    metadata = {
+        "scene": scene.source,
+        "model": model_name,
+        "learner": model.metadata.get("learner"),
+        "features": model.features.to_dict(),
+        "clipped_to": [PROBABILITY_FLOOR, 1.0 - PROBABILITY_FLOOR],
+    }
+    return Supports(
+        list(scene.detected),
+        probabilities,
+        masses=masses if all(mass is not None for mass in masses) else None,
+        metadata=metadata,
+        source=scene.source,
+    )

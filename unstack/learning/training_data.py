@@ -1,0 +1,171 @@
+"""Training examples from simulated scenes (§V-A): ISets of detected boxes, every ordered pair.
+
+For each configuration of a data set, ``isets`` random ISets of ``r`` boxes are drawn from
+its detected boxes (the complete set 𝔆; scenes with fewer than ``r + 1`` detected boxes give
+ISets of all but one, as an ISet is a strict subset), and every ordered pair (X, Y) of an
+ISet gives one example: ``F_XY`` and the ground-truth label SUPP(X, Y).
+
+Examples
+--------
+>>> from unstack.scene import Box, Scene
+>>> boxes = [Box(f"b{k}", [0.4, 0.3, 0.3], [1.0, 0.4 * k, 0.15]) for k in range(4)]
+>>> scene = Scene(boxes, np.zeros((0, 3)), ["b0", "b1", "b2", "b3"], np.zeros((4, 4)))
+>>> examples = scene_examples(scene, r=3, isets=2, seed=0)
+>>> examples.features.shape, int(examples.labels.sum())
+((12, 19), 0)
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import warnings
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from unstack.errors import UnstackError
+from unstack.learning.features import FeatureSettings, pair_features
+from unstack.scene import Scene, load_scene
+
+__all__ = ["SupportExamples", "dataset_examples", "dataset_fingerprint", "sample_isets", "scene_examples"]
+
+
+@dataclass(frozen=True)
+class SupportExamples:
+    """Feature rows with their labels and where they came from.
+
+    Attributes
+    ----------
+    features : numpy.ndarray, shape (m, 19)
+    labels : numpy.ndarray, shape (m,)
+        1 for SUPP(X, Y), 0 otherwise.
+    configuration : numpy.ndarray, shape (m,)
+        Index of the scene in the data set.
+    iset : numpy.ndarray, shape (m,)
+        Index of the ISet within its scene.
+    pairs : list of (str, str)
+        ``(X, Y)`` ids of each row.
+    """
+
+    features: np.ndarray
+    labels: np.ndarray
+    configuration: np.ndarray
+    iset: np.ndarray
+    pairs: list[tuple[str, str]]
+
+    @staticmethod
+    def concatenate(parts: Sequence[SupportExamples]) -> SupportExamples:
+        """Stack several sets of examples."""
+        if not parts:
+            return SupportExamples(np.zeros((0, 19)), np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64),
+                                   np.zeros(0, dtype=np.int64), [])  # fmt: skip
+        return SupportExamples(
+            np.concatenate([part.features for part in parts]),
+            np.concatenate([part.labels for part in parts]),
+            np.concatenate([part.configuration for part in parts]),
+            np.concatenate([part.iset for part in parts]),
+            [pair for part in parts for pair in part.pairs],
+        )
+
+
+def sample_isets(detected: Sequence[str], *, r: int, isets: int, rng: np.random.Generator) -> list[list[str]]:
+    """``isets`` random strict subsets of ``detected`` with ``min(r, len - 1)`` boxes each.
+
+    Examples
+    --------
+    >>> sample_isets(["a", "b", "c"], r=5, isets=1, rng=np.random.default_rng(0))[0].__len__()
+    2
+    """
+    size = min(r, len(detected) - 1)
+    if size < 2:
+        return []
+    return [sorted(rng.choice(list(detected), size=size, replace=False).tolist()) for _ in range(isets)]
+
+
+def scene_examples(
+    scene: Scene,
+    *,
+    r: int = 5,
+    isets: int = 1,
+    seed: int | np.random.SeedSequence = 0,
+    settings: FeatureSettings | None = None,
+    configuration: int = 0,
+) -> SupportExamples:
+    """Examples of one scene with ground truth."""
+    if scene.ground_truth is None:
+        raise UnstackError(f"{scene.source}: $.ground_truth: training needs scenes with a ground-truth support matrix")
+    rng = np.random.default_rng(seed)
+    index = {box_id: k for k, box_id in enumerate(scene.box_ids)}
+    parts = []
+    for iset_index, iset in enumerate(sample_isets(scene.detected, r=r, isets=isets, rng=rng)):
+        pairs = [(index[x], index[y]) for x in iset for y in iset if x != y]
+        features = pair_features(scene.boxes, scene.points, pairs, settings)
+        labels = np.array([scene.ground_truth[x, y] for x, y in pairs], dtype=np.int64)
+        parts.append(
+            SupportExamples(
+                features,
+                labels,
+                np.full(len(pairs), configuration, dtype=np.int64),
+                np.full(len(pairs), iset_index, dtype=np.int64),
+                [(scene.box_ids[x], scene.box_ids[y]) for x, y in pairs],
+            )
+        )
+    return SupportExamples.concatenate(parts)
+
+
+def _one_file(
+    path: Path, r: int, isets: int, seed: int, settings: FeatureSettings, configuration: int
+) -> SupportExamples:
+    scene = load_scene(path)
+    if len(scene.points) == 0:
+        warnings.warn(f"{path}: the point cloud is empty; its DBAF features are 0", stacklevel=2)
+    child = np.random.SeedSequence(seed, spawn_key=(configuration,))
+    return scene_examples(scene, r=r, isets=isets, seed=child, settings=settings, configuration=configuration)
+
+
+def dataset_fingerprint(folder: str | os.PathLike[str]) -> str:
+    """SHA-256 of a data set's manifest and scene files (what a model was trained on)."""
+    from unstack.sim.dataset import list_configurations
+
+    digest = hashlib.sha256()
+    manifest = Path(folder) / "manifest.json"
+    if manifest.is_file():
+        digest.update(manifest.read_bytes())
+    for path in list_configurations(folder):
+        digest.update(path.name.encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def dataset_examples(
+    folder: str | os.PathLike[str],
+    *,
+    r: int = 5,
+    isets: int = 1,
+    seed: int = 0,
+    settings: FeatureSettings | None = None,
+    n_jobs: int = 1,
+    progress: Callable[[int, int], None] | None = None,
+) -> SupportExamples:
+    """Examples of every scene of a simulated data set folder (``config-NNNN.json``).
+
+    ISets are seeded per configuration, so the examples do not depend on ``n_jobs``.
+    """
+    from joblib import Parallel, delayed
+
+    from unstack.sim.dataset import list_configurations
+
+    files = list_configurations(folder)
+    if not files:
+        raise UnstackError(f"{folder}: expected a data set folder with config-NNNN.json scene files, found none")
+    settings = settings or FeatureSettings()
+    tasks = (delayed(_one_file)(path, r, isets, seed, settings, int(path.stem.split("-")[1])) for path in files)
+    parts: list[SupportExamples] = []
+    for part in Parallel(n_jobs=n_jobs, return_as="generator")(tasks):
+        parts.append(part)
+        if progress is not None:
+            progress(len(parts), len(files))
+    return SupportExamples.concatenate(parts)
