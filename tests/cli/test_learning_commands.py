@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from tests.cli.test_commands import unstack
+from tests.conftest import REPO
 from unstack.jsonio import load_schema
 from unstack.sim.dataset import list_configurations
 
@@ -97,3 +98,15 @@ def test_bad_input_is_one_line(arguments: list[str], message: str, tmp_path: Pat
     assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
     assert message in result.stderr
     assert not list(tmp_path.iterdir())
+
+
+def test_an_empty_point_cloud_is_a_one_line_warning(tmp_path: Path) -> None:
+    document = json.loads((REPO / "examples" / "scene3.json").read_text())
+    document.pop("points_file", None)
+    document["points"] = []
+    scene = tmp_path / "empty.json"
+    scene.write_text(json.dumps(document))
+    result = unstack("probabilities", str(scene))
+    assert result.returncode == 0, result.stderr
+    assert result.stderr == f"unstack: warning: {scene}: the point cloud is empty; the DBAF features are 0\n"
+    assert json.loads(result.stdout)["format"] == "unstack.supports/1"

@@ -183,8 +183,16 @@ def _register_commands() -> None:
 _register_commands()
 
 
+def _warning_line(message: Warning | str, category: type[Warning], *_: object, **__: object) -> None:
+    """Library warnings (an empty point cloud, say) as one line on stderr, without source lines."""
+    click.echo(f"unstack: warning: {message}", err=True)
+
+
 def main() -> None:
     """Console-script entry point."""
+    import warnings
+
+    warnings.showwarning = _warning_line
     cli(prog_name="unstack")
 
 
