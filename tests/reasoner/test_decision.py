@@ -126,9 +126,12 @@ def test_mass_cost_without_masses_says_what_is_missing() -> None:
         decide(Supports(["a", "b"], [[0, 0.5], [0.5, 0]]), cost="mass")
 
 
-def test_auto_refuses_scenes_beyond_exact_reach() -> None:
-    with pytest.raises(TooLarge, match="limited to 8 boxes"):
-        decide(Supports(ids(9), np.zeros((9, 9))))
+def test_auto_refuses_scenes_beyond_exact_reach(rng: np.random.Generator) -> None:
+    dense = rng.uniform(0.1, 0.9, (9, 9))
+    np.fill_diagonal(dense, 0.0)
+    with pytest.raises(TooLarge, match="9 linked boxes: exact reasoning is limited to 8 boxes per group"):
+        decide(Supports(ids(9), dense))
+    assert decide(Supports(ids(9), np.zeros((9, 9)))).consistent_worlds == 1  # nine unlinked boxes
 
 
 def test_unknown_method_is_rejected() -> None:

@@ -39,7 +39,13 @@ def decision_view(decision: Decision) -> Group:
     worlds = "" if decision.consistent_worlds is None else f", {decision.consistent_worlds:,} consistent worlds"
     evidence = decision.evidence
     hard = f", hard evidence: {len(evidence.forced)} forced / {len(evidence.forbidden)} forbidden"
-    footer = Text(f"method {decision.method}{worlds}{hard}, {decision.seconds:.3f} s", style="dim")
+    linked = [group for group in decision.components if len(group) > 1]
+    groups = (
+        f", {len(decision.components)} independent groups (largest {max(len(g) for g in decision.components)})"
+        if len(decision.components) > 1 and linked
+        else ""
+    )
+    footer = Text(f"method {decision.method}{worlds}{groups}{hard}, {decision.seconds:.3f} s", style="dim")
     headline = Text.assemble(("Unload first: ", "bold"), (decision.choice, "bold green"))
     if len(decision.ties) > 1:
         headline.append(

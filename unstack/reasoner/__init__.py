@@ -12,6 +12,7 @@ Examples
 'a'
 """
 
+from unstack.reasoner.components import support_components
 from unstack.reasoner.consistency import PREORDER_COUNTS, is_transitive, transitivity_clauses
 from unstack.reasoner.costs import COSTS, cost_weights, expected_costs
 from unstack.reasoner.decision import METHODS, Decision, choose, decide
@@ -42,5 +43,6 @@ __all__ = [
     "is_transitive",
     "payoff_matrix",
     "propagate_evidence",
+    "support_components",
     "transitivity_clauses",
 ]

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from unstack.errors import UnstackError
+from unstack.reasoner.components import support_components
 from unstack.reasoner.consistency import PREORDER_COUNTS
 from unstack.reasoner.costs import cost_weights, expected_costs
 from unstack.reasoner.marginals import EXACT_MAX_BOXES
@@ -80,6 +81,9 @@ class Decision:
         Number of consistent worlds of non-zero probability, when the method counted them.
     ties : tuple of str
         Every box whose EC equals the minimum (the choice is the smallest id).
+    components : tuple of tuple of str
+        Groups of boxes linked by non-zero support probabilities; the reasoning runs on each
+        group alone (see :mod:`unstack.reasoner.components`).
     evidence : Evidence
         Hard evidence after propagation.
     seconds : float
@@ -95,6 +99,7 @@ class Decision:
     consistent_worlds: int | None
     ties: tuple[str, ...]
     evidence: Evidence
+    components: tuple[tuple[str, ...], ...] = ()
     seconds: float = field(default=0.0)
 
     def to_dict(self) -> dict[str, Any]:
@@ -111,6 +116,7 @@ class Decision:
         if self.consistent_worlds is not None:
             data["consistent_worlds"] = self.consistent_worlds
         data["ties"] = list(self.ties)
+        data["components"] = [list(group) for group in self.components]
         data["evidence"] = {
             "forced": [list(pair) for pair in self.evidence.forced],
             "forbidden": [list(pair) for pair in self.evidence.forbidden],
@@ -133,26 +139,46 @@ def choose(objects: tuple[str, ...], costs: np.ndarray) -> tuple[str, tuple[str,
     return tied[0], tied
 
 
-def _resolve_method(method: str, n: int) -> str:
+def _resolve_method(method: str, largest: int, n: int) -> str:
+    """The method for groups of at most ``largest`` linked boxes (of ``n`` in all)."""
     if method not in METHODS:
         raise UnstackError(f"unknown method {method!r}; expected one of {', '.join(METHODS)}")
     if method == "auto":
-        if n <= AUTO_SAT_MAX_BOXES:
+        if largest <= AUTO_SAT_MAX_BOXES:
             return "sat"
-        if n > EXACT_MAX_BOXES:
-            raise _too_large_for_all(n)
+        if largest > EXACT_MAX_BOXES:
+            raise _too_large_for_all(largest, n)
         return "exact"
     return method
 
 
-def _too_large_for_all(n: int) -> UnstackError:
+def _too_large_for_all(largest: int, n: int) -> UnstackError:
     from unstack.errors import TooLarge
 
+    count = PREORDER_COUNTS[largest] if largest < len(PREORDER_COUNTS) else "over 1e13"
+    where = f"{largest} linked boxes" if largest == n else f"a group of {largest} linked boxes (of {n})"
     return TooLarge(
-        f"{n} detected boxes: exact reasoning is limited to {EXACT_MAX_BOXES} boxes "
-        f"({n} boxes have {PREORDER_COUNTS[n] if n < len(PREORDER_COUNTS) else 'over 1e13'} "
-        "consistent worlds); decide on a subset of the detected boxes"
+        f"{where}: exact reasoning is limited to {EXACT_MAX_BOXES} boxes per group of boxes linked by "
+        f"non-zero support probabilities ({largest} boxes have {count} consistent worlds); decide on a "
+        "subset of the detected boxes"
     )
+
+
+def _group_marginals(
+    supports: Supports, evidence: Evidence, group: np.ndarray, method: str, max_boxes: int | None
+) -> tuple[np.ndarray, int | None]:
+    """Conditional marginals and world count of one group of linked boxes."""
+    probabilities = evidence.probabilities[np.ix_(group, group)]
+    if method == "sat":
+        from unstack.reasoner.worlds import enumerate_worlds
+
+        objects = [supports.objects[i] for i in group]
+        world_set = enumerate_worlds(Supports(objects, probabilities), max_boxes=max_boxes or SAT_MAX_BOXES)
+        return world_set.marginals(), len(world_set)
+    from unstack.reasoner.marginals import exact_marginals
+
+    result = exact_marginals(probabilities, max_boxes=max_boxes or EXACT_MAX_BOXES)
+    return result.marginals, result.consistent_worlds
 
 
 def decide(
@@ -191,28 +217,24 @@ def decide(
     start = time.perf_counter()
     n = supports.n_objects
     weights = cost_weights(supports, cost)
-    chosen_method = _resolve_method(method, n)
     evidence = propagate_evidence(supports.objects, supports.probabilities)
-    if n == 1:
-        marginals = np.zeros((1, 1))
-        worlds: int | None = 1
-    elif chosen_method == "sat":
-        from unstack.reasoner.worlds import enumerate_worlds
-
-        world_set = enumerate_worlds(supports, max_boxes=max_boxes or SAT_MAX_BOXES)
-        marginals = world_set.marginals()
-        worlds = len(world_set)
-    else:
-        from unstack.reasoner.marginals import exact_marginals
-
-        result = exact_marginals(evidence.probabilities, max_boxes=max_boxes or EXACT_MAX_BOXES)
-        marginals = result.marginals
-        worlds = result.consistent_worlds
+    groups = support_components(evidence.probabilities)
+    largest = max(len(group) for group in groups)
+    chosen_method = _resolve_method(method, largest, n)
+    marginals = np.zeros((n, n))
+    worlds: int | None = 1
+    for group in groups:
+        if len(group) == 1:
+            continue
+        group_marginals, group_worlds = _group_marginals(supports, evidence, group, chosen_method, max_boxes)
+        marginals[np.ix_(group, group)] = group_marginals
+        worlds = None if worlds is None or group_worlds is None else worlds * group_worlds
     costs = expected_costs(marginals, weights)
     choice, ties = choose(supports.objects, costs)
     return Decision(
         objects=supports.objects,
         choice=choice,
+        components=tuple(tuple(supports.objects[i] for i in group) for group in groups),
         expected_costs=costs,
         marginals=marginals,
         method=chosen_method,
