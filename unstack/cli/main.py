@@ -173,10 +173,11 @@ def validate(files: tuple[str, ...]) -> None:
 
 
 def _register_commands() -> None:
+    from unstack.cli.experiments import experiment
     from unstack.cli.learning import evaluate, probabilities, train
     from unstack.cli.simulation import render, simulate
 
-    for command in (simulate, render, train, evaluate, probabilities):
+    for command in (simulate, render, train, evaluate, probabilities, experiment):
         cli.add_command(command)
 
 

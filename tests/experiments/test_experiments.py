@@ -1,0 +1,75 @@
+"""Experiments: Table I against the paper, decision scores on simulated ISets."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tests.cli.test_commands import unstack
+from unstack.experiments.decisions import DECISION_MAKERS, _Iset, _scores, evaluate_decisions, squared_regret
+from unstack.experiments.table1 import OEIS_A000798, PAPER_TABLE_I, table1
+from unstack.learning.model_file import default_model_path, load_model
+
+
+def test_table1_reproduces_the_paper() -> None:
+    for row in table1(sizes=(3, 4, 5, 6), sat_max=5):
+        assert row["exact"] == PAPER_TABLE_I[row["n"]] == OEIS_A000798[row["n"]]
+        assert row.get("sat", row["exact"]) == row["exact"]
+        assert row["all_worlds"] == 2 ** (row["n"] * (row["n"] - 1))
+
+
+def handmade(costs: list[float], picks: dict[str, int]) -> _Iset:
+    r = len(costs)
+    disturbance = np.column_stack([np.arange(r), np.arange(r) * 0.1])
+    return _Iset("x", [f"b{k}" for k in range(r)], np.array(costs), picks, disturbance, 1.0, 0.0, 0.0)
+
+
+def test_random_scores_are_exact_expectations() -> None:
+    iset = handmade([2.0, 0.0, 1.0], {"reasoner": 1, "priors": 0, "highest": 2, "free": 1})
+    random = _scores([iset], "random")
+    assert random["squared_regret"][0] == pytest.approx((4 + 0 + 1) / 3)
+    assert random["first_pick_right"][0] == pytest.approx(1 / 3)
+    assert random["moved"][0] == pytest.approx(1.0)
+    chosen = _scores([iset], "priors")
+    assert chosen["squared_regret"][0] == squared_regret(iset.costs, 0) == 4.0
+    assert chosen["first_pick_right"][0] == 0.0 and chosen["moved"][0] == 0
+
+
+def test_decisions_on_simulated_piles(small_dataset: Path) -> None:
+    result = evaluate_decisions(small_dataset, load_model(default_model_path()), r=4, isets=12, seed=2)
+    assert result["isets"] == 12
+    for maker in DECISION_MAKERS:
+        summary = result["summary"][maker]
+        assert summary["mse_cost"] >= 0 and 0 <= summary["first_pick_right"] <= 1
+    for rows in result["bins"].values():
+        assert sum(row["isets"] for row in rows) == 12
+    again = evaluate_decisions(small_dataset, load_model(default_model_path()), r=4, isets=12, seed=2)
+    assert again["summary"] == result["summary"]
+
+
+def test_experiment_commands(small_dataset: Path, tmp_path: Path) -> None:
+    result = unstack("experiment", "table1", "--out", str(tmp_path), "--max-n", "5")
+    assert result.returncode == 0, result.stderr
+    assert [row["exact"] for row in json.loads((tmp_path / "table1.json").read_text())] == [29, 355, 6942]
+    result = unstack("experiment", "decisions", str(small_dataset), "--out", str(tmp_path), "--r", "4", "--isets", "6")
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "fig4.png").read_bytes()[:4] == b"\x89PNG"
+    assert json.loads((tmp_path / "decisions.json").read_text())["isets"] == 6
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (["table1", "--out", "{tmp}", "--max-n", "12"], "--max-n must be between 3 and 8, got 12"),
+        (["decisions", "examples", "--out", "{tmp}"], "examples: expected a data set folder with config-NNNN.json"),
+        (["decisions", "examples", "--out", "{tmp}", "--r", "1"], "expected --r >= 2 and --isets >= 1"),
+    ],
+)
+def test_experiment_bad_input(arguments: list[str], message: str, tmp_path: Path) -> None:
+    result = unstack("experiment", *[argument.format(tmp=tmp_path) for argument in arguments])
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert message in result.stderr
+    assert not list(tmp_path.iterdir())

@@ -1,0 +1,105 @@
+"""``unstack experiment``: the paper's results, reproduced from existing data sets."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import click
+from rich.console import Console
+from rich.table import Table
+
+from unstack.errors import UnstackError
+
+__all__ = ["experiment"]
+
+
+@click.group()
+def experiment() -> None:
+    """Reproduce the paper's tables and figures (results as JSON and PNG in --out)."""
+
+
+def _out(out: str) -> Path:
+    folder = Path(out)
+    if folder.exists() and not folder.is_dir():
+        raise UnstackError(f"{out}: expected a folder for the results, got a file")
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder
+
+
+def _write_json(path: Path, data: object) -> None:
+    from unstack.jsonio import atomic_write_text
+
+    atomic_write_text(path, json.dumps(data, indent=2) + "\n")
+
+
+@experiment.command()
+@click.option("--out", required=True, type=click.Path(), help="Folder for table1.json.")
+@click.option("--max-n", type=int, default=6, show_default=True, help="Largest n (7 takes seconds, 8 minutes).")
+def table1(out: str, max_n: int) -> None:
+    """Table I: consistent worlds for n = 3..max-n by the exact engine and SAT, against the paper and OEIS."""
+    from unstack.experiments.table1 import table1 as count
+
+    if not 3 <= max_n <= 8:
+        raise UnstackError(f"--max-n must be between 3 and 8, got {max_n}")
+    rows = count(range(3, max_n + 1))
+    _write_json(_out(out) / "table1.json", rows)
+    table = Table(title="Table I: consistent worlds q' of n boxes")
+    for column in ("n", "all worlds q", "exact engine", "SAT listing", "paper", "OEIS A000798"):
+        table.add_column(column, justify="right")
+    for row in rows:
+        table.add_row(
+            str(row["n"]),
+            f"{row['all_worlds']:,}",
+            f"{row['exact']:,}",
+            f"{row['sat']:,}" if "sat" in row else "-",
+            f"{row['paper']:,}" if row["paper"] else "-",
+            f"{row['oeis']:,}",
+        )
+    Console().print(table)
+
+
+@experiment.command()
+@click.argument("data_dir", type=click.Path(file_okay=False))
+@click.option("--out", required=True, type=click.Path(), help="Folder for decisions.json and fig4.png.")
+@click.option("--model", "model_path", default=None, help="Model file (default: the one shipped).")
+@click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
+@click.option("--isets", type=int, default=493, show_default=True, help="Test ISets (the paper: 493).")
+@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets.")
+def decisions(data_dir: str, out: str, model_path: str | None, r: int, isets: int, seed: int) -> None:
+    """Fig. 4 and beyond: MSE(cost), first pick right and physical disturbance of every decision maker."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
+
+    from unstack.cli.learning import load_support_model
+    from unstack.experiments.decisions import DECISION_MAKERS, evaluate_decisions, plot_fig4
+    from unstack.sim.dataset import list_configurations
+
+    if r < 2 or isets < 1:
+        raise UnstackError(f"expected --r >= 2 and --isets >= 1, got {r} and {isets}")
+    if not list_configurations(data_dir):  # before any progress bar or output folder
+        raise UnstackError(f"{data_dir}: expected a data set folder with config-NNNN.json scene files, found none")
+    model, name = load_support_model(model_path)
+    folder = _out(out)
+    with Progress("ISets", BarColumn(), MofNCompleteColumn(), "ETA", TimeRemainingColumn(),
+                  console=Console(stderr=True), transient=True) as bar:  # fmt: skip
+        task = bar.add_task("ISets", total=isets)
+        result = evaluate_decisions(
+            data_dir, model, r=r, isets=isets, seed=seed, progress=lambda done, total: bar.update(task, completed=done)
+        )
+    result["model"] = name
+    _write_json(folder / "decisions.json", result)
+    plot_fig4(result, folder / "fig4.png")
+    table = Table(title=f"{result['isets']} test ISets of {r} boxes ({data_dir})")
+    for column in ("decision maker", "MSE(cost)", "first pick right", "boxes moved > 2 cm", "displacement (m)"):
+        table.add_column(column, justify="right")
+    for maker in DECISION_MAKERS:
+        row = result["summary"][maker]
+        table.add_row(
+            maker,
+            f"{row['mse_cost']:.3f}",
+            f"{100 * row['first_pick_right']:.1f} %",
+            f"{row['boxes_moved']:.2f}",
+            f"{row['displacement_m']:.3f}",
+        )
+    Console().print(table)
+    click.echo(f"results in {folder / 'decisions.json'} and {folder / 'fig4.png'}")

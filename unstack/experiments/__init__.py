@@ -1,0 +1,18 @@
+"""Experiments that reproduce the paper's results (§V) and go beyond them.
+
+Each experiment reads existing data sets (made by ``unstack simulate``), is seeded, and
+writes JSON results and PNG plots; ``unstack experiment NAME`` runs it.
+
+Examples
+--------
+>>> from unstack.experiments import EXPERIMENTS
+>>> sorted(EXPERIMENTS)
+['decisions', 'table1']
+"""
+
+EXPERIMENTS = {
+    "table1": "unstack.experiments.table1",
+    "decisions": "unstack.experiments.decisions",
+}
+
+__all__ = ["EXPERIMENTS"]
