@@ -43,6 +43,7 @@ FORMATS: dict[str, str] = {
     "unstack.scene/1": "scene-1.schema.json",
     "unstack.decision/1": "decision-1.schema.json",
     "unstack.dataset/1": "dataset-1.schema.json",
+    "unstack.plan/1": "plan-1.schema.json",
 }
 
 STDIN_NAME = "<stdin>"

@@ -149,6 +149,35 @@ def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str) 
 
 
 @cli.command()
+@click.argument("file", type=str)
+@click.option("--json", "as_json", is_flag=True, help="Print the plan as unstack.plan/1 JSON.")
+@click.option("-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON plan to this file.")
+@click.option("--method", type=click.Choice(["auto", "exact", "sat"]), default="auto", show_default=True)
+@click.option("--cost", type=click.Choice(["count", "mass"]), default="count", show_default=True)
+@click.option("--model", "model_path", default=None, help="Model for scene files (default: the one shipped).")
+def plan(file: str, as_json: bool, output: str | None, method: str, cost: str, model_path: str | None) -> None:
+    """Order all detected boxes by repeated decisions: pick, remove from the set, decide again."""
+    from rich.table import Table
+
+    from unstack.reasoner.plan import unloading_plan
+
+    supports = _load_supports(file, model_path)
+    result = unloading_plan(supports, method=method, cost=cost)
+    document = result.to_dict()
+    _write_output(output, document)
+
+    def view() -> Table:
+        table = Table(title="Unloading plan (each step decided on the boxes still in place)", title_justify="left")
+        for column in ("step", "unload", "EC", "boxes in place"):
+            table.add_column(column, justify="right" if column != "unload" else "left")
+        for number, step in enumerate(result.steps, start=1):
+            table.add_row(str(number), step.choice, f"{step.expected_cost:.4f}", str(len(step.remaining)))
+        return table
+
+    _emit(as_json, document, view)
+
+
+@cli.command()
 @click.argument("files", nargs=-1, required=True, type=str)
 def validate(files: tuple[str, ...]) -> None:
     """Check files against their schema (unstack.supports/1, unstack.scene/1, unstack.decision/1)."""
@@ -165,6 +194,8 @@ def validate(files: tuple[str, ...]) -> None:
         elif tag == "unstack.scene/1":
             scene = Scene.from_document(document)
             detail = f"{len(scene.boxes)} boxes, {len(scene.detected)} detected, {len(scene.points):,} points"
+        elif tag == "unstack.plan/1":
+            detail = f"{len(document.data['order'])} boxes in order"
         elif tag == "unstack.dataset/1":
             detail = f"{document.data['configs']} configurations, seed {document.data['seed']}"
         else:
