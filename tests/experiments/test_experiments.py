@@ -73,3 +73,14 @@ def test_experiment_bad_input(arguments: list[str], message: str, tmp_path: Path
     assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
     assert message in result.stderr
     assert not list(tmp_path.iterdir())
+
+
+def test_fig5a_on_simulated_piles(small_dataset: Path, tmp_path: Path) -> None:
+    result = unstack("experiment", "fig5a", str(small_dataset), "--out", str(tmp_path), "--r", "4", "--isets", "3",
+                     "--cv", "3")  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert "paper (Fig. 5a)" in result.stdout and "78.4 %" in result.stdout
+    document = json.loads((tmp_path / "fig5a.json").read_text())
+    matrix = np.array(document["validation"]["confusion_matrix"])
+    assert matrix.sum() == document["validation"]["relations"]
+    assert 0.0 < document["balanced_threshold"] <= 1.0

@@ -61,6 +61,41 @@ def table1(out: str, max_n: int) -> None:
 
 @experiment.command()
 @click.argument("data_dir", type=click.Path(file_okay=False))
+@click.option("--out", required=True, type=click.Path(), help="Folder for fig5a.json.")
+@click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
+@click.option("--isets", type=int, default=1, show_default=True, help="ISets per configuration.")
+@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets, split and folds.")
+@click.option("--cv", type=int, default=10, show_default=True, help="Cross-validation folds.")
+@click.option("--jobs", type=int, default=1, show_default=True, help="Parallel processes.")
+def fig5a(data_dir: str, out: str, r: int, isets: int, seed: int, cv: int, jobs: int) -> None:
+    """Fig. 5a: the validation confusion matrix of the SVM on a simulated data set, beside the paper's."""
+    from unstack.experiments.fig5a import fig5a as run
+    from unstack.sim.dataset import list_configurations
+
+    if r < 2 or isets < 1 or cv < 2 or jobs < 1:
+        raise UnstackError("expected --r >= 2, --isets >= 1, --cv >= 2 and --jobs >= 1")
+    if not list_configurations(data_dir):
+        raise UnstackError(f"{data_dir}: expected a data set folder with config-NNNN.json scene files, found none")
+    result = run(data_dir, r=r, isets=isets, seed=seed, cv=cv, n_jobs=jobs)
+    _write_json(_out(out) / "fig5a.json", result)
+    table = Table(title=f"Fig. 5a: validation relations of {data_dir} ({result['relations']} relations, "
+                  f"{result['supp']} SUPP)")  # fmt: skip
+    for column in ("", "SUPP right", "not SUPP right"):
+        table.add_column(column, justify="right")
+    ours = result["validation"]
+    balanced = result["validation_at_balanced_threshold"]
+    table.add_row("paper (Fig. 5a)", "78.4 %", "87.5 %")
+    table.add_row("unstack, P >= 0.5", f"{100 * ours['supp_recall']:.1f} %", f"{100 * ours['not_supp_recall']:.1f} %")
+    table.add_row(
+        f"unstack, P >= {result['balanced_threshold']:.3f} (balanced on training part)",
+        f"{100 * balanced['supp_recall']:.1f} %",
+        f"{100 * balanced['not_supp_recall']:.1f} %",
+    )
+    Console().print(table)
+
+
+@experiment.command()
+@click.argument("data_dir", type=click.Path(file_okay=False))
 @click.option("--out", required=True, type=click.Path(), help="Folder for decisions.json and fig4.png.")
 @click.option("--model", "model_path", default=None, help="Model file (default: the one shipped).")
 @click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")

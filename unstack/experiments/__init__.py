@@ -7,12 +7,13 @@ Examples
 --------
 >>> from unstack.experiments import EXPERIMENTS
 >>> sorted(EXPERIMENTS)
-['decisions', 'table1']
+['decisions', 'fig5a', 'table1']
 """
 
 EXPERIMENTS = {
     "table1": "unstack.experiments.table1",
     "decisions": "unstack.experiments.decisions",
+    "fig5a": "unstack.experiments.fig5a",
 }
 
 __all__ = ["EXPERIMENTS"]
