@@ -225,10 +225,9 @@ def evaluate_decisions(
 
 def plot_fig4(result: dict[str, Any], output: str | os.PathLike[str]) -> None:
     """The paper's Fig. 4: MSE(cost) per bin for unstack and the random decision maker, with histograms."""
-    import matplotlib
+    from unstack.figures import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     labels = {
         "success_rate": "classifier success rate",
@@ -251,11 +250,6 @@ def plot_fig4(result: dict[str, Any], output: str | os.PathLike[str]) -> None:
         axes[1, column].set_ylabel("% of ISets")
     figure.suptitle(f"{result['isets']} test ISets of {result['r']} boxes from {Path(result['data']).name}")
     figure.tight_layout()
-    target = Path(output)
-    temporary = target.with_name(f".{target.name}.tmp.png")
-    try:
-        figure.savefig(temporary, dpi=110)
-        os.replace(temporary, target)
-    finally:
-        plt.close(figure)
-        temporary.unlink(missing_ok=True)
+    from unstack.figures import save_png
+
+    save_png(figure, output)

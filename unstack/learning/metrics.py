@@ -115,12 +115,10 @@ def classification_report(truth: Any, probability: Any) -> dict[str, Any]:
 
 def save_reliability_diagram(report: dict[str, Any], output: str | os.PathLike[str], *, title: str = "") -> None:
     """Draw the reliability diagram of a :func:`classification_report` into a PNG (atomically)."""
-    from pathlib import Path
 
-    import matplotlib
+    from unstack.figures import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     curve = report["reliability"]
     edges = np.asarray(curve["bin_edges"])
@@ -135,11 +133,6 @@ def save_reliability_diagram(report: dict[str, Any], output: str | os.PathLike[s
     bottom.set_xlabel("predicted P(SUPP)")
     bottom.set_ylabel("relations")
     figure.tight_layout()
-    target = Path(output)
-    temporary = target.with_name(f".{target.name}.tmp.png")
-    try:
-        figure.savefig(temporary, dpi=110)
-        os.replace(temporary, target)
-    finally:
-        plt.close(figure)
-        temporary.unlink(missing_ok=True)
+    from unstack.figures import save_png
+
+    save_png(figure, output)

@@ -109,10 +109,9 @@ def render_scene(
         Folder of the scene file, to find its per-point box labels (simulated scenes).
     title : str, optional
     """
-    import matplotlib
+    from unstack.figures import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     from matplotlib import colormaps
     from matplotlib.colors import BoundaryNorm
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
@@ -196,11 +195,6 @@ def render_scene(
         bar.set_label("boxes supported (ground truth)")
     if title:
         figure.suptitle(title)
-    target = Path(output)
-    temporary = target.with_name(f".{target.name}.tmp.png")
-    try:
-        figure.savefig(temporary, dpi=110)
-        os.replace(temporary, target)
-    finally:
-        plt.close(figure)
-        temporary.unlink(missing_ok=True)
+    from unstack.figures import save_png
+
+    save_png(figure, output)
