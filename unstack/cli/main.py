@@ -180,7 +180,7 @@ def plan(file: str, as_json: bool, output: str | None, method: str, cost: str, m
 @cli.command()
 @click.argument("files", nargs=-1, required=True, type=str)
 def validate(files: tuple[str, ...]) -> None:
-    """Check files against their schema (unstack.supports/1, unstack.scene/1, unstack.decision/1)."""
+    """Check files against their schema (supports, scene, decision, plan, data set manifest)."""
     from unstack.jsonio import read_document, validate_document
     from unstack.scene import Scene
     from unstack.supports import Supports
