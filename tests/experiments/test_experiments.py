@@ -84,3 +84,25 @@ def test_fig5a_on_simulated_piles(small_dataset: Path, tmp_path: Path) -> None:
     matrix = np.array(document["validation"]["confusion_matrix"])
     assert matrix.sum() == document["validation"]["relations"]
     assert 0.0 < document["balanced_threshold"] <= 1.0
+
+
+def test_real7_scores_every_iset(small_dataset: Path) -> None:
+    from itertools import combinations
+
+    from unstack.experiments.real7 import real7
+    from unstack.scene import load_scene
+    from unstack.sim.dataset import list_configurations
+
+    boxes = len(load_scene(list_configurations(small_dataset)[0]).boxes)
+    result = real7(small_dataset, load_model(default_model_path()), sizes=(3,), piles=1)
+    assert result["by_r"]["3"]["isets"] == len(list(combinations(range(boxes), 3)))
+    assert result["by_r"]["3"]["paper_first_pick_right"] == 0.905
+    assert 0 <= result["by_r"]["3"]["reasoner"]["first_pick_right"] <= 1
+    assert result["worst_mse"]["random"] >= 0
+
+
+def test_real7_command(small_dataset: Path, tmp_path: Path) -> None:
+    result = unstack("experiment", "real7", str(small_dataset), "--out", str(tmp_path), "--piles", "1")
+    assert result.returncode == 0, result.stderr
+    assert "90.5 %" in result.stdout and "worst MSE(cost) over r" in result.stdout
+    assert set(json.loads((tmp_path / "real7.json").read_text())["by_r"]) == {"3", "4", "5"}

@@ -138,3 +138,42 @@ def decisions(data_dir: str, out: str, model_path: str | None, r: int, isets: in
         )
     Console().print(table)
     click.echo(f"results in {folder / 'decisions.json'} and {folder / 'fig4.png'}")
+
+
+@experiment.command()
+@click.argument("data_dir", type=click.Path(file_okay=False))
+@click.option("--out", required=True, type=click.Path(), help="Folder for real7.json.")
+@click.option("--model", "model_path", default=None, help="Model trained on piles of the same four sizes.")
+@click.option("--piles", type=int, default=None, help="Use only the first N piles.")
+def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) -> None:
+    """The paper's real setting in simulation: every ISet of r = 3, 4, 5 of each 7-box pile."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
+
+    from unstack.cli.learning import load_support_model
+    from unstack.experiments.real7 import real7 as run
+    from unstack.experiments.real7 import summary_rows
+    from unstack.sim.dataset import list_configurations
+
+    if piles is not None and piles < 1:
+        raise UnstackError(f"--piles must be at least 1, got {piles}")
+    if not list_configurations(data_dir):
+        raise UnstackError(f"{data_dir}: expected a data set folder with config-NNNN.json scene files, found none")
+    model, name = load_support_model(model_path)
+    with Progress("ISets", BarColumn(), MofNCompleteColumn(), "ETA", TimeRemainingColumn(),
+                  console=Console(stderr=True), transient=True) as bar:  # fmt: skip
+        task = bar.add_task("ISets", total=None)
+        result = run(
+            data_dir, model, piles=piles, progress=lambda done, total: bar.update(task, completed=done, total=total)
+        )
+    result["model"] = name
+    _write_json(_out(out) / "real7.json", result)
+    table = Table(title=f"first pick right, {result['piles']} simulated 7-box piles ({data_dir})")
+    for column in ("r", "ISets", "paper", "unstack", "highest first", "random"):
+        table.add_column(column, justify="right")
+    for row in summary_rows(result):
+        table.add_row(*row)
+    Console().print(table)
+    worst = result["worst_mse"]
+    click.echo(
+        f"worst MSE(cost) over r: unstack {worst['reasoner']:.3f}, random {worst['random']:.3f} (paper 0.5 vs 3.5)"
+    )

@@ -7,13 +7,14 @@ Examples
 --------
 >>> from unstack.experiments import EXPERIMENTS
 >>> sorted(EXPERIMENTS)
-['decisions', 'fig5a', 'table1']
+['decisions', 'fig5a', 'real7', 'table1']
 """
 
 EXPERIMENTS = {
     "table1": "unstack.experiments.table1",
     "decisions": "unstack.experiments.decisions",
     "fig5a": "unstack.experiments.fig5a",
+    "real7": "unstack.experiments.real7",
 }
 
 __all__ = ["EXPERIMENTS"]
