@@ -9,6 +9,7 @@ import click
 from rich.console import Console
 from rich.table import Table
 
+from unstack.cli.progress import progress_bar
 from unstack.errors import UnstackError
 
 __all__ = ["experiment"]
@@ -70,12 +71,11 @@ def table1(out: str, max_n: int) -> None:
 def fig5a(data_dir: str, out: str, r: int, isets: int, seed: int, cv: int, jobs: int) -> None:
     """Fig. 5a: the validation confusion matrix of the SVM on a simulated data set, beside the paper's."""
     from unstack.experiments.fig5a import fig5a as run
-    from unstack.sim.dataset import list_configurations
+    from unstack.sim.dataset import require_configurations
 
     if r < 2 or isets < 1 or cv < 2 or jobs < 1:
         raise UnstackError("expected --r >= 2, --isets >= 1, --cv >= 2 and --jobs >= 1")
-    if not list_configurations(data_dir):
-        raise UnstackError(f"{data_dir}: expected a data set folder with config-NNNN.json scene files, found none")
+    require_configurations(data_dir)
     result = run(data_dir, r=r, isets=isets, seed=seed, cv=cv, n_jobs=jobs)
     _write_json(_out(out) / "fig5a.json", result)
     table = Table(title=f"Fig. 5a: validation relations of {data_dir} ({result['relations']} relations, "
@@ -103,24 +103,17 @@ def fig5a(data_dir: str, out: str, r: int, isets: int, seed: int, cv: int, jobs:
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets.")
 def decisions(data_dir: str, out: str, model_path: str | None, r: int, isets: int, seed: int) -> None:
     """Fig. 4 and beyond: MSE(cost), first pick right and physical disturbance of every decision maker."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
-
     from unstack.cli.learning import load_support_model
     from unstack.experiments.decisions import DECISION_MAKERS, evaluate_decisions, plot_fig4
-    from unstack.sim.dataset import list_configurations
+    from unstack.sim.dataset import require_configurations
 
     if r < 2 or isets < 1:
         raise UnstackError(f"expected --r >= 2 and --isets >= 1, got {r} and {isets}")
-    if not list_configurations(data_dir):  # before any progress bar or output folder
-        raise UnstackError(f"{data_dir}: expected a data set folder with config-NNNN.json scene files, found none")
+    require_configurations(data_dir)  # before any progress bar or output folder
     model, name = load_support_model(model_path)
     folder = _out(out)
-    with Progress("ISets", BarColumn(), MofNCompleteColumn(), "ETA", TimeRemainingColumn(),
-                  console=Console(stderr=True), transient=True) as bar:  # fmt: skip
-        task = bar.add_task("ISets", total=isets)
-        result = evaluate_decisions(
-            data_dir, model, r=r, isets=isets, seed=seed, progress=lambda done, total: bar.update(task, completed=done)
-        )
+    with progress_bar("ISets") as report:
+        result = evaluate_decisions(data_dir, model, r=r, isets=isets, seed=seed, progress=report)
     result["model"] = name
     _write_json(folder / "decisions.json", result)
     plot_fig4(result, folder / "fig4.png")
@@ -147,24 +140,17 @@ def decisions(data_dir: str, out: str, model_path: str | None, r: int, isets: in
 @click.option("--piles", type=int, default=None, help="Use only the first N piles.")
 def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) -> None:
     """The paper's real setting in simulation: every ISet of r = 3, 4, 5 of each 7-box pile."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
-
     from unstack.cli.learning import load_support_model
     from unstack.experiments.real7 import real7 as run
     from unstack.experiments.real7 import summary_rows
-    from unstack.sim.dataset import list_configurations
+    from unstack.sim.dataset import require_configurations
 
     if piles is not None and piles < 1:
         raise UnstackError(f"--piles must be at least 1, got {piles}")
-    if not list_configurations(data_dir):
-        raise UnstackError(f"{data_dir}: expected a data set folder with config-NNNN.json scene files, found none")
+    require_configurations(data_dir)
     model, name = load_support_model(model_path)
-    with Progress("ISets", BarColumn(), MofNCompleteColumn(), "ETA", TimeRemainingColumn(),
-                  console=Console(stderr=True), transient=True) as bar:  # fmt: skip
-        task = bar.add_task("ISets", total=None)
-        result = run(
-            data_dir, model, piles=piles, progress=lambda done, total: bar.update(task, completed=done, total=total)
-        )
+    with progress_bar("ISets") as report:
+        result = run(data_dir, model, piles=piles, progress=report)
     result["model"] = name
     _write_json(_out(out) / "real7.json", result)
     table = Table(title=f"first pick right, {result['piles']} simulated 7-box piles ({data_dir})")

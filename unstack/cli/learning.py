@@ -61,36 +61,16 @@ def metrics_view(report: dict[str, Any], title: str) -> Group:
     return Group(confusion, summary)
 
 
-def _progress(description: str) -> Any:
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
-
-    return Progress(  # on stderr: stdout is for results (and JSON)
-        f"[progress.description]{description}",
-        BarColumn(),
-        MofNCompleteColumn(),
-        "ETA",
-        TimeRemainingColumn(),
-        console=Console(stderr=True),
-        transient=True,
-    )
-
-
 def _examples(data_dir: str, r: int, isets: int, seed: int, jobs: int, settings: Any) -> Any:
     from unstack.learning.training_data import dataset_examples
-    from unstack.sim.dataset import list_configurations
+    from unstack.sim.dataset import require_configurations
 
-    if not list_configurations(data_dir):  # before any progress bar: the error is the only line
-        raise UnstackError(f"{data_dir}: expected a data set folder with config-NNNN.json scene files, found none")
-    with _progress("features") as bar:
-        task = bar.add_task("features", total=None)
+    require_configurations(data_dir)  # before any progress bar: the error is the only line
+    from unstack.cli.progress import progress_bar
+
+    with progress_bar("features") as report:
         examples = dataset_examples(
-            data_dir,
-            r=r,
-            isets=isets,
-            seed=seed,
-            settings=settings,
-            n_jobs=jobs,
-            progress=lambda done, total: bar.update(task, completed=done, total=total),
+            data_dir, r=r, isets=isets, seed=seed, settings=settings, n_jobs=jobs, progress=report
         )
     if len(examples.labels) == 0:
         raise UnstackError(f"{data_dir}: no ISet of at least 2 detected boxes; nothing to learn from")

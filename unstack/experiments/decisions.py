@@ -95,12 +95,10 @@ def _iset_result(scene: Any, ids: list[str], model: Any) -> _Iset:
     from unstack.learning.metrics import classification_report
     from unstack.learning.probabilities import scene_support_probabilities
     from unstack.reasoner.decision import choose, decide
-    from unstack.scene import Scene
 
-    view = Scene(scene.boxes, scene.points, ids, scene.ground_truth, source=scene.source)
-    supports = scene_support_probabilities(view, model)
-    truth = view.detected_ground_truth()
-    assert truth is not None
+    supports = scene_support_probabilities(scene, model, boxes=ids)
+    index = [scene.box_ids.index(box_id) for box_id in ids]
+    truth = scene.ground_truth[np.ix_(index, index)]
     costs = truth.sum(axis=1).astype(np.float64)
     probabilities = supports.probabilities
     off = ~np.eye(len(ids), dtype=bool)
@@ -115,7 +113,6 @@ def _iset_result(scene: Any, ids: list[str], model: Any) -> _Iset:
     }
     removal = scene.metadata.get("simulation", {}).get("removal", {})
     displacement = np.asarray(removal.get("displacement_m", np.zeros((len(scene.boxes),) * 2)))
-    index = [scene.box_ids.index(box_id) for box_id in ids]
     rows = displacement[index]
     disturbance = np.column_stack([(rows > DISTURBED).sum(axis=1), np.where(rows > DISTURBED, rows, 0).sum(axis=1)])
     return _Iset(
@@ -179,14 +176,11 @@ def evaluate_decisions(
     progress: Callable[[int, int], None] | None = None,
 ) -> dict[str, Any]:
     """Draw ``isets`` test ISets of ``r`` boxes from the data set's scenes and score every decision maker."""
-    from unstack.errors import UnstackError
     from unstack.learning.training_data import sample_isets
     from unstack.scene import load_scene
-    from unstack.sim.dataset import list_configurations
+    from unstack.sim.dataset import require_configurations
 
-    files = list_configurations(data_dir)
-    if not files:
-        raise UnstackError(f"{data_dir}: expected a data set folder with config-NNNN.json scene files, found none")
+    files = require_configurations(data_dir)
     rng = np.random.default_rng(seed)
     per_scene = int(np.ceil(isets / len(files)))
     results: list[_Iset] = []

@@ -37,13 +37,10 @@ def real7(
 ) -> dict[str, Any]:
     """Score every ISet of each r of every pile's boxes (all boxes of the pile, as the paper);
     ``piles`` limits the number of piles (the first ones)."""
-    from unstack.errors import UnstackError
     from unstack.scene import load_scene
-    from unstack.sim.dataset import list_configurations
+    from unstack.sim.dataset import require_configurations
 
-    files = list_configurations(data_dir)
-    if not files:
-        raise UnstackError(f"{data_dir}: expected a data set folder with config-NNNN.json scene files, found none")
+    files = require_configurations(data_dir)
     scenes = [load_scene(path) for path in files[:piles]]
     total = sum(len(list(itertools.combinations(scene.box_ids, r))) for scene in scenes for r in sizes)
     done = 0

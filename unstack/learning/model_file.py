@@ -89,14 +89,9 @@ class SupportModel:
         cls, classifier: SupportClassifier, features: FeatureSettings, *, training: dict[str, Any]
     ) -> SupportModel:
         """Wrap a fitted :class:`SupportClassifier`."""
-        from importlib import metadata as importlib_metadata
+        from unstack.provenance import package_versions
 
-        versions = {}
-        for package in ("unstack", "scikit-learn", "numpy", "skops"):
-            try:
-                versions[package] = importlib_metadata.version(package)
-            except importlib_metadata.PackageNotFoundError:  # pragma: no cover
-                versions[package] = "unknown"
+        versions = package_versions("unstack", "scikit-learn", "numpy", "skops")
         metadata = {
             "learner": classifier.learner,
             "best_params": {key: _plain(value) for key, value in classifier.best_params_.items()},

@@ -17,6 +17,7 @@ Examples
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -31,7 +32,9 @@ __all__ = ["PROBABILITY_FLOOR", "scene_support_probabilities"]
 PROBABILITY_FLOOR = 1e-6
 
 
-def scene_support_probabilities(scene: Scene, model: SupportModel, *, model_name: str = "") -> Supports:
+def scene_support_probabilities(
+    scene: Scene, model: SupportModel, *, model_name: str = "", boxes: Sequence[str] | None = None
+) -> Supports:
     """``P(SUPP(X, Y))`` for every ordered pair of the scene's detected boxes.
 
     Parameters
@@ -41,6 +44,8 @@ def scene_support_probabilities(scene: Scene, model: SupportModel, *, model_name
     model : SupportModel
     model_name : str
         Recorded in the metadata (for example the model file's path).
+    boxes : sequence of str, optional
+        Box ids to use instead of the scene's detected boxes (an ISet drawn from them).
 
     Returns
     -------
@@ -50,7 +55,8 @@ def scene_support_probabilities(scene: Scene, model: SupportModel, *, model_name
     if len(scene.points) == 0:
         warnings.warn(f"{scene.source}: the point cloud is empty; the DBAF features are 0", stacklevel=2)
     index = {box_id: k for k, box_id in enumerate(scene.box_ids)}
-    detected = [index[box_id] for box_id in scene.detected]
+    objects = list(scene.detected if boxes is None else boxes)
+    detected = [index[box_id] for box_id in objects]
     n = len(detected)
     pairs = [(detected[i], detected[j]) for i in range(n) for j in range(n) if i != j]
     probabilities = np.zeros((n, n))
@@ -68,7 +74,7 @@ def scene_support_probabilities(scene: Scene, model: SupportModel, *, model_name
         "clipped_to": [PROBABILITY_FLOOR, 1.0 - PROBABILITY_FLOOR],
     }
     return Supports(
-        list(scene.detected),
+        objects,
         probabilities,
         masses=masses if all(mass is not None for mass in masses) else None,
         metadata=metadata,

@@ -156,11 +156,9 @@ def dataset_examples(
     """
     from joblib import Parallel, delayed
 
-    from unstack.sim.dataset import list_configurations
+    from unstack.sim.dataset import require_configurations
 
-    files = list_configurations(folder)
-    if not files:
-        raise UnstackError(f"{folder}: expected a data set folder with config-NNNN.json scene files, found none")
+    files = require_configurations(folder)
     settings = settings or FeatureSettings()
     tasks = (delayed(_one_file)(path, r, isets, seed, settings, int(path.stem.split("-")[1])) for path in files)
     parts: list[SupportExamples] = []

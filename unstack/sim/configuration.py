@@ -18,11 +18,11 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from importlib import metadata as importlib_metadata
 from typing import Any
 
 import numpy as np
 
+from unstack.provenance import package_versions
 from unstack.scene import Box, Scene
 from unstack.sim.ground_truth import RemovalResponse, removal_responses, support_labels, transitivity_violations
 from unstack.sim.piles import Pile, build_pile
@@ -70,14 +70,8 @@ def configuration_seed(seed: int, index: int) -> np.random.SeedSequence:
     return np.random.SeedSequence(seed, spawn_key=(index,))
 
 
-def _versions() -> dict[str, str]:
-    versions = {}
-    for package in ("unstack", "pybullet", "numpy"):
-        try:
-            versions[package] = importlib_metadata.version(package)
-        except importlib_metadata.PackageNotFoundError:  # pragma: no cover
-            versions[package] = "unknown"
-    return versions
+#: Packages whose versions a simulated scene and a data set record.
+SIMULATION_PACKAGES = ("unstack", "pybullet", "numpy")
 
 
 def _creep_free_responses(pile: Pile, settings: SimulationSettings) -> tuple[RemovalResponse, int] | None:
@@ -176,7 +170,7 @@ def _scene(
             "baseline_rotation_deg": response.baseline_rotation_deg,
         },
         "transitivity": {"violated": violated, "premises": premises},
-        "versions": _versions(),
+        "versions": package_versions(*SIMULATION_PACKAGES),
     }
     return Scene(
         boxes,

@@ -53,6 +53,7 @@ __all__ = [
     "SchedulerUnavailable",
     "list_configurations",
     "read_manifest",
+    "require_configurations",
     "simulate_dataset",
 ]
 
@@ -101,6 +102,14 @@ def list_configurations(folder: str | os.PathLike[str]) -> list[Path]:
     return sorted(Path(folder).glob("config-[0-9][0-9][0-9][0-9].json"))
 
 
+def require_configurations(folder: str | os.PathLike[str]) -> list[Path]:
+    """:func:`list_configurations`, or an error naming the folder when it holds none."""
+    files = list_configurations(folder)
+    if not files:
+        raise UnstackError(f"{folder}: expected a data set folder with config-NNNN.json scene files, found none")
+    return files
+
+
 def read_manifest(folder: str | os.PathLike[str]) -> dict[str, Any] | None:
     """The folder's manifest, or ``None`` if it has none."""
     path = Path(folder) / MANIFEST
@@ -130,7 +139,8 @@ def _check_same_dataset(folder: Path, manifest: dict[str, Any], settings: Simula
 
 
 def _write_manifest(folder: Path, settings: SimulationSettings, seed: int, configs: int) -> None:
-    from unstack.sim.configuration import _versions
+    from unstack.provenance import package_versions
+    from unstack.sim.configuration import SIMULATION_PACKAGES
 
     existing = read_manifest(folder) or {}
     manifest = {
@@ -139,7 +149,7 @@ def _write_manifest(folder: Path, settings: SimulationSettings, seed: int, confi
         "configs": max(configs, int(existing.get("configs", 0))),
         "settings": settings.to_dict(),
         "created": existing.get("created", datetime.now(UTC).isoformat(timespec="seconds")),
-        "versions": _versions(),
+        "versions": package_versions(*SIMULATION_PACKAGES),
     }
     if "statistics" in existing:
         manifest["statistics"] = existing["statistics"]

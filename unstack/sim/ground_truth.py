@@ -63,10 +63,9 @@ def _run_horizon(world: PhysicsWorld, settings: GroundTruthSettings, watched: li
     for index in range(1, steps + 1):
         world.client.stepSimulation()
         elapsed = index * time_step
-        if elapsed >= settings.early_exit_after and index % check_every == 0:
-            speeds = [np.linalg.norm(world.client.getBaseVelocity(body)[0]) for body in watched]
-            if not speeds or max(speeds) < settings.early_exit_speed:
-                return elapsed
+        checking = elapsed >= settings.early_exit_after and index % check_every == 0
+        if checking and float(np.max(world.speeds(watched), initial=0.0)) < settings.early_exit_speed:
+            return elapsed
     return steps * time_step
 
 

@@ -25,8 +25,9 @@ from typing import Any
 
 import numpy as np
 
+from unstack.errors import UnstackError
 from unstack.scene import Box, Scene
-from unstack.sim.settings import SensorSettings
+from unstack.sim.settings import SensorSettings, SimulationSettings
 
 __all__ = ["box_corners", "render_scene"]
 
@@ -56,11 +57,14 @@ def _support_counts(scene: Scene) -> np.ndarray | None:
 
 
 def _sensor(scene: Scene) -> SensorSettings:
-    data = scene.metadata.get("settings", {}).get("sensor")
-    if not data:
+    """The sensor that scanned a simulated scene (the default sensor for other scenes)."""
+    data = scene.metadata.get("settings")
+    if not isinstance(data, dict):
         return SensorSettings()
-    fields: dict[str, Any] = {k: tuple(v) if isinstance(v, list) else v for k, v in data.items()}
-    return SensorSettings(**fields)
+    try:
+        return SimulationSettings.from_dict(data).sensor
+    except (KeyError, TypeError, ValueError, UnstackError):
+        return SensorSettings()
 
 
 def _point_boxes(scene: Scene, base_dir: Path | None) -> np.ndarray | None:

@@ -195,9 +195,10 @@ class PhysicsWorld:
             orientations[row] = orientation
         return positions, orientations
 
-    def speeds(self) -> np.ndarray:
-        """Linear speed of every box (m/s)."""
-        return np.array([np.linalg.norm(self.client.getBaseVelocity(body)[0]) for body in self.boxes])
+    def speeds(self, bodies: list[int] | None = None) -> np.ndarray:
+        """Linear speed of the boxes (all by default), m/s."""
+        bodies = self.boxes if bodies is None else bodies
+        return np.array([np.linalg.norm(self.client.getBaseVelocity(body)[0]) for body in bodies])
 
     def step(self, seconds: float) -> None:
         """Advance the simulation by (about) ``seconds``."""
