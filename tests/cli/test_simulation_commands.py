@@ -82,3 +82,11 @@ def test_render_bad_input_is_one_line(tmp_path: Path, arguments: list[str], mess
     assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
     assert message in result.stderr
     assert not list(tmp_path.iterdir())
+
+
+def test_render_draws_the_learned_probabilities(tmp_path: Path) -> None:
+    plain, arrows = tmp_path / "plain.png", tmp_path / "arrows.png"
+    assert unstack("render", "examples/pile5.scene.json", "-o", str(plain)).returncode == 0
+    result = unstack("render", "examples/pile5.scene.json", "-o", str(arrows), "--probabilities")
+    assert result.returncode == 0, result.stderr
+    assert arrows.read_bytes()[:4] == b"\x89PNG" and arrows.read_bytes() != plain.read_bytes()

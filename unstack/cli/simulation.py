@@ -103,7 +103,10 @@ def simulate(
 @click.argument("scene_file", type=str)
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="PNG file to write.")
 @click.option("--title", default=None, help="Title of the picture (default: the file name).")
-def render(scene_file: str, output: str, title: str | None) -> None:
+@click.option("--probabilities", "show_probabilities", is_flag=True,
+              help="Draw the learned P(X supports Y) of the detected boxes as arrows.")  # fmt: skip
+@click.option("--model", "model_path", default=None, help="Model for --probabilities (default: the one shipped).")
+def render(scene_file: str, output: str, title: str | None, show_probabilities: bool, model_path: str | None) -> None:
     """Draw a scene: oblique view and sensor view, boxes coloured by how many they support."""
     from pathlib import Path
 
@@ -115,5 +118,10 @@ def render(scene_file: str, output: str, title: str | None) -> None:
         raise UnstackError(f"{output}: expected a .png output file")
     document = read_document(scene_file)
     scene = Scene.from_document(document)
-    render_scene(scene, output, base_dir=document.base_dir, title=title or Path(scene_file).name)
+    supports = None
+    if show_probabilities:
+        from unstack.cli.learning import scene_supports
+
+        supports = scene_supports(scene, model_path)
+    render_scene(scene, output, base_dir=document.base_dir, title=title or Path(scene_file).name, supports=supports)
     click.echo(f"{output}: {len(scene.boxes)} boxes, {len(scene.detected)} detected")

@@ -95,12 +95,33 @@ def _project(points: np.ndarray, sensor: SensorSettings) -> tuple[np.ndarray, np
     return np.stack([u, v], axis=1), depth
 
 
+def _draw_supports(axes: Any, scene: Scene, supports: Any, min_probability: float, sensor: SensorSettings) -> None:
+    """Arrows X -> Y in the sensor view for the probable support relations, opacity = probability."""
+    for i, supporter in enumerate(supports.objects):
+        for j, supported in enumerate(supports.objects):
+            probability = float(supports.probabilities[i, j])
+            if i == j or probability < min_probability:
+                continue
+            ends, depths = _project(np.array([scene.box(supporter).position, scene.box(supported).position]), sensor)
+            if np.any(depths <= 0):
+                continue
+            axes.annotate(
+                "",
+                xy=ends[1],
+                xytext=ends[0],
+                arrowprops={"arrowstyle": "-|>", "color": "red", "alpha": probability, "lw": 2},
+            )
+            axes.text(*ends.mean(axis=0), f"{probability:.2f}", color="darkred", fontsize=7, ha="center")
+
+
 def render_scene(
     scene: Scene,
     output: str | os.PathLike[str],
     *,
     base_dir: str | os.PathLike[str] | None = None,
     title: str | None = None,
+    supports: Any = None,
+    min_probability: float = 0.1,
 ) -> None:
     """Draw the oblique view and the sensor view of a scene into a PNG (written atomically).
 
@@ -112,6 +133,12 @@ def render_scene(
     base_dir : path, optional
         Folder of the scene file, to find its per-point box labels (simulated scenes).
     title : str, optional
+    supports : Supports, optional
+        Support probabilities of (some of) the scene's boxes: each ordered pair with
+        P(SUPP(X, Y)) >= ``min_probability`` is drawn in the sensor view as an arrow from X's
+        centroid to Y's, as opaque as it is probable and labelled with the probability.
+    min_probability : float
+        Smallest probability drawn.
     """
     from unstack.figures import pyplot
 
@@ -191,6 +218,9 @@ def render_scene(
     view.set_ylim(sensor.height, 0)
     view.set_aspect("equal")
     view.set_title(f"sensor view ({len(scene.points):,} points)")
+    if supports is not None:
+        _draw_supports(view, scene, supports, min_probability, sensor)
+        view.set_title(f"sensor view; arrows: learned P(X supports Y) >= {min_probability:g}")
     view.set_xticks([])
     view.set_yticks([])
     if counts is not None:
