@@ -126,12 +126,28 @@ def test_mass_cost_without_masses_says_what_is_missing() -> None:
         decide(Supports(["a", "b"], [[0, 0.5], [0.5, 0]]), cost="mass")
 
 
-def test_auto_refuses_scenes_beyond_exact_reach(rng: np.random.Generator) -> None:
+def test_auto_samples_groups_beyond_exact_reach(rng: np.random.Generator) -> None:
     dense = rng.uniform(0.1, 0.9, (9, 9))
     np.fill_diagonal(dense, 0.0)
-    with pytest.raises(TooLarge, match="9 linked boxes: exact reasoning is limited to 8 boxes per group"):
-        decide(Supports(ids(9), dense))
+    decision = decide(Supports(ids(9), dense), samples=800, seed=0)
+    assert decision.method == "approx" and decision.component_methods == ("approx",)
+    assert decision.expected_cost_errors is not None and np.all(decision.expected_cost_errors > 0)
+    assert 0.0 < decision.choice_probability <= 1.0
     assert decide(Supports(ids(9), np.zeros((9, 9)))).consistent_worlds == 1  # nine unlinked boxes
+
+
+def test_auto_refuses_groups_beyond_the_sampler(rng: np.random.Generator) -> None:
+    dense = rng.uniform(0.1, 0.9, (64, 64))
+    np.fill_diagonal(dense, 0.0)
+    with pytest.raises(TooLarge, match="64 linked boxes: the sampler holds at most 63 boxes per group"):
+        decide(Supports(ids(64), dense))
+
+
+def test_explicit_exact_method_keeps_its_limit(rng: np.random.Generator) -> None:
+    dense = rng.uniform(0.1, 0.9, (9, 9))
+    np.fill_diagonal(dense, 0.0)
+    with pytest.raises(TooLarge, match="9 boxes: the exact engine is limited to 8 boxes"):
+        decide(Supports(ids(9), dense), method="exact")
 
 
 def test_unknown_method_is_rejected() -> None:

@@ -69,6 +69,43 @@ def _load_supports(path: str, model_path: str | None = None) -> Any:
     return loaded
 
 
+def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
+    """The options shared by ``decide`` and ``plan``: method, cost, sampling budget, seed."""
+    options = [
+        click.option(
+            "--method",
+            type=click.Choice(["auto", "exact", "sat", "approx"]),
+            default="auto",
+            show_default=True,
+            help="exact: weighted preorder counting (<= 8 boxes per group); sat: list worlds with CaDiCaL "
+            "(<= 6); approx: sampling with standard errors (<= 63); auto: per group, the fastest that fits.",
+        ),
+        click.option(
+            "--cost",
+            type=click.Choice(["count", "mass"]),
+            default="count",
+            show_default=True,
+            help="count: number of supported boxes (Eq. 11); mass: their total mass (needs masses).",
+        ),
+        click.option(
+            "--time-limit",
+            type=click.FloatRange(min=0.0, min_open=True),
+            default=None,
+            help="Seconds of sampling for the sampled groups (default 1; under 10 also samples groups of 8).",
+        ),
+        click.option(
+            "--samples",
+            type=click.IntRange(min=1),
+            default=None,
+            help="Recorded sweeps per sampled group instead of a time limit (reproducible with --seed).",
+        ),
+        click.option("--seed", type=int, default=None, help="Seed of the sampler."),
+    ]
+    for option in reversed(options):
+        command = option(command)
+    return command
+
+
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="unstack")
 def cli() -> None:
@@ -81,32 +118,21 @@ def cli() -> None:
 @click.option(
     "-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON decision to this file (atomically)."
 )
-@click.option(
-    "--method",
-    type=click.Choice(["auto", "exact", "sat"]),
-    default="auto",
-    show_default=True,
-    help="exact: weighted preorder counting (<= 8 boxes); sat: list worlds with CaDiCaL (<= 6 boxes).",
-)
-@click.option(
-    "--cost",
-    type=click.Choice(["count", "mass"]),
-    default="count",
-    show_default=True,
-    help="count: number of supported boxes (Eq. 11); mass: their total mass (needs masses).",
-)
+@_reasoning_options
 @click.option("--model", "model_path", default=None, help="Model for scene files (default: the one shipped).")
-def decide(file: str, as_json: bool, output: str | None, method: str, cost: str, model_path: str | None) -> None:
+def decide(file: str, as_json: bool, output: str | None, model_path: str | None, **reasoning: Any) -> None:
     """Print which box to unload first, the expected cost of every box and P(support | consistent).
 
     FILE is an unstack.supports/1 file, or an unstack.scene/1 file whose detected boxes get
     their support probabilities from the learned model ('-' reads standard input).
+    Groups of linked boxes too large to count are sampled: each EC then has a standard
+    error, and the headline says how probable it is that the choice is truly the minimum.
     """
     from unstack.cli.render import decision_view
     from unstack.reasoner.decision import decide as decide_box
 
     supports = _load_supports(file, model_path)
-    decision = decide_box(supports, method=method, cost=cost)
+    decision = decide_box(supports, **reasoning)
     document = decision.to_dict()
     _write_output(output, document)
     _emit(as_json, document, lambda: decision_view(decision))
@@ -152,17 +178,19 @@ def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str) 
 @click.argument("file", type=str)
 @click.option("--json", "as_json", is_flag=True, help="Print the plan as unstack.plan/1 JSON.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON plan to this file.")
-@click.option("--method", type=click.Choice(["auto", "exact", "sat"]), default="auto", show_default=True)
-@click.option("--cost", type=click.Choice(["count", "mass"]), default="count", show_default=True)
+@_reasoning_options
 @click.option("--model", "model_path", default=None, help="Model for scene files (default: the one shipped).")
-def plan(file: str, as_json: bool, output: str | None, method: str, cost: str, model_path: str | None) -> None:
-    """Order all detected boxes by repeated decisions: pick, remove from the set, decide again."""
+def plan(file: str, as_json: bool, output: str | None, model_path: str | None, **reasoning: Any) -> None:
+    """Order all detected boxes by repeated decisions: pick, remove from the set, decide again.
+
+    With sampling, --time-limit applies to each step.
+    """
     from rich.table import Table
 
     from unstack.reasoner.plan import unloading_plan
 
     supports = _load_supports(file, model_path)
-    result = unloading_plan(supports, method=method, cost=cost)
+    result = unloading_plan(supports, **reasoning)
     document = result.to_dict()
     _write_output(output, document)
 

@@ -24,11 +24,15 @@ def decision_view(decision: Decision) -> Group:
     costs.add_column("rank", justify="right")
     costs.add_column("box")
     costs.add_column("EC", justify="right")
+    sampled = decision.sampling is not None and decision.expected_cost_errors is not None
+    if sampled:
+        costs.add_column("± s.e.", justify="right")
     costs.add_column("")
     for rank, i in enumerate(order, start=1):
         box = decision.objects[i]
         mark = "<- unload first" if box == decision.choice else ("tie" if box in decision.ties else "")
-        costs.add_row(str(rank), box, _number(float(decision.expected_costs[i])), mark)
+        error = [] if not sampled else [f"{decision.expected_cost_errors[i]:.4f}"]  # type: ignore[index]
+        costs.add_row(str(rank), box, _number(float(decision.expected_costs[i])), *error, mark)
     matrix = Table(title="P(row supports column | consistent world)", title_justify="left")
     matrix.add_column("supports ->")
     for box in decision.objects:
@@ -46,7 +50,15 @@ def decision_view(decision: Decision) -> Group:
         else ""
     )
     footer = Text(f"method {decision.method}{worlds}{groups}{hard}, {decision.seconds:.3f} s", style="dim")
+    if decision.sampling is not None:
+        footer.append(
+            f"\nsampled: {sum(decision.sampling['samples']):,} sweeps in {decision.sampling['chains']} chains per "
+            f"group, seed {decision.sampling['seed']}; errors are standard errors (about 95 % of true values lie "
+            "within 2 of them)"
+        )
     headline = Text.assemble(("Unload first: ", "bold"), (decision.choice, "bold green"))
+    if decision.choice_probability < 1.0 or decision.sampling is not None:
+        headline.append(f"  (P(truly the minimum EC) = {decision.choice_probability:.3f})")
     if len(decision.ties) > 1:
         headline.append(
             f"  (tied with {', '.join(t for t in decision.ties if t != decision.choice)}; smallest id wins)"

@@ -30,10 +30,11 @@ import numpy as np
 
 from unstack.errors import UnstackError
 from unstack.reasoner.components import support_components
-from unstack.reasoner.consistency import PREORDER_COUNTS
+from unstack.reasoner.confidence import choice_probability
 from unstack.reasoner.costs import cost_weights, expected_costs
 from unstack.reasoner.marginals import EXACT_MAX_BOXES
 from unstack.reasoner.pruning import Evidence, propagate_evidence
+from unstack.reasoner.sampling import DEFAULT_TIME_LIMIT, SAMPLING_MAX_BOXES, SampledMarginals
 from unstack.reasoner.worlds import SAT_MAX_BOXES
 from unstack.supports import Supports
 
@@ -49,12 +50,15 @@ __all__ = [
 
 DECISION_FORMAT = "unstack.decision/1"
 #: Reasoning methods: ``exact`` (weighted preorder counting), ``sat`` (list worlds).
-METHODS = ("auto", "exact", "sat")
+METHODS = ("auto", "exact", "sat", "approx")
 #: ``auto`` lists worlds with SAT up to this size and uses the exact engine above it.
 #: Measured end to end (``unstack decide --json``, best of 3, 2-core machine): SAT 0.41 s
 #: vs exact 0.81 s at n = 5 (loading numba's cached engine dominates), SAT 5.2 s vs
 #: exact 0.96 s at n = 6.
 AUTO_SAT_MAX_BOXES = 5
+#: With a time limit below this (seconds), ``auto`` samples groups of 8 boxes instead of
+#: counting them (exact n = 8 dense: 2.6 s on a quiet 2-core machine, 4.1 s loaded).
+AUTO_EXACT8_SECONDS = 10.0
 #: Relative tolerance under which two expected costs count as tied.
 TIE_TOLERANCE = 1e-12
 
@@ -74,7 +78,7 @@ class Decision:
     marginals : numpy.ndarray, shape (n, n)
         ``P(SUPP(objects[i], objects[j]) | consistent)``.
     method : str
-        ``"exact"`` or ``"sat"``.
+        ``"exact"``, ``"sat"`` or ``"approx"`` (the method of the largest group).
     cost : str
         ``"count"`` or ``"mass"``.
     consistent_worlds : int or None
@@ -88,6 +92,16 @@ class Decision:
         Hard evidence after propagation.
     seconds : float
         Wall time of the reasoning.
+    component_methods : tuple of str
+        The method of each group in ``components``.
+    expected_cost_errors : numpy.ndarray, shape (n,)
+        Standard error of each EC (0 where exact).
+    marginal_errors : numpy.ndarray, shape (n, n)
+        Standard error of each marginal (0 where exact).
+    choice_probability : float
+        Probability that ``choice`` has the smallest true EC (1.0 when every EC is exact).
+    sampling : dict or None
+        How the sampled groups were run (chains, samples, burn-in, acceptance, seed, seconds).
     """
 
     objects: tuple[str, ...]
@@ -101,6 +115,11 @@ class Decision:
     evidence: Evidence
     components: tuple[tuple[str, ...], ...] = ()
     seconds: float = field(default=0.0)
+    component_methods: tuple[str, ...] = ()
+    expected_cost_errors: np.ndarray | None = None
+    marginal_errors: np.ndarray | None = None
+    choice_probability: float = 1.0
+    sampling: dict[str, Any] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The ``unstack.decision/1`` JSON object."""
@@ -117,6 +136,13 @@ class Decision:
             data["consistent_worlds"] = self.consistent_worlds
         data["ties"] = list(self.ties)
         data["components"] = [list(group) for group in self.components]
+        data["component_methods"] = list(self.component_methods)
+        if self.expected_cost_errors is not None and self.marginal_errors is not None:
+            data["expected_cost_errors"] = self.expected_cost_errors.tolist()
+            data["marginal_errors"] = self.marginal_errors.tolist()
+        data["choice_probability"] = self.choice_probability
+        if self.sampling is not None:
+            data["sampling"] = self.sampling
         data["evidence"] = {
             "forced": [list(pair) for pair in self.evidence.forced],
             "forbidden": [list(pair) for pair in self.evidence.forbidden],
@@ -139,46 +165,105 @@ def choose(objects: tuple[str, ...], costs: np.ndarray) -> tuple[str, tuple[str,
     return tied[0], tied
 
 
-def _resolve_method(method: str, largest: int, n: int) -> str:
-    """The method for groups of at most ``largest`` linked boxes (of ``n`` in all)."""
+def _group_methods(method: str, sizes: list[int], n: int, time_limit: float | None) -> list[str]:
+    """The method of each group of linked boxes (``sizes``: boxes per group, of ``n``)."""
     if method not in METHODS:
         raise UnstackError(f"unknown method {method!r}; expected one of {', '.join(METHODS)}")
-    if method == "auto":
-        if largest <= AUTO_SAT_MAX_BOXES:
-            return "sat"
-        if largest > EXACT_MAX_BOXES:
-            raise _too_large_for_all(largest, n)
-        return "exact"
-    return method
+    if method != "auto":
+        return [method] * len(sizes)
+    exact_limit = EXACT_MAX_BOXES
+    if time_limit is not None and time_limit < AUTO_EXACT8_SECONDS:
+        exact_limit = min(exact_limit, 7)
+    methods = []
+    for size in sizes:
+        if size <= AUTO_SAT_MAX_BOXES:
+            methods.append("sat")
+        elif size <= exact_limit:
+            methods.append("exact")
+        elif size <= SAMPLING_MAX_BOXES:
+            methods.append("approx")
+        else:
+            raise _too_large_for_all(size, n)
+    return methods
 
 
 def _too_large_for_all(largest: int, n: int) -> UnstackError:
     from unstack.errors import TooLarge
 
-    count = PREORDER_COUNTS[largest] if largest < len(PREORDER_COUNTS) else "over 1e13"
     where = f"{largest} linked boxes" if largest == n else f"a group of {largest} linked boxes (of {n})"
     return TooLarge(
-        f"{where}: exact reasoning is limited to {EXACT_MAX_BOXES} boxes per group of boxes linked by "
-        f"non-zero support probabilities ({largest} boxes have {count} consistent worlds); decide on a "
-        "subset of the detected boxes"
+        f"{where}: the sampler holds at most {SAMPLING_MAX_BOXES} boxes per group of boxes linked by "
+        "non-zero support probabilities; decide on a subset of the detected boxes"
     )
 
 
+@dataclass
+class _GroupResult:
+    """Marginals of one group, with their errors and (when sampled) the batch means."""
+
+    marginals: np.ndarray
+    worlds: int | None
+    errors: np.ndarray
+    sampled: SampledMarginals | None = None
+
+
 def _group_marginals(
-    supports: Supports, evidence: Evidence, group: np.ndarray, method: str, max_boxes: int | None
-) -> tuple[np.ndarray, int | None]:
-    """Conditional marginals and world count of one group of linked boxes."""
+    supports: Supports,
+    evidence: Evidence,
+    group: np.ndarray,
+    method: str,
+    max_boxes: int | None,
+    sampling: dict[str, Any],
+) -> _GroupResult:
+    """Conditional marginals (and world count or sampling errors) of one group of linked boxes."""
     probabilities = evidence.probabilities[np.ix_(group, group)]
+    exact_errors = np.zeros_like(probabilities)
     if method == "sat":
         from unstack.reasoner.worlds import enumerate_worlds
 
         objects = [supports.objects[i] for i in group]
         world_set = enumerate_worlds(Supports(objects, probabilities), max_boxes=max_boxes or SAT_MAX_BOXES)
-        return world_set.marginals(), len(world_set)
+        return _GroupResult(world_set.marginals(), len(world_set), exact_errors)
+    if method == "approx":
+        from unstack.reasoner.sampling import sampled_marginals
+
+        result = sampled_marginals(probabilities, **sampling)
+        return _GroupResult(result.marginals, None, result.standard_errors, result)
     from unstack.reasoner.marginals import exact_marginals
 
-    result = exact_marginals(probabilities, max_boxes=max_boxes or EXACT_MAX_BOXES)
-    return result.marginals, result.consistent_worlds
+    exact = exact_marginals(probabilities, max_boxes=max_boxes or EXACT_MAX_BOXES)
+    return _GroupResult(exact.marginals, exact.consistent_worlds, exact_errors)
+
+
+def _sampling_budgets(
+    groups: list[np.ndarray], methods: list[str], time_limit: float | None, samples: int | None, seed: int | None
+) -> list[dict[str, Any]]:
+    """Arguments of the sampler for each group: the time split in proportion to group size."""
+    sampled = sum(len(group) for group, method in zip(groups, methods, strict=True) if method == "approx")
+    total_time = time_limit if time_limit is not None else (None if samples is not None else DEFAULT_TIME_LIMIT)
+    budgets = []
+    for number, (group, method) in enumerate(zip(groups, methods, strict=True)):
+        share = None if total_time is None or method != "approx" else total_time * len(group) / sampled
+        group_seed = None
+        if seed is not None:
+            group_seed = int(np.random.SeedSequence(seed, spawn_key=(number,)).generate_state(1)[0])
+        budgets.append({"samples": samples, "time_limit": share, "seed": group_seed})
+    return budgets
+
+
+def _sampling_summary(results: list[_GroupResult], seed: int | None) -> dict[str, Any] | None:
+    """What the sampled groups ran: chains, samples, burn-in, acceptance, seconds."""
+    sampled = [result.sampled for result in results if result.sampled is not None]
+    if not sampled:
+        return None
+    return {
+        "chains": sampled[0].chains,
+        "samples": [result.samples for result in sampled],
+        "burn_in": sampled[0].burn_in,
+        "acceptance": [round(result.acceptance, 4) for result in sampled],
+        "seed": seed,
+        "seconds": round(sum(result.seconds for result in sampled), 6),
+    }
 
 
 def decide(
@@ -187,6 +272,9 @@ def decide(
     method: str = "auto",
     cost: str = "count",
     max_boxes: int | None = None,
+    time_limit: float | None = None,
+    samples: int | None = None,
+    seed: int | None = None,
 ) -> Decision:
     """Choose the box to unload first (Eq. 12) from pairwise support probabilities.
 
@@ -194,14 +282,23 @@ def decide(
     ----------
     supports : Supports
         Detected boxes and ``P(SUPP(X, Y))`` for every ordered pair.
-    method : {"auto", "exact", "sat"}
+    method : {"auto", "exact", "sat", "approx"}
         ``exact``: weighted counting of preorders (no world list, up to 8 boxes by
         default); ``sat``: list the consistent worlds with CaDiCaL (up to 6 boxes);
-        ``auto``: the faster of the two for the size.
+        ``approx``: Markov chain Monte Carlo over consistent worlds, with standard errors
+        (up to 63 boxes per group); ``auto``: per group of linked boxes, SAT up to 5
+        boxes, exact up to 8 (7 when ``time_limit`` is under 10 s), sampling above.
     cost : {"count", "mass"}
         Eq. 11 (number of supported boxes) or their total mass (needs masses).
     max_boxes : int, optional
-        Override the method's size limit.
+        Override the exact methods' size limit.
+    time_limit : float, optional
+        Seconds of sampling for the sampled groups together (default 1 s unless
+        ``samples`` is given).
+    samples : int, optional
+        Recorded sweeps per sampled group (reproducible for a ``seed``).
+    seed : int, optional
+        Seed of the sampler and of the choice probability.
 
     Returns
     -------
@@ -219,25 +316,39 @@ def decide(
     weights = cost_weights(supports, cost)
     evidence = propagate_evidence(supports.objects, supports.probabilities)
     groups = support_components(evidence.probabilities)
-    largest = max(len(group) for group in groups)
-    chosen_method = _resolve_method(method, largest, n)
+    methods = _group_methods(method, [len(group) for group in groups], n, time_limit)
+    budgets = _sampling_budgets(groups, methods, time_limit, samples, seed)
     marginals = np.zeros((n, n))
+    marginal_errors = np.zeros((n, n))
+    covariance = np.zeros((n, n))
     worlds: int | None = 1
-    for group in groups:
+    results = []
+    for group, group_method, budget in zip(groups, methods, budgets, strict=True):
         if len(group) == 1:
             continue
-        group_marginals, group_worlds = _group_marginals(supports, evidence, group, chosen_method, max_boxes)
-        marginals[np.ix_(group, group)] = group_marginals
-        worlds = None if worlds is None or group_worlds is None else worlds * group_worlds
+        result = _group_marginals(supports, evidence, group, group_method, max_boxes, budget)
+        results.append(result)
+        block = np.ix_(group, group)
+        marginals[block] = result.marginals
+        marginal_errors[block] = result.errors
+        if result.sampled is not None:
+            covariance[block] = result.sampled.errors_of(weights[group])[1]
+        worlds = None if worlds is None or result.worlds is None else worlds * result.worlds
     costs = expected_costs(marginals, weights)
     choice, ties = choose(supports.objects, costs)
+    largest = int(np.argmax([len(group) for group in groups]))
     return Decision(
         objects=supports.objects,
         choice=choice,
         components=tuple(tuple(supports.objects[i] for i in group) for group in groups),
+        component_methods=tuple(methods),
         expected_costs=costs,
+        expected_cost_errors=np.sqrt(np.diag(covariance)),
         marginals=marginals,
-        method=chosen_method,
+        marginal_errors=marginal_errors,
+        choice_probability=choice_probability(costs, covariance, supports.objects.index(choice), seed=seed),
+        sampling=_sampling_summary(results, seed),
+        method=methods[largest],
         cost=cost,
         consistent_worlds=worlds,
         ties=ties,

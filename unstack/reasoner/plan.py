@@ -35,6 +35,12 @@ class PlanStep:
     remaining: tuple[str, ...]
     decision: Decision
 
+    @property
+    def expected_cost_error(self) -> float:
+        """Standard error of ``expected_cost`` (0 when exact)."""
+        errors = self.decision.expected_cost_errors
+        return 0.0 if errors is None else float(errors[self.decision.objects.index(self.choice)])
+
 
 @dataclass(frozen=True)
 class Plan:
@@ -61,18 +67,24 @@ class Plan:
                     "remaining": list(step.remaining),
                     "method": step.decision.method,
                     "ties": list(step.decision.ties),
+                    "expected_cost_error": step.expected_cost_error,
+                    "choice_probability": step.decision.choice_probability,
                 }
                 for step in self.steps
             ],
         }
 
 
-def unloading_plan(supports: Supports, *, method: str = "auto", cost: str = "count") -> Plan:
-    """Order every box by repeated minimum-EC decisions (see the module docstring)."""
+def unloading_plan(supports: Supports, *, method: str = "auto", cost: str = "count", **sampling: Any) -> Plan:
+    """Order every box by repeated minimum-EC decisions (see the module docstring).
+
+    ``sampling``: ``time_limit``, ``samples``, ``seed`` of :func:`~unstack.reasoner.decision.decide`,
+    applied to each step.
+    """
     remaining = list(supports.objects)
     steps = []
     while remaining:
-        decision = decide(supports.subset(remaining), method=method, cost=cost)
+        decision = decide(supports.subset(remaining), method=method, cost=cost, **sampling)
         chosen = decision.objects.index(decision.choice)
         steps.append(PlanStep(decision.choice, float(decision.expected_costs[chosen]), tuple(remaining), decision))
         remaining.remove(decision.choice)
