@@ -154,3 +154,58 @@ def test_usage_errors_exit_2() -> None:
     result = unstack("decide", PILE5, "--method", "magic")
     assert result.returncode == 2
     assert "Invalid value for '--method'" in result.stderr
+
+
+@pytest.fixture
+def twelve_boxes(tmp_path: Path) -> Path:
+    """A 12-box supports file: too many linked boxes to count, so auto samples."""
+    rng = np.random.default_rng(12)
+    p = rng.uniform(0.01, 0.08, (12, 12))
+    for below in range(0, 9):
+        p[below, below + 3] = 0.9  # columns of four boxes
+    np.fill_diagonal(p, 0.0)
+    document = {"format": "unstack.supports/1", "objects": [f"b{i:02d}" for i in range(12)], "probabilities": p.tolist()}
+    path = tmp_path / "twelve.supports.json"
+    path.write_text(json.dumps(document))
+    return path
+
+
+def test_decide_samples_large_groups_reproducibly(twelve_boxes: Path) -> None:
+    runs = [unstack("decide", str(twelve_boxes), "--json", "--samples", "800", "--seed", "3") for _ in range(2)]
+    documents = [json.loads(run.stdout) for run in runs]
+    for document in documents:
+        jsonschema.validate(document, load_schema("unstack.decision/1"))
+        document.pop("seconds")
+        document["sampling"].pop("seconds")
+    assert documents[0] == documents[1]
+    assert documents[0]["method"] == "approx" and documents[0]["choice"] in {"b09", "b10", "b11"}
+    assert all(error > 0 for error in documents[0]["expected_cost_errors"])
+    table = unstack("decide", str(twelve_boxes), "--time-limit", "0.3")
+    assert table.returncode == 0, table.stderr
+    assert "± s.e." in table.stdout and "P(truly the minimum EC)" in table.stdout
+
+
+def test_approx_method_on_a_small_scene_agrees_with_exact() -> None:
+    document = json.loads(unstack("decide", PILE5, "--json", "--method", "approx", "--samples", "4000").stdout)
+    exact = json.loads(unstack("decide", PILE5, "--json").stdout)
+    assert document["choice"] == exact["choice"]
+    errors = np.abs(np.array(document["expected_costs"]) - np.array(exact["expected_costs"]))
+    assert np.all(errors <= 5 * np.array(document["expected_cost_errors"]) + 2e-3)
+
+
+def test_plan_with_sampling(twelve_boxes: Path) -> None:
+    result = unstack("plan", str(twelve_boxes), "--json", "--samples", "400", "--seed", "0")
+    assert result.returncode == 0, result.stderr
+    document = json.loads(result.stdout)
+    jsonschema.validate(document, load_schema("unstack.plan/1"))
+    assert document["steps"][0]["method"] == "approx" and document["steps"][-1]["method"] in {"exact", "sat"}
+    assert document["steps"][0]["expected_cost_error"] > 0
+
+
+@pytest.mark.parametrize(
+    ("option", "message"),
+    [(["--samples", "0"], "--samples"), (["--time-limit", "0"], "--time-limit"), (["--method", "fast"], "--method")],
+)
+def test_bad_sampling_options_exit_2(option: list[str], message: str) -> None:
+    result = unstack("decide", PILE5, *option)
+    assert result.returncode == 2 and message in result.stderr and "Traceback" not in result.stderr

@@ -50,6 +50,7 @@ __all__ = [
     "DEFAULT_TRIES",
     "SAMPLING_MAX_BOXES",
     "SampledMarginals",
+    "sample_worlds",
     "sampled_marginals",
 ]
 
@@ -255,3 +256,58 @@ def sampled_marginals(
         seed=seed,
         seconds=time.perf_counter() - start,
     )
+
+
+def sample_worlds(
+    probabilities: np.ndarray,
+    worlds: int,
+    *,
+    seed: int | None = None,
+    thin: int = 1,
+    burn_in: int = DEFAULT_BURN_IN,
+    tries: int = DEFAULT_TRIES,
+) -> np.ndarray:
+    """Draw consistent worlds from one chain of the sampler (correlated draws).
+
+    Parameters
+    ----------
+    probabilities : numpy.ndarray, shape (n, n)
+    worlds : int
+        Number of worlds.
+    seed : int, optional
+    thin : int
+        Sweeps between two recorded worlds.
+    burn_in, tries : int
+        As in :func:`sampled_marginals`.
+
+    Returns
+    -------
+    numpy.ndarray, shape (worlds, n, n), bool
+        ``[k, i, j]``: box i supports box j in world k.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> p = np.array([[0, 0.9, 0.1], [0.1, 0, 0.9], [0.1, 0.1, 0]])
+    >>> draws = sample_worlds(p, 3, seed=0)
+    >>> draws.shape
+    (3, 3, 3)
+    """
+    from unstack.reasoner._sampler_kernels import run_chains
+
+    p = np.ascontiguousarray(probabilities, dtype=np.float64)
+    n = p.shape[0]
+    if n > SAMPLING_MAX_BOXES:
+        raise TooLarge(f"{n} linked boxes: the sampler holds at most {SAMPLING_MAX_BOXES} boxes per group")
+    successors0, predecessors0 = _start_state(p)
+    successors, predecessors = successors0[None, :].copy(), predecessors0[None, :].copy()
+    rng = _chain_seeds(seed, 1)
+    accepted = np.zeros(1, dtype=np.int64)
+    unused = np.zeros((1, n, n))
+    run_chains(p, successors, predecessors, rng, burn_in, tries, False, unused, unused, unused, accepted)
+    bits = np.left_shift(np.int64(1), np.arange(n, dtype=np.int64))
+    draws = np.zeros((worlds, n, n), dtype=bool)
+    for k in range(worlds):
+        run_chains(p, successors, predecessors, rng, thin, tries, False, unused, unused, unused, accepted)
+        draws[k] = (successors[0][:, None] & bits[None, :]) != 0
+    return draws

@@ -1,0 +1,113 @@
+"""The sampling engine against exact answers, and its invariants."""
+
+from __future__ import annotations
+
+import networkx as nx
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from unstack.errors import TooLarge, UnstackError
+from unstack.reasoner.marginals import exact_marginals
+from unstack.reasoner.pruning import propagate_evidence
+from unstack.reasoner.sampling import sample_worlds, sampled_marginals
+
+
+def random_probabilities(rng: np.random.Generator, n: int, kind: str) -> np.ndarray:
+    """Dense (uniform), sparse (mostly small) or pile-like (a few strong relations) matrices."""
+    if kind == "dense":
+        p = rng.uniform(0.0, 1.0, (n, n))
+    elif kind == "sparse":
+        p = rng.beta(0.3, 3.0, (n, n))
+    else:
+        p = rng.uniform(0.01, 0.08, (n, n))
+        strong = rng.random((n, n)) < 2.0 / n
+        p[strong] = rng.uniform(0.5, 0.95, strong.sum())
+    np.fill_diagonal(p, 0.0)
+    return p
+
+
+def is_transitive(world: np.ndarray) -> bool:
+    """networkx as the oracle: the closure adds no relation."""
+    graph = nx.DiGraph()
+    graph.add_nodes_from(range(len(world)))
+    graph.add_edges_from(zip(*np.nonzero(world), strict=True))
+    closure = nx.transitive_closure(graph, reflexive=False)
+    return {(int(i), int(j)) for i, j in closure.edges if i != j} == {
+        (int(i), int(j)) for i, j in zip(*np.nonzero(world), strict=True)
+    }
+
+
+@pytest.mark.parametrize("kind", ["dense", "sparse", "pile"])
+@pytest.mark.parametrize("n", [2, 4, 6])
+def test_marginals_agree_with_the_exact_engine(rng: np.random.Generator, n: int, kind: str) -> None:
+    p = random_probabilities(rng, n, kind)
+    exact = exact_marginals(p).marginals
+    result = sampled_marginals(p, samples=16_000, seed=1)
+    off = ~np.eye(n, dtype=bool)
+    assert np.all(np.abs(result.marginals - exact)[off] <= 5 * result.standard_errors[off] + 2e-3)
+    costs, covariance = result.errors_of(np.ones(n))
+    assert np.all(np.abs(costs - exact.sum(axis=1)) <= 5 * np.sqrt(np.diag(covariance)) + 2e-3)
+
+
+def test_independent_components_up_to_forty_boxes(rng: np.random.Generator) -> None:
+    """Eight unlinked groups of five: the exact answer is known group by group."""
+    n, size = 40, 5
+    p = np.zeros((n, n))
+    exact = np.zeros((n, n))
+    for start in range(0, n, size):
+        block = slice(start, start + size)
+        p[block, block] = random_probabilities(rng, size, "pile")
+        exact[block, block] = exact_marginals(p[block, block]).marginals
+    result = sampled_marginals(p, samples=4_000, seed=2)
+    costs, covariance = result.errors_of(np.ones(n))
+    errors = np.abs(costs - exact.sum(axis=1))
+    assert np.all(errors <= 5 * np.sqrt(np.diag(covariance)) + 2e-3)
+    assert errors.max() < 0.05
+    assert np.all(result.marginals[p == 0] == 0.0)
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(arrays(np.float64, (5, 5), elements=st.sampled_from([0.0, 0.05, 0.3, 0.5, 0.9, 1.0])), st.integers(0, 2**32))
+def test_every_sampled_world_is_consistent_and_respects_evidence(matrix: np.ndarray, seed: int) -> None:
+    np.fill_diagonal(matrix, 0.0)
+    try:
+        evidence = propagate_evidence([str(i) for i in range(5)], matrix)
+    except UnstackError:
+        return  # contradictory hard evidence: nothing to sample
+    p = evidence.probabilities
+    for world in sample_worlds(p, 20, seed=seed, burn_in=2):
+        assert is_transitive(world)
+        assert np.all(world[p >= 1.0]) and not np.any(world[p <= 0.0])
+
+
+def test_same_seed_and_samples_give_the_same_answer(rng: np.random.Generator) -> None:
+    p = random_probabilities(rng, 9, "dense")
+    first = sampled_marginals(p, samples=800, seed=5)
+    second = sampled_marginals(p, samples=800, seed=5)
+    np.testing.assert_array_equal(first.marginals, second.marginals)
+    np.testing.assert_array_equal(first.standard_errors, second.standard_errors)
+    assert not np.array_equal(first.marginals, sampled_marginals(p, samples=800, seed=6).marginals)
+
+
+def test_more_samples_give_smaller_errors(rng: np.random.Generator) -> None:
+    p = random_probabilities(rng, 12, "pile")
+    short = sampled_marginals(p, samples=1_000, seed=3)
+    long = sampled_marginals(p, samples=16_000, seed=3)
+    assert long.standard_errors.max() < short.standard_errors.max()
+    assert long.samples >= 16_000 and short.samples >= 1_000
+
+
+def test_time_limit_bounds_the_run(rng: np.random.Generator) -> None:
+    p = random_probabilities(rng, 20, "pile")
+    result = sampled_marginals(p, time_limit=0.2, seed=0)
+    assert result.samples > 0 and len(result.batch_marginals) >= 2 * result.chains
+
+
+def test_bad_arguments_are_refused(rng: np.random.Generator) -> None:
+    with pytest.raises(TooLarge, match="64 linked boxes: the sampler holds at most 63 boxes"):
+        sampled_marginals(np.zeros((64, 64)), samples=10)
+    with pytest.raises(UnstackError, match="chains, tries and samples must be at least 1"):
+        sampled_marginals(np.zeros((3, 3)), samples=0)
