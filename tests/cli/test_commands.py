@@ -164,7 +164,11 @@ def twelve_boxes(tmp_path: Path) -> Path:
     for below in range(0, 9):
         p[below, below + 3] = 0.9  # columns of four boxes
     np.fill_diagonal(p, 0.0)
-    document = {"format": "unstack.supports/1", "objects": [f"b{i:02d}" for i in range(12)], "probabilities": p.tolist()}
+    document = {
+        "format": "unstack.supports/1",
+        "objects": [f"b{i:02d}" for i in range(12)],
+        "probabilities": p.tolist(),
+    }
     path = tmp_path / "twelve.supports.json"
     path.write_text(json.dumps(document))
     return path

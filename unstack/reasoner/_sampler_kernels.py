@@ -2,19 +2,20 @@
 
 A chain's state is a preorder on boxes ``0..n-1`` (``n <= 63``) kept as two arrays of bit
 masks: ``successors[i]`` (the boxes ``i`` supports) and ``predecessors[i]`` (the boxes that
-support ``i``). One move re-inserts one box ``x``: the relations of ``x`` are removed, a new
-set ``A`` of boxes that ``x`` supports and a set ``B`` of boxes that support ``x`` are
-proposed, and Metropolis-Hastings accepts or keeps the old ones.
+support ``i``). One move re-inserts one box ``x``: new sets ``A`` of boxes that ``x``
+supports and ``B`` of boxes that support ``x`` replace its relations, or the old ones stay.
 
-The proposal walks the other boxes in a random order and decides each one in turn. A box
+The proposal walks the other boxes in an order drawn at random and decides each one in
+turn, first all of ``A`` then all of ``B`` or the other way round (a coin decides). A box
 is *forced* when an earlier decision and transitivity leave one value only (``A`` must be
 closed under "supports", ``B`` under "is supported by", and every member of ``B`` must
 support every other member of ``A``); every other box is *free* and joins with its own
-probability ``p``. So the proposal is the target itself except at the forced boxes, and
-the Metropolis-Hastings ratio is the product of the forced boxes' factors (``p`` when
-forced in, ``1 - p`` when forced out) of the new insertion over the old one. Any order of
-the boxes gives a consistent result, and drawing the order before the move keeps detailed
-balance.
+probability ``p``. So the proposal is the target itself except at the forced boxes. Its
+probability under the even mixture of both phase orders is computed by replaying the
+candidate in the other order, and the move draws the next insertion among the current one
+and ``tries`` proposals with weights ``target / proposal`` (an ensemble of independent
+proposals, which keeps the target invariant). Any order of the boxes gives a consistent
+result, and drawing the order before the move keeps detailed balance.
 
 After each sweep (``n`` moves) every ordered pair adds its Rao-Blackwellised value: the
 probability of ``S_ij = 1`` given every other relation of the state, which is ``p_ij``
@@ -49,12 +50,87 @@ def _uniform(rng: np.ndarray, chain: int) -> float:
 
 
 @njit(cache=True, nogil=True)
-def _log_factor(probability: float, member: bool) -> float:
-    """``log p`` for a relation that holds, ``log(1 - p)`` for one that does not."""
-    value = probability if member else 1.0 - probability
-    if value <= 0.0:
-        return -np.inf
-    return float(np.log(value))
+def _decide_supported(
+    x: int,
+    order: np.ndarray,
+    log_present: np.ndarray,
+    log_absent: np.ndarray,
+    probabilities: np.ndarray,
+    successors: np.ndarray,
+    predecessors: np.ndarray,
+    supporters: np.int64,
+    rng: np.ndarray,
+    chain: int,
+    replay: np.int64,
+    replaying: bool,
+) -> tuple[np.int64, float, float]:
+    """Decide ``A``, the boxes ``x`` supports, given ``B`` = ``supporters`` (0 when undecided).
+
+    Returns ``(A, log proposal, log forced)``: the log probability of the free decisions
+    and the log factors of the forced ones (their sum is the log target of ``x``'s row).
+    """
+    inside = np.int64(0)
+    outside = np.int64(0)
+    log_proposal = 0.0
+    log_forced = 0.0
+    for k in order:
+        bit = np.int64(1) << k
+        allowed = (supporters & ~bit & ~predecessors[k]) == 0
+        if predecessors[k] & inside:
+            inside |= bit
+            log_forced += log_present[x, k]
+        elif (not allowed) or (successors[k] & outside):
+            outside |= bit
+            log_forced += log_absent[x, k]
+        else:
+            member = (replay & bit) != 0 if replaying else _uniform(rng, chain) < probabilities[x, k]
+            if member:
+                inside |= bit
+                log_proposal += log_present[x, k]
+            else:
+                outside |= bit
+                log_proposal += log_absent[x, k]
+    return inside, log_proposal, log_forced
+
+
+@njit(cache=True, nogil=True)
+def _decide_supporters(
+    x: int,
+    order: np.ndarray,
+    log_present: np.ndarray,
+    log_absent: np.ndarray,
+    probabilities: np.ndarray,
+    successors: np.ndarray,
+    predecessors: np.ndarray,
+    supported: np.int64,
+    rng: np.ndarray,
+    chain: int,
+    replay: np.int64,
+    replaying: bool,
+) -> tuple[np.int64, float, float]:
+    """Decide ``B``, the boxes supporting ``x``, given ``A`` = ``supported`` (0 when undecided)."""
+    inside = np.int64(0)
+    outside = np.int64(0)
+    log_proposal = 0.0
+    log_forced = 0.0
+    for k in order:
+        bit = np.int64(1) << k
+        allowed = (supported & ~bit & ~successors[k]) == 0
+        if successors[k] & inside:
+            inside |= bit
+            log_forced += log_present[k, x]
+        elif (not allowed) or (predecessors[k] & outside):
+            outside |= bit
+            log_forced += log_absent[k, x]
+        else:
+            member = (replay & bit) != 0 if replaying else _uniform(rng, chain) < probabilities[k, x]
+            if member:
+                inside |= bit
+                log_proposal += log_present[k, x]
+            else:
+                outside |= bit
+                log_proposal += log_absent[k, x]
+    return inside, log_proposal, log_forced
 
 
 @njit(cache=True, nogil=True)
@@ -62,56 +138,128 @@ def _insertion(
     x: int,
     order: np.ndarray,
     probabilities: np.ndarray,
+    log_present: np.ndarray,
+    log_absent: np.ndarray,
     successors: np.ndarray,
     predecessors: np.ndarray,
     rng: np.ndarray,
     chain: int,
+    supporters_first: bool,
     replay_supported: np.int64,
     replay_supporters: np.int64,
-    replay: bool,
-) -> tuple[np.int64, np.int64, float]:
-    """Propose (or, with ``replay``, re-trace) an insertion of ``x``: ``(A, B, log ratio)``.
+    replaying: bool,
+) -> tuple[np.int64, np.int64, float, float]:
+    """Propose (or, with ``replaying``, re-trace) an insertion of ``x``.
 
-    ``A``: boxes ``x`` supports; ``B``: boxes supporting ``x``; the log ratio is the sum of
-    the forced decisions' log factors (target over proposal).
+    ``A`` (boxes ``x`` supports) is decided before ``B`` (boxes supporting ``x``), or after
+    with ``supporters_first``. Returns ``(A, B, log proposal, log target)``. The relations
+    of ``x`` itself in ``successors``/``predecessors`` are never read: every mask they meet
+    excludes ``x``.
     """
-    supported_in = np.int64(0)
-    supported_out = np.int64(0)
-    log_ratio = 0.0
-    for k in order:
-        bit = np.int64(1) << k
-        p = probabilities[x, k]
-        if predecessors[k] & supported_in:
-            supported_in |= bit
-            log_ratio += _log_factor(p, True)
-        elif successors[k] & supported_out:
-            supported_out |= bit
-            log_ratio += _log_factor(p, False)
-        else:
-            member = (replay_supported & bit) != 0 if replay else _uniform(rng, chain) < p
-            if member:
-                supported_in |= bit
-            else:
-                supported_out |= bit
-    supporters_in = np.int64(0)
-    supporters_out = np.int64(0)
-    for k in order:
-        bit = np.int64(1) << k
-        p = probabilities[k, x]
-        allowed = (supported_in & ~bit & ~successors[k]) == 0
-        if successors[k] & supporters_in:
-            supporters_in |= bit
-            log_ratio += _log_factor(p, True)
-        elif (not allowed) or (predecessors[k] & supporters_out):
-            supporters_out |= bit
-            log_ratio += _log_factor(p, False)
-        else:
-            member = (replay_supporters & bit) != 0 if replay else _uniform(rng, chain) < p
-            if member:
-                supporters_in |= bit
-            else:
-                supporters_out |= bit
-    return supported_in, supporters_in, log_ratio
+    if supporters_first:
+        supporters, log_q1, log_f1 = _decide_supporters(
+            x,
+            order,
+            log_present,
+            log_absent,
+            probabilities,
+            successors,
+            predecessors,
+            np.int64(0),
+            rng,
+            chain,
+            replay_supporters,
+            replaying,
+        )
+        supported, log_q2, log_f2 = _decide_supported(
+            x,
+            order,
+            log_present,
+            log_absent,
+            probabilities,
+            successors,
+            predecessors,
+            supporters,
+            rng,
+            chain,
+            replay_supported,
+            replaying,
+        )
+    else:
+        supported, log_q1, log_f1 = _decide_supported(
+            x,
+            order,
+            log_present,
+            log_absent,
+            probabilities,
+            successors,
+            predecessors,
+            np.int64(0),
+            rng,
+            chain,
+            replay_supported,
+            replaying,
+        )
+        supporters, log_q2, log_f2 = _decide_supporters(
+            x,
+            order,
+            log_present,
+            log_absent,
+            probabilities,
+            successors,
+            predecessors,
+            supported,
+            rng,
+            chain,
+            replay_supporters,
+            replaying,
+        )
+    log_proposal = log_q1 + log_q2
+    return supported, supporters, log_proposal, log_proposal + log_f1 + log_f2
+
+
+@njit(cache=True, nogil=True)
+def _log_weight(
+    x: int,
+    order: np.ndarray,
+    probabilities: np.ndarray,
+    log_present: np.ndarray,
+    log_absent: np.ndarray,
+    successors: np.ndarray,
+    predecessors: np.ndarray,
+    rng: np.ndarray,
+    chain: int,
+    supported: np.int64,
+    supporters: np.int64,
+    log_proposal: float,
+    log_target: float,
+    supporters_first: bool,
+) -> float:
+    """``log(target / proposal)`` of an insertion under the even mixture of both phase orders.
+
+    ``log_proposal``/``log_target`` come from the order that drew (or replayed) it; the other
+    order is replayed here.
+    """
+    _, _, other_proposal, _ = _insertion(
+        x,
+        order,
+        probabilities,
+        log_present,
+        log_absent,
+        successors,
+        predecessors,
+        rng,
+        chain,
+        not supporters_first,
+        supported,
+        supporters,
+        True,
+    )
+    if log_proposal >= other_proposal:
+        mixture = log_proposal + np.log1p(np.exp(other_proposal - log_proposal))
+    else:
+        mixture = other_proposal + np.log1p(np.exp(log_proposal - other_proposal))
+    return float(log_target - mixture)
 
 
 @njit(cache=True, nogil=True)
@@ -140,6 +288,8 @@ def _set_relations(
 def _reinsert(
     x: int,
     probabilities: np.ndarray,
+    log_present: np.ndarray,
+    log_absent: np.ndarray,
     successors: np.ndarray,
     predecessors: np.ndarray,
     order: np.ndarray,
@@ -149,65 +299,103 @@ def _reinsert(
     candidates_supported: np.ndarray,
     candidates_supporters: np.ndarray,
     log_ratios: np.ndarray,
-    row_sums: np.ndarray,
-    column_sums: np.ndarray,
-    record: bool,
 ) -> bool:
     """One ensemble move on the relations of box ``x``; True when the relations changed.
 
     Candidates: the current insertion and ``tries`` proposals; the next insertion is drawn
     among them with weights ``target / proposal`` (Barker's rule over an ensemble of
-    independent proposals keeps the target invariant), and with ``record`` the
-    weighted mean of the candidates' relations is added to ``row_sums[x]`` (boxes ``x``
-    supports) and ``column_sums[:, x]`` (boxes supporting ``x``).
+    independent proposals keeps the target invariant).
     """
     n = probabilities.shape[0]
-    old_supported = successors[x]
-    old_supporters = predecessors[x]
-    _set_relations(x, n, np.int64(0), np.int64(0), successors, predecessors)
-    # the other boxes in a random order (Fisher-Yates over the first n - 1 slots)
+    # the other boxes from a random start, in a random direction (any order drawn
+    # independently of the state keeps detailed balance)
+    first = int(_uniform(rng, chain) * n)
+    step = 1 if _uniform(rng, chain) < 0.5 else n - 1
     m = 0
-    for k in range(n):
+    k = first
+    for _ in range(n):
         if k != x:
             order[m] = k
             m += 1
-    for i in range(m - 1, 0, -1):
-        j = int(_uniform(rng, chain) * (i + 1))
-        order[i], order[j] = order[j], order[i]
+        k = (k + step) % n
     walk = order[:m]
-    a, b, log_ratio = _insertion(
-        x, walk, probabilities, successors, predecessors, rng, chain, old_supported, old_supporters, True
+    old_supported = successors[x]
+    old_supporters = predecessors[x]
+    _, _, log_q, log_t = _insertion(
+        x,
+        walk,
+        probabilities,
+        log_present,
+        log_absent,
+        successors,
+        predecessors,
+        rng,
+        chain,
+        False,
+        old_supported,
+        old_supporters,
+        True,
     )
-    candidates_supported[0] = a
-    candidates_supporters[0] = b
-    log_ratios[0] = log_ratio
-    largest = log_ratio
+    candidates_supported[0] = old_supported
+    candidates_supporters[0] = old_supporters
+    log_ratios[0] = _log_weight(
+        x,
+        walk,
+        probabilities,
+        log_present,
+        log_absent,
+        successors,
+        predecessors,
+        rng,
+        chain,
+        old_supported,
+        old_supporters,
+        log_q,
+        log_t,
+        False,
+    )
+    largest = log_ratios[0]
     for t in range(1, tries + 1):
-        a, b, log_ratio = _insertion(
-            x, walk, probabilities, successors, predecessors, rng, chain, np.int64(0), np.int64(0), False
+        supporters_first = _uniform(rng, chain) < 0.5
+        a, b, log_q, log_t = _insertion(
+            x,
+            walk,
+            probabilities,
+            log_present,
+            log_absent,
+            successors,
+            predecessors,
+            rng,
+            chain,
+            supporters_first,
+            np.int64(0),
+            np.int64(0),
+            False,
         )
         candidates_supported[t] = a
         candidates_supporters[t] = b
-        log_ratios[t] = log_ratio
-        if log_ratio > largest:
-            largest = log_ratio
+        log_ratios[t] = _log_weight(
+            x,
+            walk,
+            probabilities,
+            log_present,
+            log_absent,
+            successors,
+            predecessors,
+            rng,
+            chain,
+            a,
+            b,
+            log_q,
+            log_t,
+            supporters_first,
+        )
+        if log_ratios[t] > largest:
+            largest = log_ratios[t]
     total = 0.0
     for t in range(tries + 1):
         log_ratios[t] = np.exp(log_ratios[t] - largest)
         total += log_ratios[t]
-    if record:
-        for t in range(tries + 1):
-            weight = log_ratios[t] / total
-            if weight == 0.0:
-                continue
-            a = candidates_supported[t]
-            b = candidates_supporters[t]
-            for k in walk:
-                bit = np.int64(1) << k
-                if a & bit:
-                    row_sums[x, k] += weight
-                if b & bit:
-                    column_sums[k, x] += weight
     u = _uniform(rng, chain) * total
     pick = tries
     for t in range(tries + 1):
@@ -215,8 +403,10 @@ def _reinsert(
         if u < 0.0:
             pick = t
             break
+    if pick == 0:
+        return False
     _set_relations(x, n, candidates_supported[pick], candidates_supporters[pick], successors, predecessors)
-    return pick != 0
+    return True
 
 
 @njit(cache=True, nogil=True)
@@ -250,15 +440,15 @@ def _add_conditionals(
 def _run_chain(
     chain: int,
     probabilities: np.ndarray,
+    log_present: np.ndarray,
+    log_absent: np.ndarray,
     successors: np.ndarray,
     predecessors: np.ndarray,
     rng: np.ndarray,
     sweeps: int,
     tries: int,
     record: bool,
-    pair_sums: np.ndarray,
-    row_sums: np.ndarray,
-    column_sums: np.ndarray,
+    sums: np.ndarray,
 ) -> int:
     """Run ``sweeps`` sweeps of one chain; add the estimates when ``record``."""
     n = probabilities.shape[0]
@@ -272,6 +462,8 @@ def _run_chain(
             if _reinsert(
                 x,
                 probabilities,
+                log_present,
+                log_absent,
                 successors,
                 predecessors,
                 order,
@@ -281,48 +473,47 @@ def _run_chain(
                 candidates_supported,
                 candidates_supporters,
                 log_ratios,
-                row_sums,
-                column_sums,
-                record,
             ):
                 accepted += 1
         if record:
-            _add_conditionals(probabilities, successors, predecessors, pair_sums)
+            _add_conditionals(probabilities, successors, predecessors, sums)
     return accepted
 
 
 @njit(cache=True, nogil=True, parallel=True)
 def run_chains(
     probabilities: np.ndarray,
+    log_present: np.ndarray,
+    log_absent: np.ndarray,
     successors: np.ndarray,
     predecessors: np.ndarray,
     rng: np.ndarray,
     sweeps: int,
     tries: int,
     record: bool,
-    pair_sums: np.ndarray,
-    row_sums: np.ndarray,
-    column_sums: np.ndarray,
+    sums: np.ndarray,
     accepted: np.ndarray,
 ) -> None:
     """Advance every chain by ``sweeps`` sweeps (chains run in parallel).
 
+    ``log_present``/``log_absent``: ``log p`` and ``log(1 - p)`` (``-inf`` at 0);
+
     ``successors``/``predecessors``: ``(chains, n)`` bit masks, updated in place;
-    ``rng``: ``(chains,)`` uint64 states; ``pair_sums``, ``row_sums``, ``column_sums``:
-    ``(chains, n, n)`` sums of the three estimators over the recorded sweeps;
+    ``rng``: ``(chains,)`` uint64 states; ``sums``: ``(chains, n, n)``, the conditionals
+    of every recorded sweep are added;
     ``accepted``: ``(chains,)`` counts of moves that changed the state.
     """
     for c in prange(successors.shape[0]):
         accepted[c] += _run_chain(
             c,
             probabilities,
+            log_present,
+            log_absent,
             successors[c],
             predecessors[c],
             rng,
             sweeps,
             tries,
             record,
-            pair_sums[c],
-            row_sums[c],
-            column_sums[c],
+            sums[c],
         )

@@ -5,18 +5,19 @@ marginals are estimated by Markov chain Monte Carlo over the consistent worlds t
 
 * the state of a chain is a preorder (a consistent world), so transitivity holds at every
   step by construction;
-* a move takes one box out and inserts it again. Several insertions are proposed, each
-  deciding which boxes the box supports and which support it one box at a time, each with
+* a move takes one box out and inserts it again. Candidate insertions are proposed,
+  deciding which boxes the box supports and which support it one box at a time (half of
+  them decide the supported boxes first, half the supporting ones), each box joining with
   its own probability unless transitivity already decides it; the next state is drawn
-  among the proposals and the current insertion with weights target / proposal (details
+  among the candidates and the current insertion with weights target / proposal (details
   in :mod:`unstack.reasoner._sampler_kernels`). Re-inserting single boxes connects every
   preorder to the empty one, so the chain reaches every consistent world -- single pair
   flips would not (three mutually supporting boxes cannot lose one relation alone);
-* three unbiased estimates of every marginal are averaged: after every sweep (one move
-  per box) the probability of each relation *given all the other relations* -- the pair's
-  own ``p`` whenever both values keep the world transitive (Rao-Blackwellisation, which
-  removes the noise of pairs that transitivity does not touch) -- and at every move the
-  weighted mean of the candidates' relations of the moved box, as a row and as a column;
+* after every sweep (one move per box) each pair contributes the probability of its
+  relation *given all the other relations*: the pair's own ``p`` whenever both values
+  keep the world transitive, else the value transitivity leaves. This Rao-Blackwellisation
+  removes the noise of the many pairs that transitivity does not touch (measured: it beats
+  averaging the moved box's candidate relations, which was tried and dropped);
 * several chains run in parallel from the closure of the hard evidence; the first sweeps
   are discarded (burn-in), the rest are grouped into batches, and the standard error of
   every marginal comes from the spread of the batch means (batch means over all chains).
@@ -60,8 +61,9 @@ SAMPLING_MAX_BOXES = 63
 DEFAULT_CHAINS = 8
 #: Seconds of sampling when neither ``samples`` nor ``time_limit`` is given.
 DEFAULT_TIME_LIMIT = 1.0
-#: Proposals per move: more proposals mix faster per sweep and average more candidates.
-DEFAULT_TRIES = 8
+#: Proposals per move. Measured on classifier matrices of 39-40 boxes (1 s, 8 seeded runs):
+#: worst EC error 0.074 / 0.034 / 0.034 with 1 / 2 / 4 proposals; 2 is cheaper than 4.
+DEFAULT_TRIES = 2
 #: Sweeps per chain discarded before recording.
 DEFAULT_BURN_IN = 64
 #: Sweeps per chain in one round of the anytime loop (one call of the compiled kernel).
@@ -141,6 +143,12 @@ def _start_state(probabilities: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return successors, predecessors
 
 
+def _log_tables(probabilities: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``log p`` and ``log(1 - p)``, with ``-inf`` where the factor is 0."""
+    with np.errstate(divide="ignore"):
+        return np.log(probabilities), np.log1p(-probabilities)
+
+
 def _chain_seeds(seed: int | None, chains: int) -> np.ndarray:
     """One non-zero xorshift state per chain, from ``numpy.random.SeedSequence(seed)``."""
     states = np.random.SeedSequence(seed).generate_state(chains, dtype=np.uint64)
@@ -202,12 +210,13 @@ def sampled_marginals(
     deadline = None if time_limit is None else start + time_limit
     per_chain = None if samples is None else -(-samples // chains)
     successors0, predecessors0 = _start_state(p)
+    log_tables = _log_tables(p)
     successors = np.repeat(successors0[None, :], chains, axis=0)
     predecessors = np.repeat(predecessors0[None, :], chains, axis=0)
     rng = _chain_seeds(seed, chains)
     accepted = np.zeros(chains, dtype=np.int64)
-    pair_sums, row_sums, column_sums = (np.zeros((chains, n, n)) for _ in range(3))
-    run_chains(p, successors, predecessors, rng, burn_in, tries, False, pair_sums, row_sums, column_sums, accepted)
+    sums = np.zeros((chains, n, n))
+    run_chains(p, *log_tables, successors, predecessors, rng, burn_in, tries, False, sums, accepted)
 
     batches = np.zeros((chains, _MAX_BATCHES, n, n))
     batch_length = _ROUND_SWEEPS  # sweeps per chain in one batch
@@ -215,12 +224,9 @@ def sampled_marginals(
     partial = 0  # sweeps per chain in the open batch
     recorded = 0  # sweeps per chain
     while True:
-        for sums in (pair_sums, row_sums, column_sums):
-            sums[:] = 0.0
-        run_chains(
-            p, successors, predecessors, rng, _ROUND_SWEEPS, tries, True, pair_sums, row_sums, column_sums, accepted
-        )
-        batches[:, filled] += (pair_sums + row_sums + column_sums) / 3.0
+        sums[:] = 0.0
+        run_chains(p, *log_tables, successors, predecessors, rng, _ROUND_SWEEPS, tries, True, sums, accepted)
+        batches[:, filled] += sums
         partial += _ROUND_SWEEPS
         recorded += _ROUND_SWEEPS
         if partial == batch_length:
@@ -300,14 +306,15 @@ def sample_worlds(
     if n > SAMPLING_MAX_BOXES:
         raise TooLarge(f"{n} linked boxes: the sampler holds at most {SAMPLING_MAX_BOXES} boxes per group")
     successors0, predecessors0 = _start_state(p)
+    log_tables = _log_tables(p)
     successors, predecessors = successors0[None, :].copy(), predecessors0[None, :].copy()
     rng = _chain_seeds(seed, 1)
     accepted = np.zeros(1, dtype=np.int64)
     unused = np.zeros((1, n, n))
-    run_chains(p, successors, predecessors, rng, burn_in, tries, False, unused, unused, unused, accepted)
+    run_chains(p, *log_tables, successors, predecessors, rng, burn_in, tries, False, unused, accepted)
     bits = np.left_shift(np.int64(1), np.arange(n, dtype=np.int64))
     draws = np.zeros((worlds, n, n), dtype=bool)
     for k in range(worlds):
-        run_chains(p, successors, predecessors, rng, thin, tries, False, unused, unused, unused, accepted)
+        run_chains(p, *log_tables, successors, predecessors, rng, thin, tries, False, unused, accepted)
         draws[k] = (successors[0][:, None] & bits[None, :]) != 0
     return draws
