@@ -16,6 +16,10 @@ def _number(value: float) -> str:
     return f"{value:.4f}"
 
 
+#: Above this many boxes the support matrix is left to the JSON output.
+MATRIX_MAX_BOXES = 12
+
+
 def decision_view(decision: Decision) -> Group:
     """The choice, the expected cost of every box and the conditional support matrix."""
     unit = "boxes" if decision.cost == "count" else "kg"
@@ -33,13 +37,17 @@ def decision_view(decision: Decision) -> Group:
         mark = "<- unload first" if box == decision.choice else ("tie" if box in decision.ties else "")
         error = [] if not sampled else [f"{decision.expected_cost_errors[i]:.4f}"]  # type: ignore[index]
         costs.add_row(str(rank), box, _number(float(decision.expected_costs[i])), *error, mark)
-    matrix = Table(title="P(row supports column | consistent world)", title_justify="left")
-    matrix.add_column("supports ->")
-    for box in decision.objects:
-        matrix.add_column(box, justify="right")
-    for i, box in enumerate(decision.objects):
-        cells = ["-" if i == j else f"{decision.marginals[i, j]:.3f}" for j in range(len(decision.objects))]
-        matrix.add_row(box, *cells)
+    matrix: Table | Text
+    if len(decision.objects) <= MATRIX_MAX_BOXES:
+        matrix = Table(title="P(row supports column | consistent world)", title_justify="left")
+        matrix.add_column("supports ->")
+        for box in decision.objects:
+            matrix.add_column(box, justify="right")
+        for i, box in enumerate(decision.objects):
+            cells = ["-" if i == j else f"{decision.marginals[i, j]:.3f}" for j in range(len(decision.objects))]
+            matrix.add_row(box, *cells)
+    else:
+        matrix = Text(f"({len(decision.objects)} boxes: P(row supports column | consistent) is in --json)")
     worlds = "" if decision.consistent_worlds is None else f", {decision.consistent_worlds:,} consistent worlds"
     evidence = decision.evidence
     hard = f", hard evidence: {len(evidence.forced)} forced / {len(evidence.forbidden)} forbidden"
