@@ -46,3 +46,30 @@ def test_fingerprint_changes_with_the_data(small_dataset: Path, tmp_path: Path) 
 def test_a_folder_without_scenes(tmp_path: Path) -> None:
     with pytest.raises(UnstackError, match=r"expected a data set folder with config-NNNN\.json scene files"):
         dataset_examples(tmp_path)
+
+
+def test_neighbour_isets_are_the_nearest_boxes_to_a_centre(rng: np.random.Generator) -> None:
+    positions = rng.uniform(0.0, 3.0, (12, 3))
+    ids = [f"b{k:02d}" for k in range(12)]
+    for iset in sample_isets(ids, r=4, isets=20, rng=rng, draw="neighbours", positions=positions):
+        members = [ids.index(box) for box in iset]
+        # some member is the centre: the other members are its 3 nearest boxes
+        assert any(
+            set(np.argsort(np.linalg.norm(positions - positions[c], axis=1), kind="stable")[:4]) == set(members)
+            for c in members
+        )
+
+
+def test_neighbour_isets_hold_more_support_relations(small_dataset: Path) -> None:
+    near = dataset_examples(small_dataset, r=4, isets=6, seed=0, draw="neighbours")
+    assert near.features.shape[1] == 19 and len(near.labels) > 0
+    assert near.labels.mean() >= dataset_examples(small_dataset, r=4, isets=6, seed=0).labels.mean()
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [({"draw": "clusters"}, "unknown ISet draw 'clusters'"), ({"draw": "neighbours"}, "need the centroid")],
+)
+def test_bad_iset_draws(kwargs: dict[str, str], message: str, rng: np.random.Generator) -> None:
+    with pytest.raises(UnstackError, match=message):
+        sample_isets(["a", "b", "c"], r=2, isets=1, rng=rng, **kwargs)

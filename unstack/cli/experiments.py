@@ -9,6 +9,7 @@ import click
 from rich.console import Console
 from rich.table import Table
 
+from unstack.cli.learning import ISETS_FROM_HELP
 from unstack.cli.progress import progress_bar
 from unstack.errors import UnstackError
 
@@ -65,10 +66,14 @@ def table1(out: str, max_n: int) -> None:
 @click.option("--out", required=True, type=click.Path(), help="Folder for fig5a.json.")
 @click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
 @click.option("--isets", type=int, default=1, show_default=True, help="ISets per configuration.")
+@click.option("--isets-from", "draw", type=click.Choice(["random", "neighbours"]), default="random",
+              show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
+@click.option("--learner", type=click.Choice(["svm", "gradient_boosting", "calibrated_svm"]), default="svm",
+              show_default=True, help="svm: the paper's RBF SVM with probabilities.")  # fmt: skip
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets, split and folds.")
 @click.option("--cv", type=int, default=10, show_default=True, help="Cross-validation folds.")
 @click.option("--jobs", type=int, default=1, show_default=True, help="Parallel processes.")
-def fig5a(data_dir: str, out: str, r: int, isets: int, seed: int, cv: int, jobs: int) -> None:
+def fig5a(data_dir: str, out: str, r: int, isets: int, draw: str, learner: str, seed: int, cv: int, jobs: int) -> None:
     """Fig. 5a: the validation confusion matrix of the SVM on a simulated data set, beside the paper's."""
     from unstack.experiments.fig5a import fig5a as run
     from unstack.sim.dataset import require_configurations
@@ -76,7 +81,7 @@ def fig5a(data_dir: str, out: str, r: int, isets: int, seed: int, cv: int, jobs:
     if r < 2 or isets < 1 or cv < 2 or jobs < 1:
         raise UnstackError("expected --r >= 2, --isets >= 1, --cv >= 2 and --jobs >= 1")
     require_configurations(data_dir)
-    result = run(data_dir, r=r, isets=isets, seed=seed, cv=cv, n_jobs=jobs)
+    result = run(data_dir, r=r, isets=isets, seed=seed, cv=cv, n_jobs=jobs, draw=draw, learner=learner)
     _write_json(_out(out) / "fig5a.json", result)
     table = Table(title=f"Fig. 5a: validation relations of {data_dir} ({result['relations']} relations, "
                   f"{result['supp']} SUPP)")  # fmt: skip
@@ -85,7 +90,9 @@ def fig5a(data_dir: str, out: str, r: int, isets: int, seed: int, cv: int, jobs:
     ours = result["validation"]
     balanced = result["validation_at_balanced_threshold"]
     table.add_row("paper (Fig. 5a)", "78.4 %", "87.5 %")
-    table.add_row("unstack, P >= 0.5", f"{100 * ours['supp_recall']:.1f} %", f"{100 * ours['not_supp_recall']:.1f} %")
+    table.add_row(
+        f"unstack {learner}, P >= 0.5", f"{100 * ours['supp_recall']:.1f} %", f"{100 * ours['not_supp_recall']:.1f} %"
+    )
     table.add_row(
         f"unstack, P >= {result['balanced_threshold']:.3f} (balanced on training part)",
         f"{100 * balanced['supp_recall']:.1f} %",
@@ -100,8 +107,10 @@ def fig5a(data_dir: str, out: str, r: int, isets: int, seed: int, cv: int, jobs:
 @click.option("--model", "model_path", default=None, help="Model file (default: the one shipped).")
 @click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
 @click.option("--isets", type=int, default=493, show_default=True, help="Test ISets (the paper: 493).")
+@click.option("--isets-from", "draw", type=click.Choice(["random", "neighbours"]), default="random",
+              show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets.")
-def decisions(data_dir: str, out: str, model_path: str | None, r: int, isets: int, seed: int) -> None:
+def decisions(data_dir: str, out: str, model_path: str | None, r: int, isets: int, draw: str, seed: int) -> None:
     """Fig. 4 and beyond: MSE(cost), first pick right and physical disturbance of every decision maker."""
     from unstack.cli.learning import load_support_model
     from unstack.experiments.decisions import DECISION_MAKERS, evaluate_decisions, plot_fig4
@@ -113,7 +122,7 @@ def decisions(data_dir: str, out: str, model_path: str | None, r: int, isets: in
     model, name = load_support_model(model_path)
     folder = _out(out)
     with progress_bar("ISets") as report:
-        result = evaluate_decisions(data_dir, model, r=r, isets=isets, seed=seed, progress=report)
+        result = evaluate_decisions(data_dir, model, r=r, isets=isets, seed=seed, progress=report, draw=draw)
     result["model"] = name
     _write_json(folder / "decisions.json", result)
     plot_fig4(result, folder / "fig4.png")

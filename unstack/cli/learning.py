@@ -61,7 +61,10 @@ def metrics_view(report: dict[str, Any], title: str) -> Group:
     return Group(confusion, summary)
 
 
-def _examples(data_dir: str, r: int, isets: int, seed: int, jobs: int, settings: Any) -> Any:
+ISETS_FROM_HELP = "How ISets are drawn: random detected boxes, or a detected box and its nearest neighbours."
+
+
+def _examples(data_dir: str, r: int, isets: int, seed: int, jobs: int, settings: Any, draw: str = "random") -> Any:
     from unstack.learning.training_data import dataset_examples
     from unstack.sim.dataset import require_configurations
 
@@ -70,7 +73,7 @@ def _examples(data_dir: str, r: int, isets: int, seed: int, jobs: int, settings:
 
     with progress_bar("features") as report:
         examples = dataset_examples(
-            data_dir, r=r, isets=isets, seed=seed, settings=settings, n_jobs=jobs, progress=report
+            data_dir, r=r, isets=isets, seed=seed, settings=settings, n_jobs=jobs, progress=report, draw=draw
         )
     if len(examples.labels) == 0:
         raise UnstackError(f"{data_dir}: no ISet of at least 2 detected boxes; nothing to learn from")
@@ -84,6 +87,8 @@ def _examples(data_dir: str, r: int, isets: int, seed: int, jobs: int, settings:
               show_default=True, help="svm: RBF SVM with LIBSVM probabilities (the paper).")  # fmt: skip
 @click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
 @click.option("--isets", type=int, default=3, show_default=True, help="ISets drawn per configuration.")
+@click.option("--isets-from", "draw", type=click.Choice(["random", "neighbours"]), default="random",
+              show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets, the split and the folds.")
 @click.option("--cv", type=int, default=10, show_default=True, help="Cross-validation folds on the training part.")
 @click.option("--validation-size", type=float, default=0.3, show_default=True, help="Share held out for validation.")
@@ -97,6 +102,7 @@ def train(
     learner: str,
     r: int,
     isets: int,
+    draw: str,
     seed: int,
     cv: int,
     validation_size: float,
@@ -115,7 +121,7 @@ def train(
     if r < 2 or isets < 1 or cv < 2 or jobs < 1 or not 0.0 <= validation_size < 1.0:
         raise UnstackError("expected --r >= 2, --isets >= 1, --cv >= 2, --jobs >= 1 and 0 <= --validation-size < 1")
     settings = FeatureSettings(offset=offset, sigma=sigma)
-    examples = _examples(data_dir, r, isets, seed, jobs, settings)
+    examples = _examples(data_dir, r, isets, seed, jobs, settings, draw)
     console = Console(stderr=as_json)
     console.print(
         f"{len(examples.labels)} relations ({int(examples.labels.sum())} SUPP) from "
@@ -133,6 +139,7 @@ def train(
         "seed": seed,
         "r": r,
         "isets_per_configuration": isets,
+        "isets_from": draw,
         "relations": len(examples.labels),
         "supp": int(examples.labels.sum()),
         "validation_size": validation_size,
@@ -157,12 +164,22 @@ def train(
 @click.argument("data_dir", type=click.Path(file_okay=False))
 @click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
 @click.option("--isets", type=int, default=3, show_default=True, help="ISets drawn per configuration.")
+@click.option("--isets-from", "draw", type=click.Choice(["random", "neighbours"]), default="random",
+              show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
 @click.option("--seed", type=int, default=1, show_default=True, help="Seed of the ISets.")
 @click.option("--jobs", type=int, default=1, show_default=True, help="Parallel processes.")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
 @click.option("--reliability", type=click.Path(dir_okay=False), default=None, help="Write a reliability diagram PNG.")
 def evaluate(
-    model_file: str, data_dir: str, r: int, isets: int, seed: int, jobs: int, as_json: bool, reliability: str | None
+    model_file: str,
+    data_dir: str,
+    r: int,
+    isets: int,
+    draw: str,
+    seed: int,
+    jobs: int,
+    as_json: bool,
+    reliability: str | None,
 ) -> None:
     """Score a model on a data set: confusion matrix, success rate, BER, entropy, calibration."""
     from unstack.learning.metrics import classification_report, save_reliability_diagram
@@ -171,7 +188,7 @@ def evaluate(
     if r < 2 or isets < 1 or jobs < 1:
         raise UnstackError("expected --r >= 2, --isets >= 1 and --jobs >= 1")
     model = load_model(model_file)
-    examples = _examples(data_dir, r, isets, seed, jobs, model.features)
+    examples = _examples(data_dir, r, isets, seed, jobs, model.features, draw)
     report = classification_report(examples.labels, model.support_probability(examples.features))
     if reliability:
         save_reliability_diagram(report, reliability, title=f"{model_file} on {data_dir}")

@@ -174,9 +174,13 @@ def evaluate_decisions(
     isets: int = 493,
     seed: int = 0,
     progress: Callable[[int, int], None] | None = None,
+    draw: str = "random",
 ) -> dict[str, Any]:
-    """Draw ``isets`` test ISets of ``r`` boxes from the data set's scenes and score every decision maker."""
-    from unstack.learning.training_data import sample_isets
+    """Draw ``isets`` test ISets of ``r`` boxes from the data set's scenes and score every decision maker.
+
+    ``draw``: how the ISets are drawn (see :data:`unstack.learning.training_data.ISET_DRAWS`).
+    """
+    from unstack.learning.training_data import detected_positions, sample_isets
     from unstack.scene import load_scene
     from unstack.sim.dataset import require_configurations
 
@@ -188,7 +192,15 @@ def evaluate_decisions(
         if len(results) >= isets:
             break
         scene = load_scene(path)
-        for ids in sample_isets(scene.detected, r=r, isets=min(per_scene, isets - len(results)), rng=rng):
+        drawn = sample_isets(
+            scene.detected,
+            r=r,
+            isets=min(per_scene, isets - len(results)),
+            rng=rng,
+            draw=draw,
+            positions=detected_positions(scene),
+        )
+        for ids in drawn:
             results.append(_iset_result(scene, list(ids), model))
             if progress is not None:
                 progress(len(results), isets)

@@ -38,7 +38,15 @@ def _balanced_threshold(truth: np.ndarray, probability: np.ndarray) -> float:
 
 
 def fig5a(
-    data_dir: str | os.PathLike[str], *, r: int = 5, isets: int = 1, seed: int = 0, cv: int = 10, n_jobs: int = 1
+    data_dir: str | os.PathLike[str],
+    *,
+    r: int = 5,
+    isets: int = 1,
+    seed: int = 0,
+    cv: int = 10,
+    n_jobs: int = 1,
+    draw: str = "random",
+    learner: str = "svm",
 ) -> dict[str, Any]:
     """Train on the data set and report the validation confusion matrix against the paper."""
     from sklearn.model_selection import train_test_split
@@ -47,8 +55,10 @@ def fig5a(
     from unstack.learning.metrics import classification_report
     from unstack.learning.training_data import dataset_examples
 
-    examples = dataset_examples(data_dir, r=r, isets=isets, seed=seed, n_jobs=n_jobs)
-    classifier = SupportClassifier(cv=cv, random_state=seed, n_jobs=n_jobs).fit(examples.features, examples.labels)
+    examples = dataset_examples(data_dir, r=r, isets=isets, seed=seed, n_jobs=n_jobs, draw=draw)
+    classifier = SupportClassifier(learner=learner, cv=cv, random_state=seed, n_jobs=n_jobs).fit(
+        examples.features, examples.labels
+    )
     train_x, valid_x, train_y, valid_y = train_test_split(
         examples.features, examples.labels, test_size=0.3, stratify=examples.labels, random_state=seed
     )
@@ -57,6 +67,8 @@ def fig5a(
     at_threshold = classification_report(valid_y, (valid_p >= threshold).astype(float))
     return {
         "data": str(data_dir),
+        "isets_from": draw,
+        "learner": learner,
         "relations": len(examples.labels),
         "supp": int(examples.labels.sum()),
         "best_params": {key: float(value) for key, value in classifier.best_params_.items()},
