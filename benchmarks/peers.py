@@ -1,7 +1,8 @@
-"""Side by side: unstack's two methods against ProbLog and PySDD on the same instances.
+"""Side by side: unstack's methods against ProbLog, PySDD and Ganak on the same instances.
 
 Every method answers the same question -- ``P(S_xy = 1 | consistent)`` for every ordered
-pair -- on the matrices of :mod:`instances` (``dense`` and ``sparse``, seeded):
+pair -- on the matrices of :mod:`instances` (``dense`` and ``sparse``, seeded random;
+``classifier``, the shipped classifier on simulated piles of 31-40 boxes):
 
 ``exact``
     ``unstack.decide(supports, method="exact")``: weighted counting of preorders (numba,
@@ -10,6 +11,13 @@ pair -- on the matrices of :mod:`instances` (``dense`` and ``sparse``, seeded):
     the same with ``NUMBA_NUM_THREADS=1``: one core, like the peers.
 ``sat``
     ``unstack.decide(supports, method="sat")``: lists the worlds with CaDiCaL (n <= 6).
+``approx``
+    ``unstack.reasoner.decision.decide(supports, method="approx", time_limit=T, seed=0)``
+    with ``T = --approx-seconds`` (default 1 s): MCMC over consistent worlds, so it takes
+    about ``T`` at every size and runs every size. Not exact: it is scored against exact
+    by its largest marginal difference and its largest EC error, ``max_i |sum_j
+    approx[i, j] - sum_j exact[i, j]|`` (Eq. 11's count cost), next to its own largest
+    EC standard error -- never flagged as a disagreement.
 ``problog``
     ProbLog 2 through its Python API with its default knowledge compiler (SDD when PySDD is
     installed): ``p::s(X,Y).`` per ordered pair, ``inconsistent :- s(X,Y), s(Y,Z), X \\= Z,
@@ -19,6 +27,25 @@ pair -- on the matrices of :mod:`instances` (``dense`` and ``sparse``, seeded):
     ordered triple) compiled bottom-up into an SDD over the ``n(n-1)`` pair variables, then
     one weighted model count with literal weights ``p`` and ``1 - p`` (log mode) and every
     conditional marginal from ``WmcManager.literal_pr`` after one ``propagate()``.
+``pyganak``
+    Ganak (Arjun preprocessing, exact weighted model counting in 128-bit MPFR) through
+    PyPI's ``pyganak``: the same CNF, one variable per ordered pair with literal weights
+    ``p`` and ``1 - p`` divided by ``max(p, 1 - p)`` (the ratios are unchanged, the counts
+    stay far from float64's underflow), and ``m + 1`` counts for ``m = n(n-1)`` pairs:
+    ``Z``, then ``Z_xy`` with the unit clause ``s_xy`` added, ``P = Z_xy / Z``. A counter
+    counts once, so each count builds its own. ``count()`` returns a float64: when ``Z``
+    still underflows (or overflows) the result's status is ``underflow``, not numbers.
+
+The exact methods (all but ``approx``) must agree with unstack exact to
+:data:`AGREE_TOLERANCE` (``1e-9``) on every marginal; a larger difference is flagged
+``DISAGREES`` in the table and the script exits with status 1.
+
+Sizes. ``exact``/``exact-1t`` skip ``n`` above unstack's exact limit (8, or
+``--max-boxes``), ``sat`` above 6, a ``classifier`` size above its pile's box count. Every
+exact method also skips, per family, every size above the first at which it timed out, ran
+out of memory or underflowed (sizes run in increasing order); ``approx`` runs every size.
+A method that cannot be imported is tried once per family. A summary after the tables
+gives, per family and method, the largest ``n`` within the timeout.
 
 Each (method, family, n) runs in its own subprocess with a timeout and an address-space
 limit; the parent reads the child's peak RSS from ``os.wait4``. Inside the child the first
@@ -32,6 +59,11 @@ figure of the same instance measured in the same run.
 Usage::
 
     python benchmarks/peers.py --sizes 3-7 --families dense,sparse --timeout 120 --seed 0 --json out.json
+    python benchmarks/peers.py --sizes 3-8,10,20,30,40 --families dense,sparse,classifier
+    python benchmarks/peers.py --sizes 20,40 --methods approx --approx-seconds 2
+
+``--methods`` picks a subset (unstack exact always runs: it is the reference of every
+difference and ratio).
 
 The worker mode (``--worker``) is internal.
 """
@@ -61,18 +93,29 @@ HERE = Path(__file__).resolve().parent
 if str(HERE) not in sys.path:
     sys.path.insert(0, str(HERE))
 
-from instances import FAMILIES, box_ids, instance  # noqa: E402
+from instances import ALL_FAMILIES, box_ids, instance  # noqa: E402
 
-METHODS: tuple[str, ...] = ("exact", "exact-1t", "sat", "problog", "pysdd")
+METHODS: tuple[str, ...] = ("exact", "exact-1t", "sat", "approx", "problog", "pysdd", "pyganak")
 LABELS: dict[str, str] = {
     "exact": "exact",
     "exact-1t": "exact 1 thread",
     "sat": "sat",
+    "approx": "approx",
     "problog": "ProbLog",
     "pysdd": "PySDD",
+    "pyganak": "Ganak",
 }
+#: Methods whose marginals are estimates: scored against exact, never flagged.
+APPROXIMATE: frozenset[str] = frozenset({"approx"})
+#: Below this acceptance rate the approx row warns that its chains barely moved.
+STUCK_ACCEPTANCE = 0.01
+#: Largest marginal difference an exact method may have from unstack exact.
+AGREE_TOLERANCE = 1e-9
 #: unstack's SAT enumeration refuses more boxes than this.
 SAT_MAX_BOXES = 6
+#: unstack's exact engine refuses more boxes than this unless ``--max-boxes`` raises it
+#: (``unstack.reasoner.marginals.EXACT_MAX_BOXES``).
+EXACT_MAX_BOXES = 8
 #: Repeat a call only while one call takes less than this (seconds).
 REPEAT_BELOW_SECONDS = 20.0
 
@@ -85,7 +128,7 @@ class Outcome:
     family: str
     n: int
     seed: int
-    status: str = "ok"  # ok | timeout | memory | error | skipped
+    status: str = "ok"  # ok | timeout | memory | underflow | error | skipped
     reason: str = ""
     first_seconds: float | None = None
     seconds: float | None = None
@@ -97,6 +140,8 @@ class Outcome:
     wall_seconds: float | None = None  # the whole subprocess, every repeat included
     max_rss_mib: float | None = None
     max_abs_diff: float | None = None
+    max_ec_error: float | None = None  # max_i |sum_j marginals[i, j] - sum_j exact[i, j]|
+    agrees: bool | None = None  # exact methods: max_abs_diff <= AGREE_TOLERANCE
     ratio: float | None = None
     wall_ratio: float | None = None
     details: dict[str, Any] = field(default_factory=dict)
@@ -115,6 +160,23 @@ def run_unstack(method: str, probabilities: np.ndarray, max_boxes: int | None) -
     supports = unstack.Supports(box_ids(len(probabilities)), probabilities)
     decision = unstack.decide(supports, method=method, max_boxes=max_boxes)
     return decision.marginals, {}, {"consistent_worlds": decision.consistent_worlds, "choice": decision.choice}
+
+
+def run_approx(probabilities: np.ndarray, seconds: float) -> CallResult:
+    from unstack.reasoner.decision import decide
+    from unstack.supports import Supports
+
+    supports = Supports(box_ids(len(probabilities)), probabilities)
+    decision = decide(supports, method="approx", time_limit=seconds, seed=0)
+    sampling = decision.sampling or {}
+    details: dict[str, Any] = {"choice": decision.choice, "component_methods": list(decision.component_methods)}
+    details |= {key: sampling.get(key) for key in ("chains", "samples", "burn_in", "acceptance")}
+    if decision.expected_cost_errors is not None:
+        details["max_ec_standard_error"] = float(np.max(decision.expected_cost_errors))
+    if decision.marginal_errors is not None:
+        details["max_marginal_standard_error"] = float(np.max(decision.marginal_errors))
+    timings = {"sample": float(sampling["seconds"])} if "seconds" in sampling else {}
+    return decision.marginals, timings, details
 
 
 def problog_program(probabilities: np.ndarray) -> str:
@@ -178,8 +240,59 @@ def run_pysdd(probabilities: np.ndarray, minimize: bool) -> CallResult:
     return marginals, timings, details
 
 
+class Underflow(ArithmeticError):
+    """A weighted count that float64 cannot hold (0, subnormal or infinite)."""
+
+
+def run_pyganak(probabilities: np.ndarray) -> CallResult:
+    from itertools import permutations
+
+    from pyganak import WeightedCounter
+
+    n = len(probabilities)
+    pairs = [(i, j) for i in range(n) for j in range(n) if i != j]
+    variable = {pair: k + 1 for k, pair in enumerate(pairs)}
+    clauses = [[-variable[x, y], -variable[y, z], variable[x, z]] for x, y, z in permutations(range(n), 3)]
+    weights: list[tuple[int, float]] = []
+    for (x, y), var in variable.items():
+        p = float(probabilities[x, y])
+        larger = max(p, 1.0 - p)  # rescale each pair: the likelier literal weighs 1
+        weights += [(var, p / larger), (-var, (1.0 - p) / larger)]
+
+    def count(unit: int | None = None) -> float:
+        counter = WeightedCounter()  # count() may be called once per counter
+        counter.add_clauses(clauses)
+        if unit is not None:
+            counter.add_clause([unit])
+        for literal, weight in weights:
+            counter.set_lit_weight(literal, weight)
+        return float(counter.count())
+
+    start = time.perf_counter()
+    total = count()
+    counted = time.perf_counter()
+    if not (math.isfinite(total) and total >= sys.float_info.min):
+        raise Underflow(f"Z = {total!r} (rescaled weights) is not a normal float64: the marginals would be garbage")
+    marginals = np.zeros((n, n))
+    for (x, y), var in variable.items():
+        # Z_xy >= 0 and Z normal: a subnormal Z_xy costs at most 5e-324 / Z absolute error
+        marginals[x, y] = count(var) / total
+    done = time.perf_counter()
+    timings = {"Z": counted - start, f"{len(pairs)} x Z_xy": done - counted}
+    details = {"counts": len(pairs) + 1, "clauses": len(clauses), "z_rescaled": total}
+    return marginals, timings, details
+
+
 def worker(
-    method: str, family: str, n: int, seed: int, max_boxes: int | None, sdd_minimize: bool, repeat: int, budget: float
+    method: str,
+    family: str,
+    n: int,
+    seed: int,
+    max_boxes: int | None,
+    sdd_minimize: bool,
+    repeat: int,
+    budget: float,
+    approx_seconds: float = 1.0,
 ) -> Outcome:
     """Time ``method`` on one instance inside this process (the child)."""
     outcome = Outcome(method, family, n, seed)
@@ -192,6 +305,12 @@ def worker(
         name = "sat" if method == "sat" else "exact"
         call = lambda: run_unstack(name, probabilities, max_boxes)  # noqa: E731
         outcome.details["unstack"] = unstack.__version__
+    elif method == "approx":
+        import unstack
+
+        call = lambda: run_approx(probabilities, approx_seconds)  # noqa: E731
+        outcome.details["unstack"] = unstack.__version__
+        outcome.details["time_limit"] = approx_seconds
     elif method == "problog":
         import problog
 
@@ -204,6 +323,11 @@ def worker(
 
         call = lambda: run_pysdd(probabilities, sdd_minimize)  # noqa: E731
         outcome.details["pysdd"] = version("PySDD")
+    elif method == "pyganak":
+        import pyganak
+
+        call = lambda: run_pyganak(probabilities)  # noqa: E731
+        outcome.details["pyganak"] = pyganak.__version__
     else:
         raise ValueError(f"unknown method {method!r}")
     outcome.import_seconds = time.perf_counter() - start
@@ -236,19 +360,30 @@ def worker(
 def worker_main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(prog="peers.py --worker")
     parser.add_argument("--worker", required=True, choices=METHODS)
-    parser.add_argument("--family", required=True, choices=FAMILIES)
+    parser.add_argument("--family", required=True, choices=ALL_FAMILIES)
     parser.add_argument("--n", type=int, required=True)
     parser.add_argument("--seed", type=int, required=True)
     parser.add_argument("--max-boxes", type=int, default=None)
     parser.add_argument("--sdd-minimize", action="store_true")
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--budget", type=float, default=60.0)
+    parser.add_argument("--approx-seconds", type=float, default=1.0)
     parser.add_argument("--out", type=Path, required=True)
     args = parser.parse_args(argv)
     try:
         outcome = worker(
-            args.worker, args.family, args.n, args.seed, args.max_boxes, args.sdd_minimize, args.repeat, args.budget
+            args.worker,
+            args.family,
+            args.n,
+            args.seed,
+            args.max_boxes,
+            args.sdd_minimize,
+            args.repeat,
+            args.budget,
+            args.approx_seconds,
         )
+    except Underflow as error:
+        outcome = Outcome(args.worker, args.family, args.n, args.seed, status="underflow", reason=str(error))
     except MemoryError:
         outcome = Outcome(args.worker, args.family, args.n, args.seed, status="memory", reason="MemoryError")
     except ImportError as error:
@@ -277,7 +412,7 @@ def run_child(method: str, family: str, n: int, seed: int, args: argparse.Namesp
     out = out_dir / f"{method}-{family}-{n}.json"
     command = [sys.executable, str(Path(__file__).resolve()), "--worker", method, "--family", family]
     command += ["--n", str(n), "--seed", str(seed), "--repeat", str(args.repeat), "--out", str(out)]
-    command += ["--budget", str(args.timeout / 2)]
+    command += ["--budget", str(args.timeout / 2), "--approx-seconds", str(args.approx_seconds)]
     if args.max_boxes is not None:
         command += ["--max-boxes", str(args.max_boxes)]
     if args.sdd_minimize:
@@ -335,14 +470,44 @@ def run_child(method: str, family: str, n: int, seed: int, args: argparse.Namesp
 
 
 def parse_sizes(text: str) -> list[int]:
-    sizes: list[int] = []
-    for part in text.split(","):
-        if "-" in part:
-            low, high = part.split("-")
-            sizes.extend(range(int(low), int(high) + 1))
-        else:
-            sizes.append(int(part))
-    return sizes
+    """Box counts from ``3-8,10,20,40``: ranges and single sizes, sorted, each once.
+
+    Examples
+    --------
+    >>> parse_sizes("10,3-5, 4,40")
+    [3, 4, 5, 10, 40]
+    """
+    sizes: set[int] = set()
+    for part in (piece.strip() for piece in text.split(",")):
+        if not part:
+            continue
+        try:
+            if "-" in part:
+                low, high = (int(bound) for bound in part.split("-"))
+                if low > high:
+                    raise ValueError
+                sizes.update(range(low, high + 1))
+            else:
+                sizes.add(int(part))
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"bad size {part!r}: expected N or LOW-HIGH, e.g. 3-8,10,20") from None
+    if not sizes or min(sizes) < 2:
+        raise argparse.ArgumentTypeError(f"sizes {text!r}: need at least one size, each at least 2")
+    return sorted(sizes)
+
+
+def static_skip(method: str, family: str, n: int, seed: int, max_boxes: int | None) -> str | None:
+    """Why ``method`` cannot run this instance at all (without trying), or None."""
+    if method == "sat" and n > SAT_MAX_BOXES:
+        return f"unstack sat refuses n > {SAT_MAX_BOXES}"
+    limit = max_boxes or EXACT_MAX_BOXES
+    if method in ("exact", "exact-1t") and n > limit:
+        return f"unstack exact refuses n > {limit} (--max-boxes raises it)"
+    try:
+        instance(family, n, seed)
+    except ValueError as error:
+        return str(error)
+    return None
 
 
 def compare(outcomes: list[Outcome]) -> None:
@@ -353,7 +518,11 @@ def compare(outcomes: list[Outcome]) -> None:
         if exact is None or outcome.status != "ok":
             continue
         if outcome.marginals is not None and exact.marginals is not None:
-            outcome.max_abs_diff = float(np.max(np.abs(np.array(outcome.marginals) - np.array(exact.marginals))))
+            mine, theirs = np.array(outcome.marginals), np.array(exact.marginals)
+            outcome.max_abs_diff = float(np.max(np.abs(mine - theirs)))
+            outcome.max_ec_error = float(np.max(np.abs(mine.sum(axis=1) - theirs.sum(axis=1))))
+            if outcome.method not in APPROXIMATE:
+                outcome.agrees = outcome.max_abs_diff <= AGREE_TOLERANCE
         if outcome.seconds and exact.seconds:
             outcome.ratio = outcome.seconds / exact.seconds
         if outcome.end_to_end_seconds and exact.end_to_end_seconds:
@@ -387,6 +556,7 @@ COLUMNS = (
     "phases",
     "peak RSS",
     "max abs diff",
+    "max EC err",
     "status",
 )
 
@@ -395,9 +565,22 @@ def row(outcome: Outcome) -> list[str]:
     ok = outcome.status == "ok"
     split = " + ".join(f"{name} {seconds_text(value)}" for name, value in outcome.phases.items()) if ok else ""
     diff = "" if outcome.max_abs_diff is None else f"{outcome.max_abs_diff:.1e}"
+    ec_error = "" if outcome.max_ec_error is None else f"{outcome.max_ec_error:.1e}"
     if outcome.method == "exact" and ok:
-        diff = "(reference)"
+        diff = ec_error = "(reference)"
     status = "ok" if ok else f"{outcome.status}: {outcome.reason}"
+    if outcome.agrees is False:
+        status = f"DISAGREES (> {AGREE_TOLERANCE:g})"
+    elif outcome.method in APPROXIMATE and ok:
+        status = "ok (estimate)"
+        standard_error = outcome.details.get("max_ec_standard_error")
+        if standard_error is not None:
+            ec_error += f" (se {standard_error:.1e})" if ec_error else f"se {standard_error:.1e}"
+        acceptance = outcome.details.get("acceptance")
+        if acceptance:
+            status += f", acceptance {min(acceptance):.2f}"
+            if min(acceptance) < STUCK_ACCEPTANCE:
+                status += " -- chains barely moved: errors unreliable"
     return [
         str(outcome.n),
         LABELS[outcome.method],
@@ -409,8 +592,47 @@ def row(outcome: Outcome) -> list[str]:
         split,
         "" if outcome.max_rss_mib is None else f"{outcome.max_rss_mib:.0f} MiB",
         diff,
+        ec_error,
         status,
     ]
+
+
+def largest_within(outcomes: list[Outcome], timeout: float) -> dict[str, dict[str, dict[str, Any]]]:
+    """Per family and method: the largest ``n`` that answered, and what stopped it."""
+    summary: dict[str, dict[str, dict[str, Any]]] = {}
+    for family in dict.fromkeys(o.family for o in outcomes):
+        summary[family] = {}
+        for method in dict.fromkeys(o.method for o in outcomes if o.family == family):
+            mine = sorted((o for o in outcomes if o.family == family and o.method == method), key=lambda o: o.n)
+            answered = [o.n for o in mine if o.status == "ok"]
+            largest = max(answered) if answered else None
+            stopped = next(
+                (o for o in mine if o.status != "ok" and (largest is None or o.n > largest)),
+                None,
+            )
+            entry: dict[str, Any] = {"largest_n": largest, "timeout": timeout}
+            if stopped is not None:
+                entry["stopped_at"] = stopped.n
+                entry["stopped_by"] = f"{stopped.status}: {stopped.reason}"
+            disagreeing = [o.n for o in mine if o.agrees is False]
+            if disagreeing:
+                entry["disagrees_at"] = disagreeing
+            summary[family][method] = entry
+    return summary
+
+
+def summary_lines(summary: dict[str, dict[str, dict[str, Any]]]) -> list[str]:
+    lines = []
+    for family, methods in summary.items():
+        for method, entry in methods.items():
+            largest = "none" if entry["largest_n"] is None else str(entry["largest_n"])
+            text = f"{family:<10} {LABELS[method]:<15} largest n within the {entry['timeout']:g} s timeout: {largest}"
+            if "stopped_at" in entry:
+                text += f" (n={entry['stopped_at']}: {entry['stopped_by']})"
+            if "disagrees_at" in entry:
+                text += f"; DISAGREES with exact at n={entry['disagrees_at']}"
+            lines.append(text)
+    return lines
 
 
 def print_table(outcomes: list[Outcome], title: str) -> None:
@@ -464,8 +686,12 @@ def main(argv: list[str] | None = None) -> int:
     if "--worker" in argv:
         return worker_main(argv)
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0] if __doc__ else None)
-    parser.add_argument("--sizes", default="3-7", help="box counts, e.g. 3-7 or 3,5,8 (default 3-7)")
-    parser.add_argument("--families", default=",".join(FAMILIES), help="comma-separated: dense,sparse")
+    parser.add_argument(
+        "--sizes", type=parse_sizes, default="3-7", help="box counts, e.g. 3-7 or 3-8,10,20,40 (default 3-7)"
+    )
+    parser.add_argument(
+        "--families", default=",".join(ALL_FAMILIES), help=f"comma-separated subset of {','.join(ALL_FAMILIES)}"
+    )
     parser.add_argument("--methods", default=",".join(METHODS), help=f"comma-separated subset of {','.join(METHODS)}")
     parser.add_argument("--seed", type=int, default=0, help="instance seed (default 0)")
     parser.add_argument("--timeout", type=float, default=120.0, help="seconds per subprocess (default 120)")
@@ -473,14 +699,17 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeat", type=int, default=3, help="repeats after the first call (while < 20 s each)")
     parser.add_argument("--max-boxes", type=int, default=None, help="raise unstack exact's size limit (e.g. 9)")
     parser.add_argument("--sdd-minimize", action="store_true", help="PySDD: dynamic vtree minimization on")
+    parser.add_argument(
+        "--approx-seconds", type=float, default=1.0, help="approx: sampling time limit per call (default 1)"
+    )
     parser.add_argument("--json", type=Path, default=None, help="write every outcome (with marginals) here")
     parser.add_argument("--markdown", type=Path, default=None, help="write the tables as Markdown here")
     args = parser.parse_args(argv)
-    sizes = parse_sizes(args.sizes)
-    families = [f for f in args.families.split(",") if f]
-    methods = [m for m in args.methods.split(",") if m]
+    sizes: list[int] = args.sizes
+    families = [f.strip() for f in args.families.split(",") if f.strip()]
+    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     for name in families:
-        if name not in FAMILIES:
+        if name not in ALL_FAMILIES:
             parser.error(f"unknown family {name!r}")
     for name in methods:
         if name not in METHODS:
@@ -490,26 +719,49 @@ def main(argv: list[str] | None = None) -> int:
     outcomes: list[Outcome] = []
     with tempfile.TemporaryDirectory(prefix="unstack-peers-") as tmp:
         for family in families:
+            # an exact method that timed out (or ran out of memory) at n skips every larger n
+            stopped: dict[str, Outcome] = {}
             for n in sizes:
                 for method in methods:
-                    if method == "sat" and n > SAT_MAX_BOXES:
-                        outcome = Outcome(method, family, n, args.seed, status="skipped")
-                        outcome.reason = f"unstack sat refuses n > {SAT_MAX_BOXES}"
+                    reason = static_skip(method, family, n, args.seed, args.max_boxes)
+                    if reason is None and method in stopped:
+                        first = stopped[method]
+                        reason = f"{first.status} at n={first.n}"
+                        if first.status == "error":
+                            reason = f"{first.reason} (n={first.n})"
+                    if reason is not None:
+                        outcome = Outcome(method, family, n, args.seed, status="skipped", reason=reason)
                     else:
                         outcome = run_child(method, family, n, args.seed, args, Path(tmp))
+                        if outcome.status in ("timeout", "memory", "underflow") and method not in APPROXIMATE:
+                            stopped[method] = outcome
+                        elif outcome.status == "error" and outcome.reason.startswith("cannot import"):
+                            stopped[method] = outcome  # not installed: the same at every size
                     outcomes.append(outcome)
                     shown = seconds_text(outcome.seconds) if outcome.status == "ok" else outcome.reason
                     print(f"{family} n={n} {method}: {outcome.status} {shown}", file=sys.stderr, flush=True)
     compare(outcomes)
     print_table(outcomes, f"P(S_xy | consistent), seed {args.seed}")
+    summary = largest_within(outcomes, args.timeout)
+    lines = summary_lines(summary)
+    print("\n".join(lines))
+    disagreeing = [o for o in outcomes if o.agrees is False]
+    for outcome in disagreeing:
+        print(
+            f"DISAGREEMENT: {outcome.method} {outcome.family} n={outcome.n}: max abs diff "
+            f"{outcome.max_abs_diff:.2e} > {AGREE_TOLERANCE:g}",
+            file=sys.stderr,
+        )
     if args.json is not None:
-        report = {"arguments": vars(args) | {"json": str(args.json), "markdown": str(args.markdown)}}
+        arguments = vars(args) | {"json": str(args.json), "markdown": str(args.markdown)}
+        report: dict[str, Any] = {"arguments": arguments}
         report["machine"] = machine()
+        report["largest_n_within_timeout"] = summary
         report["outcomes"] = [asdict(o) for o in outcomes]
         args.json.write_text(json.dumps(report, indent=1))
     if args.markdown is not None:
-        args.markdown.write_text(markdown(outcomes))
-    return 0
+        args.markdown.write_text(markdown(outcomes) + "\n" + "\n".join(f"- {line}" for line in lines) + "\n")
+    return 1 if disagreeing else 0
 
 
 if __name__ == "__main__":
