@@ -64,6 +64,8 @@ def decision_view(decision: Decision) -> Group:
             f"group, seed {decision.sampling['seed']}; errors are standard errors (about 95 % of true values lie "
             "within 2 of them)"
         )
+        if "warning" in decision.sampling:
+            footer.append(f"\nwarning: {decision.sampling['warning']}", style="bold yellow")
     headline = Text.assemble(("Unload first: ", "bold"), (decision.choice, "bold green"))
     if decision.choice_probability < 1.0 or decision.sampling is not None:
         headline.append(f"  (P(truly the minimum EC) = {decision.choice_probability:.3f})")

@@ -299,8 +299,12 @@ def _reinsert(
     candidates_supported: np.ndarray,
     candidates_supporters: np.ndarray,
     log_ratios: np.ndarray,
+    scatter: bool,
 ) -> bool:
     """One ensemble move on the relations of box ``x``; True when the relations changed.
+
+    With ``scatter`` the first proposal is taken whatever its weight (if not 0): used once
+    to spread the chains' starting worlds, never while recording.
 
     Candidates: the current insertion and ``tries`` proposals; the next insertion is drawn
     among them with weights ``target / proposal`` (Barker's rule over an ensemble of
@@ -396,17 +400,53 @@ def _reinsert(
     for t in range(tries + 1):
         log_ratios[t] = np.exp(log_ratios[t] - largest)
         total += log_ratios[t]
-    u = _uniform(rng, chain) * total
     pick = tries
-    for t in range(tries + 1):
-        u -= log_ratios[t]
-        if u < 0.0:
-            pick = t
-            break
+    if scatter:
+        pick = 1 if log_ratios[1] > 0.0 else 0  # any proposal of non-zero weight
+    else:
+        u = _uniform(rng, chain) * total
+        for t in range(tries + 1):
+            u -= log_ratios[t]
+            if u < 0.0:
+                pick = t
+                break
     if pick == 0:
         return False
     _set_relations(x, n, candidates_supported[pick], candidates_supporters[pick], successors, predecessors)
     return True
+
+
+@njit(cache=True, nogil=True)
+def _flip_pairs(
+    probabilities: np.ndarray, successors: np.ndarray, predecessors: np.ndarray, rng: np.ndarray, chain: int
+) -> None:
+    """One Gibbs pass over the ordered pairs: a pair whose both values keep the world
+    transitive is redrawn with its own probability; the others keep their value.
+
+    Local moves like these keep the chain moving where every re-insertion proposal is far
+    less probable than the current state (dense matrices of 20 boxes and more).
+    """
+    n = probabilities.shape[0]
+    for i in range(n):
+        ibit = np.int64(1) << i
+        for j in range(n):
+            if i == j:
+                continue
+            jbit = np.int64(1) << j
+            if successors[i] & jbit:
+                free = (successors[i] & predecessors[j] & ~ibit & ~jbit) == 0
+            else:
+                free = (successors[j] & ~ibit & ~successors[i]) == 0 and (
+                    predecessors[i] & ~jbit & ~predecessors[j]
+                ) == 0
+            if not free:
+                continue
+            if _uniform(rng, chain) < probabilities[i, j]:
+                successors[i] |= jbit
+                predecessors[j] |= ibit
+            else:
+                successors[i] &= ~jbit
+                predecessors[j] &= ~ibit
 
 
 @njit(cache=True, nogil=True)
@@ -449,6 +489,7 @@ def _run_chain(
     tries: int,
     record: bool,
     sums: np.ndarray,
+    scatter: bool,
 ) -> int:
     """Run ``sweeps`` sweeps of one chain; add the estimates when ``record``."""
     n = probabilities.shape[0]
@@ -458,6 +499,7 @@ def _run_chain(
     log_ratios = np.empty(tries + 1)
     accepted = 0
     for _ in range(sweeps):
+        _flip_pairs(probabilities, successors, predecessors, rng, chain)
         for x in range(n):
             if _reinsert(
                 x,
@@ -473,6 +515,7 @@ def _run_chain(
                 candidates_supported,
                 candidates_supporters,
                 log_ratios,
+                scatter,
             ):
                 accepted += 1
         if record:
@@ -493,6 +536,7 @@ def run_chains(
     record: bool,
     sums: np.ndarray,
     accepted: np.ndarray,
+    scatter: bool = False,
 ) -> None:
     """Advance every chain by ``sweeps`` sweeps (chains run in parallel).
 
@@ -500,7 +544,8 @@ def run_chains(
 
     ``successors``/``predecessors``: ``(chains, n)`` bit masks, updated in place;
     ``rng``: ``(chains,)`` uint64 states; ``sums``: ``(chains, n, n)``, the conditionals
-    of every recorded sweep are added;
+    of every recorded sweep are added; ``scatter``: take every first proposal (to spread
+    the starting worlds of the chains);
     ``accepted``: ``(chains,)`` counts of moves that changed the state.
     """
     for c in prange(successors.shape[0]):
@@ -516,4 +561,5 @@ def run_chains(
             tries,
             record,
             sums[c],
+            scatter,
         )

@@ -59,6 +59,12 @@ AUTO_SAT_MAX_BOXES = 5
 #: With a time limit below this (seconds), ``auto`` samples groups of 8 boxes instead of
 #: counting them (exact n = 8 dense: 2.6 s on a quiet 2-core machine, 4.1 s loaded).
 AUTO_EXACT8_SECONDS = 10.0
+#: Seconds of a time limit kept for the work after sampling (costs, choice probability).
+DECISION_MARGIN = 0.03
+#: Seconds every sampled group gets even when the time limit is spent.
+MINIMUM_SAMPLING = 0.05
+#: Below this share of accepted re-insertions the decision warns that the errors may be too small.
+LOW_ACCEPTANCE = 0.05
 #: Relative tolerance under which two expected costs count as tied.
 TIE_TOLERANCE = 1e-12
 
@@ -235,20 +241,20 @@ def _group_marginals(
     return _GroupResult(exact.marginals, exact.consistent_worlds, exact_errors)
 
 
-def _sampling_budgets(
-    groups: list[np.ndarray], methods: list[str], time_limit: float | None, samples: int | None, seed: int | None
-) -> list[dict[str, Any]]:
-    """Arguments of the sampler for each group: the time split in proportion to group size."""
-    sampled = sum(len(group) for group, method in zip(groups, methods, strict=True) if method == "approx")
-    total_time = time_limit if time_limit is not None else (None if samples is not None else DEFAULT_TIME_LIMIT)
-    budgets = []
-    for number, (group, method) in enumerate(zip(groups, methods, strict=True)):
-        share = None if total_time is None or method != "approx" else total_time * len(group) / sampled
-        group_seed = None
-        if seed is not None:
-            group_seed = int(np.random.SeedSequence(seed, spawn_key=(number,)).generate_state(1)[0])
-        budgets.append({"samples": samples, "time_limit": share, "seed": group_seed})
-    return budgets
+def _group_seeds(count: int, seed: int | None) -> list[int | None]:
+    """An independent sampler seed per group (``SeedSequence(seed, spawn_key=(group,))``)."""
+    if seed is None:
+        return [None] * count
+    return [int(np.random.SeedSequence(seed, spawn_key=(k,)).generate_state(1)[0]) for k in range(count)]
+
+
+def _time_share(deadline: float | None, group: np.ndarray, waiting: int) -> float | None:
+    """Seconds for a sampled group: the time left, in proportion to its share of the boxes
+    still waiting to be sampled (``waiting`` includes this group)."""
+    if deadline is None:
+        return None
+    left = deadline - time.perf_counter() - DECISION_MARGIN
+    return max(left, MINIMUM_SAMPLING) * len(group) / waiting
 
 
 def _sampling_summary(results: list[_GroupResult], seed: int | None) -> dict[str, Any] | None:
@@ -256,7 +262,7 @@ def _sampling_summary(results: list[_GroupResult], seed: int | None) -> dict[str
     sampled = [result.sampled for result in results if result.sampled is not None]
     if not sampled:
         return None
-    return {
+    summary: dict[str, Any] = {
         "chains": sampled[0].chains,
         "samples": [result.samples for result in sampled],
         "burn_in": sampled[0].burn_in,
@@ -264,6 +270,13 @@ def _sampling_summary(results: list[_GroupResult], seed: int | None) -> dict[str
         "seed": seed,
         "seconds": round(sum(result.seconds for result in sampled), 6),
     }
+    slowest = min(result.acceptance for result in sampled)
+    if slowest < LOW_ACCEPTANCE:
+        summary["warning"] = (
+            f"re-insertion moves were accepted in only {100 * slowest:.1f} % of the tries: the chains mix slowly "
+            "and the standard errors may be too small; sample longer and compare seeds"
+        )
+    return summary
 
 
 def decide(
@@ -293,8 +306,8 @@ def decide(
     max_boxes : int, optional
         Override the exact methods' size limit.
     time_limit : float, optional
-        Seconds of sampling for the sampled groups together (default 1 s unless
-        ``samples`` is given).
+        Seconds for the whole decision: the sampled groups share what the exact ones leave
+        (default 1 s unless ``samples`` is given).
     samples : int, optional
         Recorded sweeps per sampled group (reproducible for a ``seed``).
     seed : int, optional
@@ -317,15 +330,23 @@ def decide(
     evidence = propagate_evidence(supports.objects, supports.probabilities)
     groups = support_components(evidence.probabilities)
     methods = _group_methods(method, [len(group) for group in groups], n, time_limit)
-    budgets = _sampling_budgets(groups, methods, time_limit, samples, seed)
+    seeds = _group_seeds(len(groups), seed)
+    if time_limit is None and samples is None:
+        time_limit = DEFAULT_TIME_LIMIT
+    deadline = None if time_limit is None else start + time_limit
+    waiting = sum(len(group) for group, method in zip(groups, methods, strict=True) if method == "approx")
     marginals = np.zeros((n, n))
     marginal_errors = np.zeros((n, n))
     covariance = np.zeros((n, n))
     worlds: int | None = 1
     results = []
-    for group, group_method, budget in zip(groups, methods, budgets, strict=True):
+    for group, group_method, group_seed in zip(groups, methods, seeds, strict=True):
         if len(group) == 1:
             continue
+        budget: dict[str, Any] = {"samples": samples, "seed": group_seed, "time_limit": None}
+        if group_method == "approx":
+            budget["time_limit"] = _time_share(deadline, group, waiting)
+            waiting -= len(group)
         result = _group_marginals(supports, evidence, group, group_method, max_boxes, budget)
         results.append(result)
         block = np.ix_(group, group)
