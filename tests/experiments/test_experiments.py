@@ -66,6 +66,7 @@ def test_experiment_commands(small_dataset: Path, tmp_path: Path) -> None:
         (["table1", "--out", "{tmp}", "--max-n", "12"], "--max-n must be between 3 and 8, got 12"),
         (["decisions", "examples", "--out", "{tmp}"], "examples: expected a data set folder with config-NNNN.json"),
         (["decisions", "examples", "--out", "{tmp}", "--r", "1"], "expected --r >= 2 and --isets >= 1"),
+        (["unload", "examples", "--out", "{tmp}"], "examples: expected a data set folder with config-NNNN.json"),
     ],
 )
 def test_experiment_bad_input(arguments: list[str], message: str, tmp_path: Path) -> None:
@@ -106,3 +107,17 @@ def test_real7_command(small_dataset: Path, tmp_path: Path) -> None:
     assert result.returncode == 0, result.stderr
     assert "90.5 %" in result.stdout and "worst MSE(cost) over r" in result.stdout
     assert set(json.loads((tmp_path / "real7.json").read_text())["by_r"]) == {"3", "4", "5"}
+
+
+def test_unload_command_executes_every_order(small_dataset: Path, tmp_path: Path) -> None:
+    result = unstack("experiment", "unload", str(small_dataset), "--out", str(tmp_path), "--configs", "2",
+                     "--time-limit", "0.1")  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    document = json.loads((tmp_path / "unloading.json").read_text())
+    assert (tmp_path / "unloading.png").read_bytes()[:4] == b"\x89PNG"
+    assert document["configs"] == 2
+    for pile in document["piles"]:
+        orders = [run["order"] for run in pile["runs"].values()]
+        assert all(sorted(order) == sorted(orders[0]) and len(order) == pile["detected"] for order in orders)
+        for run in pile["runs"].values():
+            assert run["boxes_moved"] == sum(len(step["moved"]) for step in run["steps"])

@@ -172,3 +172,49 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
     click.echo(
         f"worst MSE(cost) over r: unstack {worst['reasoner']:.3f}, random {worst['random']:.3f} (paper 0.5 vs 3.5)"
     )
+
+
+@experiment.command()
+@click.argument("data_dir", type=click.Path(file_okay=False))
+@click.option("--out", required=True, type=click.Path(), help="Folder for unloading.json and unloading.png.")
+@click.option("--model", "model_path", default=None, help="Model file (default: the one shipped).")
+@click.option("--configs", type=click.IntRange(min=1), default=4, show_default=True, help="Piles (the first N).")
+@click.option("--time-limit", type=click.FloatRange(min=0.0, min_open=True), default=0.3, show_default=True,
+              help="Seconds per decision of the plan (large groups are sampled).")  # fmt: skip
+@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the sampler and the random order.")
+def unload(data_dir: str, out: str, model_path: str | None, configs: int, time_limit: float, seed: int) -> None:
+    """Order every detected box of each pile and execute the orders in the simulator, box by box."""
+    from unstack.cli.learning import load_support_model
+    from unstack.experiments.unloading import UNLOADING_MAKERS, plot_unloading, unloading_experiment
+    from unstack.sim.dataset import require_configurations
+
+    require_configurations(data_dir)
+    model, name = load_support_model(model_path)
+    folder = _out(out)
+    with progress_bar("piles") as report:
+        result = unloading_experiment(
+            data_dir, model, configs=configs, time_limit=time_limit, seed=seed, progress=report
+        )
+    result["model"] = name
+    _write_json(folder / "unloading.json", result)
+    plot_unloading(result, folder / "unloading.png")
+    table = Table(title=f"Unloading every detected box of {result['configs']} piles ({data_dir}) in the simulator")
+    for column in (
+        "decision maker",
+        "boxes moved > 2 cm per pile",
+        "per pick",
+        "picks moving nothing",
+        "displacement (m)",
+    ):
+        table.add_column(column, justify="right")
+    for maker in UNLOADING_MAKERS:
+        row = result["summary"][maker]
+        table.add_row(
+            maker,
+            f"{row['boxes_moved_per_pile']:.2f}",
+            f"{row['boxes_moved_per_pick']:.3f}",
+            f"{100 * row['calm_picks']:.1f} %",
+            f"{row['displacement_m_per_pile']:.3f}",
+        )
+    Console().print(table)
+    click.echo(f"results in {folder / 'unloading.json'} and {folder / 'unloading.png'}")

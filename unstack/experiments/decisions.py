@@ -68,7 +68,7 @@ class _Iset:
     average_entropy: float
 
 
-def _free_pick(boxes: list[Any]) -> int:
+def free_pick(boxes: list[Any]) -> int:
     from unstack.learning.features import bounding_boxes
 
     bounds = bounding_boxes(boxes)
@@ -109,7 +109,7 @@ def _iset_result(scene: Any, ids: list[str], model: Any) -> _Iset:
         "reasoner": ids.index(decide(supports).choice),
         "priors": ids.index(choose(tuple(ids), priors_costs)[0]),
         "highest": int(np.argmax([box.position[2] for box in boxes])),
-        "free": _free_pick(boxes),
+        "free": free_pick(boxes),
     }
     removal = scene.metadata.get("simulation", {}).get("removal", {})
     displacement = np.asarray(removal.get("displacement_m", np.zeros((len(scene.boxes),) * 2)))

@@ -55,7 +55,7 @@ class RemovalResponse:
     simulated_seconds: float
 
 
-def _run_horizon(world: PhysicsWorld, settings: GroundTruthSettings, watched: list[int]) -> float:
+def run_horizon(world: PhysicsWorld, settings: GroundTruthSettings, watched: list[int]) -> float:
     """Step for the horizon, leaving early once every watched box is slow."""
     time_step = world.settings.pile.time_step
     steps = max(1, round(settings.horizon / time_step))
@@ -81,7 +81,7 @@ def removal_responses(world: PhysicsWorld, settings: GroundTruthSettings) -> Rem
     start_positions, start_orientations = world.poses(bodies)
     displacement = np.zeros((n, n))
     rotation = np.zeros((n, n))
-    simulated = _run_horizon(world, settings, bodies)
+    simulated = run_horizon(world, settings, bodies)
     positions, orientations = world.poses(bodies)
     baseline_displacement = float(np.max(np.linalg.norm(positions - start_positions, axis=1), initial=0.0))
     baseline_rotation = float(np.max(rotation_angles_deg(start_orientations, orientations), initial=0.0))
@@ -91,7 +91,7 @@ def removal_responses(world: PhysicsWorld, settings: GroundTruthSettings) -> Rem
         client.resetBasePositionAndOrientation(body, parking.tolist(), [0.0, 0.0, 0.0, 1.0])
         client.resetBaseVelocity(body, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
         others = bodies[:x] + bodies[x + 1 :]
-        simulated += _run_horizon(world, settings, others)
+        simulated += run_horizon(world, settings, others)
         positions, orientations = world.poses(bodies)
         moved = np.linalg.norm(positions - start_positions, axis=1)
         turned = rotation_angles_deg(start_orientations, orientations)

@@ -1,0 +1,44 @@
+"""Executing unloading orders in the simulator."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from unstack.errors import UnstackError
+from unstack.scene import Scene, load_scene
+from unstack.sim.dataset import list_configurations
+from unstack.sim.unloading import execute_unloading
+
+
+@pytest.fixture
+def pile(small_dataset: Path) -> Scene:
+    return load_scene(list_configurations(small_dataset)[0])
+
+
+def test_top_down_disturbs_less_than_bottom_up(pile: Scene) -> None:
+    by_height = sorted(pile.box_ids, key=lambda box_id: -pile.box(box_id).position[2])
+    top_down = execute_unloading(pile, by_height)
+    bottom_up = execute_unloading(pile, by_height[::-1])
+    assert [step.box for step in top_down.steps] == by_height
+    assert top_down.resettle_drift_m < 0.01
+    assert top_down.boxes_moved < bottom_up.boxes_moved
+    assert bottom_up.steps[0].boxes_moved > 0  # the lowest box holds others up
+    assert all(box not in step.moved for step in top_down.steps for box in by_height[: by_height.index(step.box) + 1])
+
+
+def test_repeating_an_order_repeats_the_measurement(pile: Scene) -> None:
+    order = list(pile.detected)
+    assert execute_unloading(pile, order).to_dict() == execute_unloading(pile, order).to_dict()
+
+
+@pytest.mark.parametrize("order", [["nope"], ["b00", "b00"]])
+def test_bad_orders_are_refused(pile: Scene, order: list[str]) -> None:
+    with pytest.raises(UnstackError, match="the order names unknown or repeated boxes"):
+        execute_unloading(pile, order)
+
+
+def test_a_scene_without_simulation_settings(repo: Path) -> None:
+    with pytest.raises(UnstackError, match=r"\$\.metadata\.settings: executing an order needs a simulated scene"):
+        execute_unloading(load_scene(repo / "examples" / "scene3.json"), [])
