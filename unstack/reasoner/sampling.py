@@ -68,9 +68,10 @@ DEFAULT_CHAINS = 8
 #: Seconds of sampling when neither ``samples`` nor ``time_limit`` is given.
 DEFAULT_TIME_LIMIT = 1.0
 #: Proposals per move. Measured on the classifier matrices of two 39-40-box piles (1 s,
-#: 4 seeds each, with the pair pass): mean worst EC error 0.030 / 0.030 / 0.039 with
-#: 1 / 2 / 4 proposals.
-DEFAULT_TRIES = 2
+#: 4 seeds each, 2 free cores, against 100 s reference runs): mean worst EC error 0.0198 /
+#: 0.0216 / 0.0275 with 1 / 2 / 3 proposals (worst 0.025 / 0.039 / 0.040); a second pass
+#: over the pairs per sweep made it worse (0.023).
+DEFAULT_TRIES = 1
 #: Sweeps per chain discarded before recording.
 DEFAULT_BURN_IN = 64
 #: Sweeps per chain in one round of the anytime loop (one call of the compiled kernel).
