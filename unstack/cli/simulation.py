@@ -38,6 +38,8 @@ def parse_box_range(text: str) -> tuple[int, int]:
 @click.option("--jobs", type=int, default=1, show_default=True, help="Worker processes on this machine.")
 @click.option("--scheduler", default=None, help="Address of a dask.distributed scheduler to run the tasks on.")
 @click.option("--depth", type=float, default=2.0, show_default=True, help="Container section depth along x (m).")
+@click.option("--width", type=float, default=2.35, show_default=True,
+              help="Container section width along y (m); narrower sections stack the boxes higher.")  # fmt: skip
 @click.option("--horizon", type=float, default=1.0, show_default=True, help="Seconds simulated after each removal.")
 @click.option("--noise/--no-noise", default=False, show_default=True, help="Kinect-like depth noise.")
 @click.option("--resolution", default="640x480", show_default=True, help="Sensor image size WIDTHxHEIGHT.")
@@ -53,6 +55,7 @@ def simulate(
     jobs: int,
     scheduler: str | None,
     depth: float,
+    width: float,
     horizon: float,
     noise: bool,
     resolution: str,
@@ -72,8 +75,10 @@ def simulate(
     match = re.fullmatch(r"(\d+)x(\d+)", resolution.strip())
     if not match or min(int(match.group(1)), int(match.group(2))) < 1:
         raise UnstackError(f"--resolution: expected WIDTHxHEIGHT in pixels (for example 640x480), got {resolution!r}")
-    if depth <= 0 or horizon <= 0:
-        raise UnstackError(f"--depth and --horizon must be positive, got {depth:g} and {horizon:g}")
+    if depth <= 0 or width <= 0 or horizon <= 0:
+        raise UnstackError(
+            f"--depth, --width and --horizon must be positive, got {depth:g}, {width:g} and {horizon:g}"
+        )
     if seed < 0:
         raise UnstackError(f"--seed must be a non-negative integer, got {seed}")
     sensor = replace(
@@ -82,7 +87,7 @@ def simulate(
     settings = SimulationSettings(
         boxes=parse_box_range(boxes),
         sizes=sizes,
-        container=Container(depth=depth),
+        container=Container(depth=depth, width=width),
         ground_truth=GroundTruthSettings(horizon=horizon),
         sensor=sensor,
     )
