@@ -50,24 +50,28 @@ def _uniform(rng: np.ndarray, chain: int) -> float:
 
 
 @njit(cache=True, nogil=True)
-def _decide_supported(
+def _decide_side(
     x: int,
     order: np.ndarray,
     log_present: np.ndarray,
     log_absent: np.ndarray,
     probabilities: np.ndarray,
-    successors: np.ndarray,
-    predecessors: np.ndarray,
-    supporters: np.int64,
+    forward: np.ndarray,
+    backward: np.ndarray,
+    other_side: np.int64,
     rng: np.ndarray,
     chain: int,
     replay: np.int64,
     replaying: bool,
 ) -> tuple[np.int64, float, float]:
-    """Decide ``A``, the boxes ``x`` supports, given ``B`` = ``supporters`` (0 when undecided).
+    """Decide the boxes that ``x`` supports, given the boxes ``other_side`` that support it
+    (0 when undecided).
 
-    Returns ``(A, log proposal, log forced)``: the log probability of the free decisions
-    and the log factors of the forced ones (their sum is the log target of ``x``'s row).
+    Called with the transposed probability tables and ``forward``/``backward`` swapped, the
+    same walk decides the boxes that support ``x`` given those it supports. ``forward[k]``:
+    the boxes ``k`` supports; ``backward[k]``: the boxes supporting ``k``. Returns
+    ``(set, log proposal, log forced)``: the log probability of the free decisions and the log
+    factors of the forced ones (their sum is the log target of this side of ``x``).
     """
     inside = np.int64(0)
     outside = np.int64(0)
@@ -75,11 +79,11 @@ def _decide_supported(
     log_forced = 0.0
     for k in order:
         bit = np.int64(1) << k
-        allowed = (supporters & ~bit & ~predecessors[k]) == 0
-        if predecessors[k] & inside:
+        allowed = (other_side & ~bit & ~backward[k]) == 0
+        if backward[k] & inside:
             inside |= bit
             log_forced += log_present[x, k]
-        elif (not allowed) or (successors[k] & outside):
+        elif (not allowed) or (forward[k] & outside):
             outside |= bit
             log_forced += log_absent[x, k]
         else:
@@ -90,46 +94,6 @@ def _decide_supported(
             else:
                 outside |= bit
                 log_proposal += log_absent[x, k]
-    return inside, log_proposal, log_forced
-
-
-@njit(cache=True, nogil=True)
-def _decide_supporters(
-    x: int,
-    order: np.ndarray,
-    log_present: np.ndarray,
-    log_absent: np.ndarray,
-    probabilities: np.ndarray,
-    successors: np.ndarray,
-    predecessors: np.ndarray,
-    supported: np.int64,
-    rng: np.ndarray,
-    chain: int,
-    replay: np.int64,
-    replaying: bool,
-) -> tuple[np.int64, float, float]:
-    """Decide ``B``, the boxes supporting ``x``, given ``A`` = ``supported`` (0 when undecided)."""
-    inside = np.int64(0)
-    outside = np.int64(0)
-    log_proposal = 0.0
-    log_forced = 0.0
-    for k in order:
-        bit = np.int64(1) << k
-        allowed = (supported & ~bit & ~successors[k]) == 0
-        if successors[k] & inside:
-            inside |= bit
-            log_forced += log_present[k, x]
-        elif (not allowed) or (predecessors[k] & outside):
-            outside |= bit
-            log_forced += log_absent[k, x]
-        else:
-            member = (replay & bit) != 0 if replaying else _uniform(rng, chain) < probabilities[k, x]
-            if member:
-                inside |= bit
-                log_proposal += log_present[k, x]
-            else:
-                outside |= bit
-                log_proposal += log_absent[k, x]
     return inside, log_proposal, log_forced
 
 
@@ -156,22 +120,24 @@ def _insertion(
     of ``x`` itself in ``successors``/``predecessors`` are never read: every mask they meet
     excludes ``x``.
     """
+    # the supporters of x are the boxes x supports in the transposed relation
+    p_t, present_t, absent_t = probabilities.T, log_present.T, log_absent.T
     if supporters_first:
-        supporters, log_q1, log_f1 = _decide_supporters(
+        supporters, log_q1, log_f1 = _decide_side(
             x,
             order,
-            log_present,
-            log_absent,
-            probabilities,
-            successors,
+            present_t,
+            absent_t,
+            p_t,
             predecessors,
+            successors,
             np.int64(0),
             rng,
             chain,
             replay_supporters,
             replaying,
         )
-        supported, log_q2, log_f2 = _decide_supported(
+        supported, log_q2, log_f2 = _decide_side(
             x,
             order,
             log_present,
@@ -186,7 +152,7 @@ def _insertion(
             replaying,
         )
     else:
-        supported, log_q1, log_f1 = _decide_supported(
+        supported, log_q1, log_f1 = _decide_side(
             x,
             order,
             log_present,
@@ -200,14 +166,14 @@ def _insertion(
             replay_supported,
             replaying,
         )
-        supporters, log_q2, log_f2 = _decide_supporters(
+        supporters, log_q2, log_f2 = _decide_side(
             x,
             order,
-            log_present,
-            log_absent,
-            probabilities,
-            successors,
+            present_t,
+            absent_t,
+            p_t,
             predecessors,
+            successors,
             supported,
             rng,
             chain,
