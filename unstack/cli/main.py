@@ -196,10 +196,13 @@ def plan(file: str, as_json: bool, output: str | None, model_path: str | None, *
 
     def view() -> Table:
         table = Table(title="Unloading plan (each step decided on the boxes still in place)", title_justify="left")
-        for column in ("step", "unload", "EC", "boxes in place"):
+        sampled = any(step.decision.sampling is not None for step in result.steps)
+        columns = ("step", "unload", "EC", *(("± s.e.", "P(minimum)") if sampled else ()), "boxes in place")
+        for column in columns:
             table.add_column(column, justify="right" if column != "unload" else "left")
         for number, step in enumerate(result.steps, start=1):
-            table.add_row(str(number), step.choice, f"{step.expected_cost:.4f}", str(len(step.remaining)))
+            errors = (f"{step.expected_cost_error:.4f}", f"{step.decision.choice_probability:.3f}") if sampled else ()
+            table.add_row(str(number), step.choice, f"{step.expected_cost:.4f}", *errors, str(len(step.remaining)))
         return table
 
     _emit(as_json, document, view)
