@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import networkx as nx
 import numpy as np
 import pytest
@@ -111,3 +113,22 @@ def test_bad_arguments_are_refused(rng: np.random.Generator) -> None:
         sampled_marginals(np.zeros((64, 64)), samples=10)
     with pytest.raises(UnstackError, match="chains, tries and samples must be at least 1"):
         sampled_marginals(np.zeros((3, 3)), samples=0)
+
+
+def test_convergence_is_near_one_when_chains_agree(rng: np.random.Generator) -> None:
+    p = random_probabilities(rng, 5, "dense")
+    result = sampled_marginals(p, samples=16_000, seed=0)
+    rhat = result.convergence_of(np.ones(5))
+    assert rhat.shape == (5,) and np.all(rhat < 1.05)
+
+
+def test_a_short_run_on_a_real_pile_warns_that_chains_disagree(repo: Path) -> None:
+    from unstack.reasoner.decision import decide
+    from unstack.supports import load_supports
+
+    supports = load_supports(repo / "examples" / "pile31.supports.json")
+    short = decide(supports, samples=500, seed=0)
+    assert short.sampling is not None and short.sampling["rhat_max"] > 1.1
+    assert "the chains disagree" in short.sampling["warning"]
+    longer = decide(supports, samples=8_000, seed=0)
+    assert longer.sampling is not None and "warning" not in longer.sampling

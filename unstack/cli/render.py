@@ -61,8 +61,8 @@ def decision_view(decision: Decision) -> Group:
     if decision.sampling is not None:
         footer.append(
             f"\nsampled: {sum(decision.sampling['samples']):,} sweeps in {decision.sampling['chains']} chains per "
-            f"group, seed {decision.sampling['seed']}; errors are standard errors (about 95 % of true values lie "
-            "within 2 of them)"
+            f"group, seed {decision.sampling['seed']}, largest R-hat {decision.sampling['rhat_max']}; errors are "
+            "standard errors (about 95 % of true values lie within 2 of them)"
         )
         if "warning" in decision.sampling:
             footer.append(f"\nwarning: {decision.sampling['warning']}", style="bold yellow")

@@ -76,9 +76,7 @@ def simulate(
     if not match or min(int(match.group(1)), int(match.group(2))) < 1:
         raise UnstackError(f"--resolution: expected WIDTHxHEIGHT in pixels (for example 640x480), got {resolution!r}")
     if depth <= 0 or width <= 0 or horizon <= 0:
-        raise UnstackError(
-            f"--depth, --width and --horizon must be positive, got {depth:g}, {width:g} and {horizon:g}"
-        )
+        raise UnstackError(f"--depth, --width and --horizon must be positive, got {depth:g}, {width:g} and {horizon:g}")
     if seed < 0:
         raise UnstackError(f"--seed must be a non-negative integer, got {seed}")
     sensor = replace(

@@ -65,6 +65,8 @@ DECISION_MARGIN = 0.03
 MINIMUM_SAMPLING = 0.05
 #: Below this share of accepted re-insertions the decision warns that the errors may be too small.
 LOW_ACCEPTANCE = 0.05
+#: Above this Gelman-Rubin R-hat of any sampled EC the decision warns that the chains disagree.
+HIGH_RHAT = 1.1
 #: Relative tolerance under which two expected costs count as tied.
 TIE_TOLERANCE = 1e-12
 
@@ -271,10 +273,17 @@ def _sampling_summary(results: list[_GroupResult], seed: int | None) -> dict[str
         "seconds": round(sum(result.seconds for result in sampled), 6),
     }
     slowest = min(result.acceptance for result in sampled)
+    worst_rhat = max(float(np.max(result.convergence_of(np.ones(result.marginals.shape[0])))) for result in sampled)
+    summary["rhat_max"] = round(worst_rhat, 4) if np.isfinite(worst_rhat) else None
     if slowest < LOW_ACCEPTANCE:
         summary["warning"] = (
             f"re-insertion moves were accepted in only {100 * slowest:.1f} % of the tries: the chains mix slowly "
             "and the standard errors may be too small; sample longer and compare seeds"
+        )
+    elif not worst_rhat <= HIGH_RHAT:
+        summary["warning"] = (
+            f"the chains disagree (R-hat of an EC {worst_rhat:.2f} > {HIGH_RHAT}): they have not mixed and the "
+            "standard errors are too small; sample longer"
         )
     return summary
 

@@ -134,6 +134,26 @@ class SampledMarginals:
         covariance = np.atleast_2d(np.cov(batch_values, rowvar=False)) * self.error_scale**2
         return values, covariance
 
+    def convergence_of(self, weights: np.ndarray) -> np.ndarray:
+        """Gelman-Rubin potential scale reduction (R-hat) of each ``marginals @ weights``.
+
+        Computed from the batch means grouped by chain: near 1 when the chains, started from
+        scattered worlds, agree as well as their own batches do; above about 1.1 they have
+        not mixed and the standard errors are too small.
+        """
+        n = self.marginals.shape[0]
+        values = (self.batch_marginals @ weights).reshape(self.chains, -1, n)
+        batches = values.shape[1]
+        if self.chains < 2 or batches < 2:
+            return np.ones(n)
+        within = values.var(axis=1, ddof=1).mean(axis=0)
+        between = batches * values.mean(axis=1).var(axis=0, ddof=1)
+        pooled = (batches - 1) / batches * within + between / batches
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.where(within > 0, pooled / within, np.where(between > 0, np.inf, 1.0))
+        result: np.ndarray = np.sqrt(ratio)
+        return result
+
 
 def _start_state(probabilities: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Bit masks of the transitive closure of the relations forced by probability 1."""
