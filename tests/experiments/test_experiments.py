@@ -76,15 +76,17 @@ def test_experiment_bad_input(arguments: list[str], message: str, tmp_path: Path
     assert not list(tmp_path.iterdir())
 
 
-def test_fig5a_on_simulated_piles(small_dataset: Path, tmp_path: Path) -> None:
+@pytest.mark.parametrize("split", ["pairs", "configuration"])
+def test_fig5a_on_simulated_piles(small_dataset: Path, tmp_path: Path, split: str) -> None:
     result = unstack("experiment", "fig5a", str(small_dataset), "--out", str(tmp_path), "--r", "4", "--isets", "3",
-                     "--cv", "3")  # fmt: skip
+                     "--cv", "3", "--split-by", split)  # fmt: skip
     assert result.returncode == 0, result.stderr
     assert "paper (Fig. 5a)" in result.stdout and "78.4 %" in result.stdout
     document = json.loads((tmp_path / "fig5a.json").read_text())
     matrix = np.array(document["validation"]["confusion_matrix"])
     assert matrix.sum() == document["validation"]["relations"]
     assert 0.0 < document["balanced_threshold"] <= 1.0
+    assert document["split_by"] == split
 
 
 def test_real7_scores_every_iset(small_dataset: Path) -> None:

@@ -89,3 +89,21 @@ def test_unknown_learner(rng: np.random.Generator) -> None:
     features, labels = separable(rng)
     with pytest.raises(ValueError, match="unknown learner 'forest'; expected one of svm, gradient_boosting"):
         SupportClassifier(learner="forest").fit(features, labels)
+
+
+def test_grouped_split_keeps_every_group_on_one_side(rng: np.random.Generator) -> None:
+    features, labels = separable(rng)
+    groups = np.arange(len(labels)) // 8  # 20 piles of 8 relations
+    model = SupportClassifier(cv=3, param_grid=SMALL_GRID, random_state=0).fit(features, labels, groups=groups)
+    train, valid = set(groups[model.train_indices_]), set(groups[model.validation_indices_])
+    assert model.grouped_ and train and valid and not train & valid
+    assert sorted(model.train_indices_.tolist() + model.validation_indices_.tolist()) == list(range(len(labels)))
+    assert model.validation_metrics_["relations"] == len(model.validation_indices_)
+    ungrouped = SupportClassifier(cv=3, param_grid=SMALL_GRID, random_state=0).fit(features, labels)
+    assert not ungrouped.grouped_ and len(ungrouped.validation_indices_) == 48
+
+
+def test_groups_must_match_the_rows(rng: np.random.Generator) -> None:
+    features, labels = separable(rng)
+    with pytest.raises(ValueError, match="groups has 3 labels for 160 rows"):
+        SupportClassifier(cv=3, param_grid=SMALL_GRID).fit(features, labels, groups=[0, 1, 2])

@@ -70,10 +70,14 @@ def table1(out: str, max_n: int) -> None:
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
 @click.option("--learner", type=click.Choice(["svm", "gradient_boosting", "calibrated_svm"]), default="svm",
               show_default=True, help="svm: the paper's RBF SVM with probabilities.")  # fmt: skip
+@click.option("--split-by", type=click.Choice(["pairs", "configuration"]), default="pairs", show_default=True,
+              help="pairs: the paper's split of the relations; configuration: whole piles on one side.")  # fmt: skip
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets, split and folds.")
 @click.option("--cv", type=int, default=10, show_default=True, help="Cross-validation folds.")
 @click.option("--jobs", type=int, default=1, show_default=True, help="Parallel processes.")
-def fig5a(data_dir: str, out: str, r: int, isets: int, draw: str, learner: str, seed: int, cv: int, jobs: int) -> None:
+def fig5a(
+    data_dir: str, out: str, r: int, isets: int, draw: str, learner: str, split_by: str, seed: int, cv: int, jobs: int
+) -> None:
     """Fig. 5a: the validation confusion matrix of the SVM on a simulated data set, beside the paper's."""
     from unstack.experiments.fig5a import fig5a as run
     from unstack.sim.dataset import require_configurations
@@ -81,7 +85,9 @@ def fig5a(data_dir: str, out: str, r: int, isets: int, draw: str, learner: str, 
     if r < 2 or isets < 1 or cv < 2 or jobs < 1:
         raise UnstackError("expected --r >= 2, --isets >= 1, --cv >= 2 and --jobs >= 1")
     require_configurations(data_dir)
-    result = run(data_dir, r=r, isets=isets, seed=seed, cv=cv, n_jobs=jobs, draw=draw, learner=learner)
+    result = run(
+        data_dir, r=r, isets=isets, seed=seed, cv=cv, n_jobs=jobs, draw=draw, learner=learner, split_by=split_by
+    )
     _write_json(_out(out) / "fig5a.json", result)
     table = Table(title=f"Fig. 5a: validation relations of {data_dir} ({result['relations']} relations, "
                   f"{result['supp']} SUPP)")  # fmt: skip

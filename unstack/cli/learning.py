@@ -90,6 +90,8 @@ def _examples(data_dir: str, r: int, isets: int, seed: int, jobs: int, settings:
 @click.option("--isets-from", "draw", type=click.Choice(["random", "neighbours"]), default="random",
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets, the split and the folds.")
+@click.option("--split-by", type=click.Choice(["pairs", "configuration"]), default="pairs", show_default=True,
+              help="pairs: the paper's split of the relations; configuration: whole piles on one side.")  # fmt: skip
 @click.option("--cv", type=int, default=10, show_default=True, help="Cross-validation folds on the training part.")
 @click.option("--validation-size", type=float, default=0.3, show_default=True, help="Share held out for validation.")
 @click.option("--offset", type=float, default=1.0, show_default=True, help="d: interest-point offset (m).")
@@ -104,6 +106,7 @@ def train(
     isets: int,
     draw: str,
     seed: int,
+    split_by: str,
     cv: int,
     validation_size: float,
     offset: float,
@@ -129,7 +132,7 @@ def train(
     )
     classifier = SupportClassifier(
         learner=learner, cv=cv, validation_size=validation_size, n_jobs=jobs, random_state=seed
-    ).fit(examples.features, examples.labels)
+    ).fit(examples.features, examples.labels, groups=examples.configuration if split_by == "configuration" else None)
     manifest = read_manifest(data_dir) or {}
     training = {
         "data": str(data_dir),
@@ -140,6 +143,7 @@ def train(
         "r": r,
         "isets_per_configuration": isets,
         "isets_from": draw,
+        "split_by": split_by,
         "relations": len(examples.labels),
         "supp": int(examples.labels.sum()),
         "validation_size": validation_size,

@@ -5,6 +5,11 @@ A scikit-learn estimator. ``fit`` holds out ``validation_size`` of the data (str
 cross-validation on the training part (10-fold, as the paper), refits the best model on
 the training part and scores it on the held-out part (``validation_metrics_``).
 
+With ``groups`` (for example the configuration each relation comes from), the hold-out
+and the folds keep every group on one side: relations of one pile never appear in both
+training and validation. Without them the split is by relation, as the paper describes it,
+and pairs of one pile land on both sides -- which flatters the validation figures.
+
 Learners (``learner=``):
 
 ``"svm"`` (the paper)
@@ -38,7 +43,13 @@ from typing import Any
 
 import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin
-from sklearn.model_selection import GridSearchCV, StratifiedKFold, train_test_split
+from sklearn.model_selection import (
+    GridSearchCV,
+    GroupShuffleSplit,
+    StratifiedGroupKFold,
+    StratifiedKFold,
+    train_test_split,
+)
 from sklearn.pipeline import Pipeline
 from sklearn.utils.multiclass import type_of_target, unique_labels
 from sklearn.utils.validation import check_is_fitted, validate_data
@@ -110,6 +121,10 @@ class SupportClassifier(ClassifierMixin, BaseEstimator):
         Mean cross-validated score of the best parameters.
     validation_metrics_ : dict
         :func:`unstack.learning.metrics.classification_report` on the held-out part.
+    train_indices_, validation_indices_ : numpy.ndarray
+        Rows of ``X`` in the training and the held-out part.
+    grouped_ : bool
+        Whether the split kept groups together.
     n_features_in_ : int
     """
 
@@ -137,8 +152,11 @@ class SupportClassifier(ClassifierMixin, BaseEstimator):
         tags.classifier_tags.multi_class = False  # SUPP or not
         return tags
 
-    def fit(self, X: Any, y: Any) -> SupportClassifier:
-        """Split, cross-validate the grid on the training part, refit, validate."""
+    def fit(self, X: Any, y: Any, groups: Any = None) -> SupportClassifier:
+        """Split, cross-validate the grid on the training part, refit, validate.
+
+        ``groups``: one label per row; the hold-out and the folds keep each group whole.
+        """
         from unstack.learning.metrics import classification_report
 
         X, y = validate_data(self, X, y)
@@ -150,25 +168,47 @@ class SupportClassifier(ClassifierMixin, BaseEstimator):
         self.classes_ = unique_labels(y)
         if len(self.classes_) < 2:
             raise ValueError(f"SupportClassifier needs both classes in y, got only 1 class: {self.classes_.tolist()}")
-        if self.validation_size > 0:
-            X_train, X_valid, y_train, y_valid = train_test_split(
-                X, y, test_size=self.validation_size, stratify=y, random_state=self.random_state
+        rows = np.arange(len(y))
+        group_labels = None if groups is None else np.asarray(groups)
+        if group_labels is not None and len(group_labels) != len(y):
+            raise ValueError(f"groups has {len(group_labels)} labels for {len(y)} rows")
+        if self.validation_size > 0 and group_labels is not None:
+            splitter = GroupShuffleSplit(n_splits=1, test_size=self.validation_size, random_state=self.random_state)
+            train_rows, valid_rows = next(splitter.split(X, y, group_labels))
+        elif self.validation_size > 0:
+            train_rows, valid_rows = train_test_split(
+                rows, test_size=self.validation_size, stratify=y, random_state=self.random_state
             )
         else:
-            X_train, y_train, X_valid, y_valid = X, y, X[:0], y[:0]
+            train_rows, valid_rows = rows, rows[:0]
+        self.train_indices_, self.validation_indices_ = np.sort(train_rows), np.sort(valid_rows)
+        self.grouped_ = group_labels is not None
+        X_train, y_train = X[self.train_indices_], y[self.train_indices_]
+        X_valid, y_valid = X[self.validation_indices_], y[self.validation_indices_]
+        if len(np.unique(y_train)) < 2:
+            raise ValueError("the training part holds one class only; use more groups or a smaller validation_size")
         smallest_class = int(np.min(np.unique(y_train, return_counts=True)[1]))
         folds = max(2, min(self.cv, smallest_class))
+        if group_labels is not None:
+            folds = max(2, min(folds, len(np.unique(group_labels[self.train_indices_]))))
         # the probability calibration runs inside each fold's training part: fewer folds for tiny data
         calibration_folds = max(2, min(5, smallest_class * (folds - 1) // folds))
         search = GridSearchCV(
             make_learner(self.learner, self.random_state, calibration_folds=calibration_folds),
             self.param_grid or default_grid(self.learner),
             scoring=self.scoring,
-            cv=StratifiedKFold(folds, shuffle=True, random_state=self.random_state),
+            cv=(
+                StratifiedKFold(folds, shuffle=True, random_state=self.random_state)
+                if group_labels is None
+                else StratifiedGroupKFold(folds, shuffle=True, random_state=self.random_state)
+            ),
             n_jobs=self.n_jobs,
             refit=True,
         )
-        search.fit(X_train, y_train)
+        if group_labels is None:
+            search.fit(X_train, y_train)
+        else:
+            search.fit(X_train, y_train, groups=group_labels[self.train_indices_])
         self.estimator_ = search.best_estimator_
         self.best_params_ = dict(search.best_params_)
         self.cv_score_ = float(search.best_score_)
