@@ -208,8 +208,14 @@ def test_plan_with_sampling(twelve_boxes: Path) -> None:
 
 @pytest.mark.parametrize(
     ("option", "message"),
-    [(["--samples", "0"], "--samples"), (["--time-limit", "0"], "--time-limit"), (["--method", "fast"], "--method")],
+    [
+        (["--samples", "0"], "--samples"),
+        (["--time-limit", "0"], "--time-limit"),
+        (["--method", "fast"], "--method"),
+        (["--seed", "-1"], "--seed"),
+    ],
 )
 def test_bad_sampling_options_exit_2(option: list[str], message: str) -> None:
     result = unstack("decide", PILE5, *option)
     assert result.returncode == 2 and message in result.stderr and "Traceback" not in result.stderr
+    assert result.stderr.startswith("unstack: error: unstack decide: ") and result.stderr.count("\n") == 1

@@ -113,6 +113,8 @@ def test_bad_arguments_are_refused(rng: np.random.Generator) -> None:
         sampled_marginals(np.zeros((64, 64)), samples=10)
     with pytest.raises(UnstackError, match="chains, tries and samples must be at least 1"):
         sampled_marginals(np.zeros((3, 3)), samples=0)
+    with pytest.raises(UnstackError, match="the seed must be a non-negative integer, got -2"):
+        sampled_marginals(np.zeros((3, 3)), samples=10, seed=-2)
 
 
 def test_convergence_is_near_one_when_chains_agree(rng: np.random.Generator) -> None:

@@ -187,7 +187,8 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
 @click.option("--configs", type=click.IntRange(min=1), default=4, show_default=True, help="Piles (the first N).")
 @click.option("--time-limit", type=click.FloatRange(min=0.0, min_open=True), default=0.3, show_default=True,
               help="Seconds per decision of the plan (large groups are sampled).")  # fmt: skip
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the sampler and the random order.")
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Seed of the sampler and the random order.")  # fmt: skip
 def unload(data_dir: str, out: str, model_path: str | None, configs: int, time_limit: float, seed: int) -> None:
     """Order every detected box of each pile and execute the orders in the simulator, box by box."""
     from unstack.cli.learning import load_support_model

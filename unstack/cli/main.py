@@ -99,7 +99,7 @@ def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
             default=None,
             help="Recorded sweeps per sampled group instead of a time limit (reproducible with --seed).",
         ),
-        click.option("--seed", type=int, default=None, help="Seed of the sampler."),
+        click.option("--seed", type=click.IntRange(min=0), default=None, help="Seed of the sampler."),
     ]
     for option in reversed(options):
         command = option(command)
@@ -256,7 +256,21 @@ def main() -> None:
     import warnings
 
     warnings.showwarning = _warning_line
-    cli(prog_name="unstack")
+    try:
+        status = cli.main(prog_name="unstack", standalone_mode=False)
+    except click.exceptions.NoArgsIsHelpError as error:  # bare "unstack": the help, as click shows it
+        click.echo(error.format_message(), err=True)
+        sys.exit(2)
+    except click.UsageError as error:  # a bad option or argument: one line, exit code 2
+        where = error.ctx.command_path if error.ctx is not None else "unstack"
+        _fail(f"{where}: {error.format_message()} (see {where} --help)")
+    except click.ClickException as error:
+        _fail(error.format_message())
+    except click.Abort:
+        click.echo("unstack: aborted", err=True)
+        sys.exit(1)
+    if isinstance(status, int) and status:
+        sys.exit(status)
 
 
 if __name__ == "__main__":

@@ -334,6 +334,8 @@ def decide(
         The scene is beyond the method's limit.
     """
     start = time.perf_counter()
+    if seed is not None and seed < 0:
+        raise UnstackError(f"the seed must be a non-negative integer, got {seed}")
     n = supports.n_objects
     weights = cost_weights(supports, cost)
     evidence = propagate_evidence(supports.objects, supports.probabilities)

@@ -233,6 +233,8 @@ def sampled_marginals(
         raise TooLarge(f"{n} linked boxes: the sampler holds at most {SAMPLING_MAX_BOXES} boxes per group")
     if chains < 1 or tries < 1 or burn_in < 0 or (samples is not None and samples < 1):
         raise UnstackError("chains, tries and samples must be at least 1 and burn_in at least 0")
+    if seed is not None and seed < 0:
+        raise UnstackError(f"the seed must be a non-negative integer, got {seed}")
     if samples is None and time_limit is None:
         time_limit = DEFAULT_TIME_LIMIT
     deadline = None if time_limit is None else start + time_limit
