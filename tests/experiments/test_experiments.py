@@ -54,6 +54,9 @@ def test_experiment_commands(small_dataset: Path, tmp_path: Path) -> None:
     result = unstack("experiment", "table1", "--out", str(tmp_path), "--max-n", "5")
     assert result.returncode == 0, result.stderr
     assert [row["exact"] for row in json.loads((tmp_path / "table1.json").read_text())] == [29, 355, 6942]
+    result = unstack("experiment", "table1", "--out", str(tmp_path), "--full")
+    assert result.returncode == 0, result.stderr
+    assert [row["n"] for row in json.loads((tmp_path / "table1.json").read_text())] == [3, 4, 5, 6, 7]
     result = unstack("experiment", "decisions", str(small_dataset), "--out", str(tmp_path), "--r", "4", "--isets", "6")
     assert result.returncode == 0, result.stderr
     assert (tmp_path / "fig4.png").read_bytes()[:4] == b"\x89PNG"
@@ -67,10 +70,11 @@ def test_experiment_commands(small_dataset: Path, tmp_path: Path) -> None:
         (["decisions", "examples", "--out", "{tmp}"], "examples: expected a data set folder with config-NNNN.json"),
         (["decisions", "examples", "--out", "{tmp}", "--r", "1"], "expected --r >= 2 and --isets >= 1"),
         (["unload", "examples", "--out", "{tmp}"], "examples: expected a data set folder with config-NNNN.json"),
+        (["fig5a", "{data}", "--out", "{tmp}", "--full"], "--full is the paper's size: 200 configurations and 10"),
     ],
 )
-def test_experiment_bad_input(arguments: list[str], message: str, tmp_path: Path) -> None:
-    result = unstack("experiment", *[argument.format(tmp=tmp_path) for argument in arguments])
+def test_experiment_bad_input(arguments: list[str], message: str, tmp_path: Path, small_dataset: Path) -> None:
+    result = unstack("experiment", *[argument.format(tmp=tmp_path, data=small_dataset) for argument in arguments])
     assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
     assert message in result.stderr
     assert not list(tmp_path.iterdir())

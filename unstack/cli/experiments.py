@@ -18,7 +18,16 @@ __all__ = ["experiment"]
 
 @click.group()
 def experiment() -> None:
-    """Reproduce the paper's tables and figures (results as JSON and PNG in --out)."""
+    """Reproduce the paper's tables and figures (results as JSON and PNG in --out).
+
+    Defaults are small (seconds to minutes); --full runs the paper's size. real7 always
+    scores every ISet of r = 3, 4, 5 of each pile, as the paper.
+    """
+
+
+#: The paper's sizes (§V): 200 simulated configurations for Fig. 5a, 493 test ISets for Fig. 4.
+PAPER_CONFIGURATIONS = 200
+PAPER_TEST_ISETS = 493
 
 
 def _out(out: str) -> Path:
@@ -38,9 +47,13 @@ def _write_json(path: Path, data: object) -> None:
 @experiment.command()
 @click.option("--out", required=True, type=click.Path(), help="Folder for table1.json.")
 @click.option("--max-n", type=int, default=6, show_default=True, help="Largest n (7 takes seconds, 8 minutes).")
-def table1(out: str, max_n: int) -> None:
+@click.option("--full", is_flag=True, help="The paper's size: n = 3..7 (overrides --max-n).")
+def table1(out: str, max_n: int, full: bool) -> None:
     """Table I: consistent worlds for n = 3..max-n by the exact engine and SAT, against the paper and OEIS."""
     from unstack.experiments.table1 import table1 as count
+
+    if full:
+        max_n = 7
 
     if not 3 <= max_n <= 8:
         raise UnstackError(f"--max-n must be between 3 and 8, got {max_n}")
@@ -75,8 +88,19 @@ def table1(out: str, max_n: int) -> None:
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets, split and folds.")
 @click.option("--cv", type=int, default=10, show_default=True, help="Cross-validation folds.")
 @click.option("--jobs", type=int, default=1, show_default=True, help="Parallel processes.")
+@click.option("--full", is_flag=True, help="Insist on the paper's size: at least 200 configurations, 10 folds.")
 def fig5a(
-    data_dir: str, out: str, r: int, isets: int, draw: str, learner: str, split_by: str, seed: int, cv: int, jobs: int
+    data_dir: str,
+    out: str,
+    r: int,
+    isets: int,
+    draw: str,
+    learner: str,
+    split_by: str,
+    seed: int,
+    cv: int,
+    jobs: int,
+    full: bool,
 ) -> None:
     """Fig. 5a: the validation confusion matrix of the SVM on a simulated data set, beside the paper's."""
     from unstack.experiments.fig5a import fig5a as run
@@ -84,7 +108,12 @@ def fig5a(
 
     if r < 2 or isets < 1 or cv < 2 or jobs < 1:
         raise UnstackError("expected --r >= 2, --isets >= 1, --cv >= 2 and --jobs >= 1")
-    require_configurations(data_dir)
+    found = len(require_configurations(data_dir))
+    if full and (found < PAPER_CONFIGURATIONS or cv != 10):
+        raise UnstackError(
+            f"{data_dir}: --full is the paper's size: {PAPER_CONFIGURATIONS} configurations and 10 folds; "
+            f"this data set has {found} and --cv is {cv} (make it with unstack simulate --configs 200)"
+        )
     result = run(
         data_dir, r=r, isets=isets, seed=seed, cv=cv, n_jobs=jobs, draw=draw, learner=learner, split_by=split_by
     )
@@ -112,16 +141,21 @@ def fig5a(
 @click.option("--out", required=True, type=click.Path(), help="Folder for decisions.json and fig4.png.")
 @click.option("--model", "model_path", default=None, help="Model file (default: the one shipped).")
 @click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
-@click.option("--isets", type=int, default=493, show_default=True, help="Test ISets (the paper: 493).")
+@click.option("--isets", type=int, default=50, show_default=True, help="Test ISets (the paper: 493).")
 @click.option("--isets-from", "draw", type=click.Choice(["random", "neighbours"]), default="random",
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets.")
-def decisions(data_dir: str, out: str, model_path: str | None, r: int, isets: int, draw: str, seed: int) -> None:
+@click.option("--full", is_flag=True, help="The paper's size: 493 test ISets (overrides --isets).")
+def decisions(
+    data_dir: str, out: str, model_path: str | None, r: int, isets: int, draw: str, seed: int, full: bool
+) -> None:
     """Fig. 4 and beyond: MSE(cost), first pick right and physical disturbance of every decision maker."""
     from unstack.cli.learning import load_support_model
     from unstack.experiments.decisions import DECISION_MAKERS, evaluate_decisions, plot_fig4
     from unstack.sim.dataset import require_configurations
 
+    if full:
+        isets = PAPER_TEST_ISETS
     if r < 2 or isets < 1:
         raise UnstackError(f"expected --r >= 2 and --isets >= 1, got {r} and {isets}")
     require_configurations(data_dir)  # before any progress bar or output folder
@@ -189,13 +223,18 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
               help="Seconds per decision of the plan (large groups are sampled).")  # fmt: skip
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of the sampler and the random order.")  # fmt: skip
-def unload(data_dir: str, out: str, model_path: str | None, configs: int, time_limit: float, seed: int) -> None:
+@click.option("--full", is_flag=True, help="Every configuration of the data set (overrides --configs).")
+def unload(
+    data_dir: str, out: str, model_path: str | None, configs: int, time_limit: float, seed: int, full: bool
+) -> None:
     """Order every detected box of each pile and execute the orders in the simulator, box by box."""
     from unstack.cli.learning import load_support_model
     from unstack.experiments.unloading import UNLOADING_MAKERS, plot_unloading, unloading_experiment
     from unstack.sim.dataset import require_configurations
 
-    require_configurations(data_dir)
+    found = len(require_configurations(data_dir))
+    if full:
+        configs = found
     model, name = load_support_model(model_path)
     folder = _out(out)
     with progress_bar("piles") as report:
