@@ -39,6 +39,16 @@ __all__ = ["UNLOADING_MAKERS", "plot_unloading", "unloading_experiment", "unload
 UNLOADING_MAKERS = ("reasoner", "priors", "highest", "free", "random")
 
 
+def _repeated(pick: Callable[[list[str]], str], boxes: list[str]) -> list[str]:
+    """An order made by picking from the boxes still in place until none is left."""
+    remaining = list(boxes)
+    order = []
+    while remaining:
+        order.append(pick(remaining))
+        remaining.remove(order[-1])
+    return order
+
+
 def unloading_orders(scene: Any, model: Any, *, time_limit: float, seed: int) -> dict[str, list[str]]:
     """The order of the scene's detected boxes for every decision maker."""
     from unstack.experiments.decisions import free_pick
@@ -49,23 +59,20 @@ def unloading_orders(scene: Any, model: Any, *, time_limit: float, seed: int) ->
     supports = scene_support_probabilities(scene, model)
     detected = list(scene.detected)
     plan = unloading_plan(supports, time_limit=time_limit, seed=seed)
-    priors: list[str] = []
-    remaining = list(detected)
-    while remaining:
+
+    def raw_priors(remaining: list[str]) -> str:
         subset = supports.subset(remaining)
-        priors.append(choose(subset.objects, subset.probabilities.sum(axis=1))[0])
-        remaining.remove(priors[-1])
-    free: list[str] = []
-    remaining = list(detected)
-    while remaining:
-        free.append(remaining[free_pick([scene.box(box_id) for box_id in remaining])])
-        remaining.remove(free[-1])
+        return choose(subset.objects, subset.probabilities.sum(axis=1))[0]
+
+    def footprint_rule(remaining: list[str]) -> str:
+        return remaining[free_pick([scene.box(box_id) for box_id in remaining])]
+
     heights = {box_id: scene.box(box_id).position[2] for box_id in detected}
     return {
         "reasoner": plan.order,
-        "priors": priors,
+        "priors": _repeated(raw_priors, detected),
         "highest": sorted(detected, key=lambda box_id: (-heights[box_id], box_id)),
-        "free": free,
+        "free": _repeated(footprint_rule, detected),
         "random": [str(box_id) for box_id in np.random.default_rng(seed).permutation(detected)],
     }
 

@@ -383,6 +383,21 @@ def _reinsert(
 
 
 @njit(cache=True, nogil=True)
+def _pair_is_free(i: int, j: int, successors: np.ndarray, predecessors: np.ndarray) -> bool:
+    """Whether both values of ``S_ij`` keep the world transitive, the other relations fixed.
+
+    Dropping a present ``S_ij`` needs no ``k`` with ``i -> k -> j``; adding an absent one
+    needs ``i`` to support everything ``j`` supports and ``j`` to be supported by everything
+    supporting ``i``.
+    """
+    ibit = np.int64(1) << i
+    jbit = np.int64(1) << j
+    if successors[i] & jbit:
+        return bool((successors[i] & predecessors[j] & ~ibit & ~jbit) == 0)
+    return bool((successors[j] & ~ibit & ~successors[i]) == 0 and (predecessors[i] & ~jbit & ~predecessors[j]) == 0)
+
+
+@njit(cache=True, nogil=True)
 def _flip_pairs(
     probabilities: np.ndarray, successors: np.ndarray, predecessors: np.ndarray, rng: np.ndarray, chain: int
 ) -> None:
@@ -394,52 +409,32 @@ def _flip_pairs(
     """
     n = probabilities.shape[0]
     for i in range(n):
-        ibit = np.int64(1) << i
         for j in range(n):
-            if i == j:
-                continue
-            jbit = np.int64(1) << j
-            if successors[i] & jbit:
-                free = (successors[i] & predecessors[j] & ~ibit & ~jbit) == 0
-            else:
-                free = (successors[j] & ~ibit & ~successors[i]) == 0 and (
-                    predecessors[i] & ~jbit & ~predecessors[j]
-                ) == 0
-            if not free:
+            if i == j or not _pair_is_free(i, j, successors, predecessors):
                 continue
             if _uniform(rng, chain) < probabilities[i, j]:
-                successors[i] |= jbit
-                predecessors[j] |= ibit
+                successors[i] |= np.int64(1) << j
+                predecessors[j] |= np.int64(1) << i
             else:
-                successors[i] &= ~jbit
-                predecessors[j] &= ~ibit
+                successors[i] &= ~(np.int64(1) << j)
+                predecessors[j] &= ~(np.int64(1) << i)
 
 
 @njit(cache=True, nogil=True)
 def _add_conditionals(
     probabilities: np.ndarray, successors: np.ndarray, predecessors: np.ndarray, sums: np.ndarray
 ) -> None:
-    """Add ``P(S_ij = 1 | every other relation)`` of the current state to ``sums``."""
+    """Add ``P(S_ij = 1 | every other relation)`` of the current state to ``sums``: ``p_ij``
+    for a free pair, else its current value."""
     n = probabilities.shape[0]
     for i in range(n):
-        ibit = np.int64(1) << i
         for j in range(n):
             if i == j:
                 continue
-            jbit = np.int64(1) << j
-            if successors[i] & jbit:
-                # may S_ij be dropped? only if no k has i -> k -> j
-                if successors[i] & predecessors[j] & ~ibit & ~jbit:
-                    sums[i, j] += 1.0
-                else:
-                    sums[i, j] += probabilities[i, j]
-            else:
-                # may S_ij be added? everything j supports, i must support; everything
-                # supporting i must support j
-                missing_below = successors[j] & ~ibit & ~successors[i]
-                missing_above = predecessors[i] & ~jbit & ~predecessors[j]
-                if missing_below == 0 and missing_above == 0:
-                    sums[i, j] += probabilities[i, j]
+            if _pair_is_free(i, j, successors, predecessors):
+                sums[i, j] += probabilities[i, j]
+            elif successors[i] & (np.int64(1) << j):
+                sums[i, j] += 1.0
 
 
 @njit(cache=True, nogil=True)

@@ -191,11 +191,11 @@ def _group_methods(method: str, sizes: list[int], n: int, time_limit: float | No
         elif size <= SAMPLING_MAX_BOXES:
             methods.append("approx")
         else:
-            raise _too_large_for_all(size, n)
+            raise _too_large_to_sample(size, n)
     return methods
 
 
-def _too_large_for_all(largest: int, n: int) -> UnstackError:
+def _too_large_to_sample(largest: int, n: int) -> UnstackError:
     from unstack.errors import TooLarge
 
     where = f"{largest} linked boxes" if largest == n else f"a group of {largest} linked boxes (of {n})"

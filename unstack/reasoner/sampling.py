@@ -184,6 +184,51 @@ def _chain_seeds(seed: int | None, chains: int) -> np.ndarray:
     return states
 
 
+class _Chains:
+    """The state of ``chains`` chains on one probability matrix, started and burnt in.
+
+    Each chain starts from the closure of the hard evidence, takes one sweep of every first
+    proposal (scattered starts), then ``burn_in`` ordinary sweeps.
+    """
+
+    def __init__(self, probabilities: np.ndarray, *, chains: int, seed: int | None, burn_in: int, tries: int) -> None:
+        from unstack.reasoner._sampler_kernels import run_chains
+
+        n = probabilities.shape[0]
+        if n > SAMPLING_MAX_BOXES:
+            raise TooLarge(f"{n} linked boxes: the sampler holds at most {SAMPLING_MAX_BOXES} boxes per group")
+        if seed is not None and seed < 0:
+            raise UnstackError(f"the seed must be a non-negative integer, got {seed}")
+        self._run = run_chains
+        self.probabilities = probabilities
+        self.log_tables = _log_tables(probabilities)
+        successors, predecessors = _start_state(probabilities)
+        self.successors = np.repeat(successors[None, :], chains, axis=0)
+        self.predecessors = np.repeat(predecessors[None, :], chains, axis=0)
+        self.rng = _chain_seeds(seed, chains)
+        self.tries = tries
+        self.accepted = np.zeros(chains, dtype=np.int64)
+        self.sums = np.zeros((chains, n, n))
+        self.advance(1, scatter=True)
+        self.advance(burn_in)
+
+    def advance(self, sweeps: int, *, record: bool = False, scatter: bool = False) -> None:
+        """Run every chain ``sweeps`` sweeps; with ``record`` the conditionals go to ``sums``."""
+        self._run(
+            self.probabilities,
+            *self.log_tables,
+            self.successors,
+            self.predecessors,
+            self.rng,
+            sweeps,
+            self.tries,
+            record,
+            self.sums,
+            self.accepted,
+            scatter,
+        )
+
+
 def sampled_marginals(
     probabilities: np.ndarray,
     *,
@@ -225,29 +270,15 @@ def sampled_marginals(
         More than :data:`SAMPLING_MAX_BOXES` boxes.
     """
     start = time.perf_counter()  # loading the compiled kernels counts against the time limit
-    from unstack.reasoner._sampler_kernels import run_chains
-
     p = np.ascontiguousarray(probabilities, dtype=np.float64)
     n = p.shape[0]
-    if n > SAMPLING_MAX_BOXES:
-        raise TooLarge(f"{n} linked boxes: the sampler holds at most {SAMPLING_MAX_BOXES} boxes per group")
     if chains < 1 or tries < 1 or burn_in < 0 or (samples is not None and samples < 1):
         raise UnstackError("chains, tries and samples must be at least 1 and burn_in at least 0")
-    if seed is not None and seed < 0:
-        raise UnstackError(f"the seed must be a non-negative integer, got {seed}")
     if samples is None and time_limit is None:
         time_limit = DEFAULT_TIME_LIMIT
     deadline = None if time_limit is None else start + time_limit
     per_chain = None if samples is None else -(-samples // chains)
-    successors0, predecessors0 = _start_state(p)
-    log_tables = _log_tables(p)
-    successors = np.repeat(successors0[None, :], chains, axis=0)
-    predecessors = np.repeat(predecessors0[None, :], chains, axis=0)
-    rng = _chain_seeds(seed, chains)
-    accepted = np.zeros(chains, dtype=np.int64)
-    sums = np.zeros((chains, n, n))
-    run_chains(p, *log_tables, successors, predecessors, rng, 1, tries, False, sums, accepted, True)
-    run_chains(p, *log_tables, successors, predecessors, rng, burn_in, tries, False, sums, accepted)
+    state = _Chains(p, chains=chains, seed=seed, burn_in=burn_in, tries=tries)
 
     batches = np.zeros((chains, _MAX_BATCHES, n, n))
     batch_length = _ROUND_SWEEPS  # sweeps per chain in one batch
@@ -257,10 +288,10 @@ def sampled_marginals(
     round_seconds = 0.0
     while True:
         round_start = time.perf_counter()
-        sums[:] = 0.0
-        run_chains(p, *log_tables, successors, predecessors, rng, _ROUND_SWEEPS, tries, True, sums, accepted)
+        state.sums[:] = 0.0
+        state.advance(_ROUND_SWEEPS, record=True)
         round_seconds = time.perf_counter() - round_start
-        batches[:, filled] += sums
+        batches[:, filled] += state.sums
         partial += _ROUND_SWEEPS
         recorded += _ROUND_SWEEPS
         if partial == batch_length:
@@ -283,7 +314,7 @@ def sampled_marginals(
     error_scale = float(np.sqrt(full_share / (chains * filled)))
     spread = batch_marginals.std(axis=0, ddof=1) if len(batch_marginals) > 1 else np.zeros((n, n))
     np.fill_diagonal(marginals, 0.0)
-    moves = chains * (burn_in + recorded) * n
+    moves = chains * (1 + burn_in + recorded) * n  # the scattering sweep, burn-in and recorded sweeps
     return SampledMarginals(
         marginals=marginals,
         standard_errors=spread * error_scale,
@@ -292,7 +323,7 @@ def sampled_marginals(
         chains=chains,
         samples=chains * recorded,
         burn_in=burn_in,
-        acceptance=float(accepted.sum() / moves) if moves else 1.0,
+        acceptance=float(state.accepted.sum() / moves) if moves else 1.0,
         seed=seed,
         seconds=time.perf_counter() - start,
     )
@@ -333,22 +364,12 @@ def sample_worlds(
     >>> draws.shape
     (3, 3, 3)
     """
-    from unstack.reasoner._sampler_kernels import run_chains
-
     p = np.ascontiguousarray(probabilities, dtype=np.float64)
     n = p.shape[0]
-    if n > SAMPLING_MAX_BOXES:
-        raise TooLarge(f"{n} linked boxes: the sampler holds at most {SAMPLING_MAX_BOXES} boxes per group")
-    successors0, predecessors0 = _start_state(p)
-    log_tables = _log_tables(p)
-    successors, predecessors = successors0[None, :].copy(), predecessors0[None, :].copy()
-    rng = _chain_seeds(seed, 1)
-    accepted = np.zeros(1, dtype=np.int64)
-    unused = np.zeros((1, n, n))
-    run_chains(p, *log_tables, successors, predecessors, rng, burn_in, tries, False, unused, accepted)
+    state = _Chains(p, chains=1, seed=seed, burn_in=burn_in, tries=tries)
     bits = np.left_shift(np.int64(1), np.arange(n, dtype=np.int64))
     draws = np.zeros((worlds, n, n), dtype=bool)
     for k in range(worlds):
-        run_chains(p, *log_tables, successors, predecessors, rng, thin, tries, False, unused, accepted)
-        draws[k] = (successors[0][:, None] & bits[None, :]) != 0
+        state.advance(thin)
+        draws[k] = (state.successors[0][:, None] & bits[None, :]) != 0
     return draws
