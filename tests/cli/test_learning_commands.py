@@ -30,13 +30,16 @@ def model(small_dataset: Path, tmp_path_factory: pytest.TempPathFactory) -> Path
 
 def test_train_json_report(small_dataset: Path, tmp_path: Path) -> None:
     result = unstack("train", str(small_dataset), "-o", str(tmp_path / "m.skops"), "--r", "4", "--cv", "3",
-                     "--learner", "gradient_boosting", "--json")  # fmt: skip
+                     "--learner", "gradient_boosting", "--features", "extended", "--json")  # fmt: skip
     assert result.returncode == 0, result.stderr
     report = json.loads(result.stdout)
-    assert report["learner"] == "gradient_boosting"
+    assert report["learner"] == "gradient_boosting" and report["features"]["feature_set"] == "extended"
     assert report["training"]["r"] == 4
     assert report["validation"]["relations"] == math.ceil(0.3 * report["training"]["relations"])
     assert len(report["training"]["fingerprint"]) == 64
+    decided = unstack("decide", SCENE, "--model", str(tmp_path / "m.skops"), "--json")  # the model's features
+    assert decided.returncode == 0, decided.stderr
+    assert json.loads(decided.stdout)["objects"] == ["b03", "b04", "b06", "b13", "b14"]
 
 
 def test_evaluate_prints_the_confusion_matrix_and_a_reliability_diagram(

@@ -80,17 +80,21 @@ def test_experiment_bad_input(arguments: list[str], message: str, tmp_path: Path
     assert not list(tmp_path.iterdir())
 
 
-@pytest.mark.parametrize("split", ["pairs", "configuration"])
-def test_fig5a_on_simulated_piles(small_dataset: Path, tmp_path: Path, split: str) -> None:
+@pytest.mark.parametrize(("split", "features"), [("pairs", "paper"), ("configuration", "extended")])
+def test_fig5a_on_simulated_piles(small_dataset: Path, tmp_path: Path, split: str, features: str) -> None:
     result = unstack("experiment", "fig5a", str(small_dataset), "--out", str(tmp_path), "--r", "4", "--isets", "3",
-                     "--cv", "3", "--split-by", split)  # fmt: skip
+                     "--cv", "3", "--split-by", split, "--features", features)  # fmt: skip
     assert result.returncode == 0, result.stderr
     assert "paper (Fig. 5a)" in result.stdout and "78.4 %" in result.stdout
     document = json.loads((tmp_path / "fig5a.json").read_text())
     matrix = np.array(document["validation"]["confusion_matrix"])
     assert matrix.sum() == document["validation"]["relations"]
     assert 0.0 < document["balanced_threshold"] <= 1.0
-    assert document["split_by"] == split
+    assert document["split_by"] == split and document["features"]["feature_set"] == features
+    roc = document["validation_roc"]
+    assert 0.0 <= roc["not_supp_recall_at_paper_supp_recall"] <= 1.0 and 0.0 <= roc["auc"] <= 1.0
+    assert np.all(np.diff(roc["supp_recall"]) <= 0)  # a stricter not-SUPP recall never raises the SUPP recall
+    assert (tmp_path / "fig5a.png").read_bytes()[:4] == b"\x89PNG"
 
 
 def test_real7_scores_every_iset(small_dataset: Path) -> None:

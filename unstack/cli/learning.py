@@ -62,6 +62,7 @@ def metrics_view(report: dict[str, Any], title: str) -> Group:
 
 
 ISETS_FROM_HELP = "How ISets are drawn: random detected boxes, or a detected box and its nearest neighbours."
+FEATURES_HELP = "paper: the 19 numbers of Eq. 6; extended: those and 17 contact features (gaps, overlaps, cloud)."
 
 
 def _examples(data_dir: str, r: int, isets: int, seed: int, jobs: int, settings: Any, draw: str = "random") -> Any:
@@ -94,6 +95,8 @@ def _examples(data_dir: str, r: int, isets: int, seed: int, jobs: int, settings:
               help="pairs: the paper's split of the relations; configuration: whole piles on one side.")  # fmt: skip
 @click.option("--cv", type=int, default=10, show_default=True, help="Cross-validation folds on the training part.")
 @click.option("--validation-size", type=float, default=0.3, show_default=True, help="Share held out for validation.")
+@click.option("--features", "feature_set", type=click.Choice(["paper", "extended"]), default="paper",
+              show_default=True, help=FEATURES_HELP)  # fmt: skip
 @click.option("--offset", type=float, default=1.0, show_default=True, help="d: interest-point offset (m).")
 @click.option("--sigma", type=float, default=0.5, show_default=True, help="Width of the DBAF's Gaussian (m).")
 @click.option("--jobs", type=int, default=1, show_default=True, help="Parallel processes.")
@@ -109,6 +112,7 @@ def train(
     split_by: str,
     cv: int,
     validation_size: float,
+    feature_set: str,
     offset: float,
     sigma: float,
     jobs: int,
@@ -123,7 +127,7 @@ def train(
 
     if r < 2 or isets < 1 or cv < 2 or jobs < 1 or not 0.0 <= validation_size < 1.0:
         raise UnstackError("expected --r >= 2, --isets >= 1, --cv >= 2, --jobs >= 1 and 0 <= --validation-size < 1")
-    settings = FeatureSettings(offset=offset, sigma=sigma)
+    settings = FeatureSettings(offset=offset, sigma=sigma, feature_set=feature_set)
     examples = _examples(data_dir, r, isets, seed, jobs, settings, draw)
     console = Console(stderr=as_json)
     console.print(
@@ -150,7 +154,8 @@ def train(
     }
     model = SupportModel.from_classifier(classifier, settings, training=training)
     save_model(model, output)
-    report = {"model": output, "learner": learner, **{k: model.metadata[k] for k in ("best_params", "cv_score")},
+    report = {"model": output, "learner": learner, "features": settings.to_dict(),
+              **{k: model.metadata[k] for k in ("best_params", "cv_score")},
               "validation": classifier.validation_metrics_, "training": {k: v for k, v in training.items()
               if k != "simulation_settings"}}  # fmt: skip
     if as_json:

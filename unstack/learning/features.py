@@ -10,6 +10,10 @@
 * ``F_XY = [dcc, F_BB(X, Y), F_DBAF(X), F_DBAF(Y)]`` (Eq. 6): 19 numbers; ``F_YX`` swaps
   the roles (Eq. 7).
 
+``FeatureSettings(feature_set="extended")`` appends the 17 contact features of
+:mod:`unstack.learning.contact_features` (vertical gap, footprint overlap, heights, what the
+cloud shows between and on the boxes): 36 numbers. ``"paper"`` (the default) is Eq. 6 alone.
+
 The DBAF sums are computed by one of two methods, chosen by ``dbaf_method``:
 
 ``"direct"``
@@ -48,10 +52,12 @@ from unstack.scene import Box
 
 __all__ = [
     "FEATURE_NAMES",
+    "FEATURE_SETS",
     "FeatureSettings",
     "bounding_boxes",
     "dbaf",
     "dbaf_features",
+    "feature_names",
     "interest_points",
     "pair_features",
 ]
@@ -63,6 +69,8 @@ FEATURE_NAMES: tuple[str, ...] = (
     *(f"dbaf_x_{k}" for k in ("+x", "-x", "+y", "-y", "+z", "-z")),
     *(f"dbaf_y_{k}" for k in ("+x", "-x", "+y", "-y", "+z", "-z")),
 )
+#: Feature sets of ``FeatureSettings.feature_set``: Eq. 6 alone, or Eq. 6 and the contact features.
+FEATURE_SETS = ("paper", "extended")
 #: Interest points whose truncation ball covers more than this share of the cloud's
 #: bounding box make ``"auto"`` use the direct sum.
 KDTREE_MAX_COVER = 0.05
@@ -82,12 +90,16 @@ class FeatureSettings:
         How the DBAF sums are computed (see the module docstring).
     tolerance : float
         Largest neglected term of the ``kdtree`` method, relative to the largest term.
+    feature_set : {"paper", "extended"}
+        ``"paper"``: the 19 numbers of Eq. 6; ``"extended"``: those and the 17 contact
+        features (:mod:`unstack.learning.contact_features`).
     """
 
     offset: float = 1.0
     sigma: float = 0.5
     dbaf_method: str = "auto"
     tolerance: float = 1e-9
+    feature_set: str = "paper"
 
     def __post_init__(self) -> None:
         from unstack.errors import UnstackError
@@ -99,10 +111,26 @@ class FeatureSettings:
             )
         if self.dbaf_method not in ("auto", "direct", "kdtree"):
             raise UnstackError(f"unknown DBAF method {self.dbaf_method!r}; expected auto, direct or kdtree")
+        if self.feature_set not in FEATURE_SETS:
+            raise UnstackError(f"unknown feature set {self.feature_set!r}; expected one of {', '.join(FEATURE_SETS)}")
 
     def to_dict(self) -> dict[str, float | str]:
         """JSON-ready dict."""
         return asdict(self)
+
+
+def feature_names(settings: FeatureSettings | None = None) -> tuple[str, ...]:
+    """Names of the columns :func:`pair_features` returns with these settings.
+
+    Examples
+    --------
+    >>> len(feature_names()), len(feature_names(FeatureSettings(feature_set="extended")))
+    (19, 36)
+    """
+    from unstack.learning.contact_features import CONTACT_FEATURE_NAMES
+
+    settings = settings or FeatureSettings()
+    return FEATURE_NAMES + (CONTACT_FEATURE_NAMES if settings.feature_set == "extended" else ())
 
 
 def interest_points(boxes: Sequence[Box], offset: float = 1.0) -> np.ndarray:
@@ -233,7 +261,11 @@ def pair_features(
     pairs: Sequence[tuple[int, int]],
     settings: FeatureSettings | None = None,
 ) -> np.ndarray:
-    """``F_XY`` (Eq. 6) for each ordered pair ``(X, Y)`` of box indices, shape (len(pairs), 19)."""
+    """``F_XY`` (Eq. 6) for each ordered pair ``(X, Y)`` of box indices, shape (len(pairs), 19).
+
+    With ``settings.feature_set == "extended"`` the 17 contact features follow: shape
+    (len(pairs), 36), columns named by :func:`feature_names`.
+    """
     settings = settings or FeatureSettings()
     index = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
     used = np.unique(index)
@@ -245,4 +277,9 @@ def pair_features(
     x = np.array([local[int(value)] for value in index[:, 0]], dtype=np.int64)
     y = np.array([local[int(value)] for value in index[:, 1]], dtype=np.int64)
     dcc = np.linalg.norm(centroids[x] - centroids[y], axis=1)
-    return np.column_stack([dcc, boxes_bb[x] - boxes_bb[y], dbafs[x], dbafs[y]])
+    paper = np.column_stack([dcc, boxes_bb[x] - boxes_bb[y], dbafs[x], dbafs[y]])
+    if settings.feature_set == "paper":
+        return paper
+    from unstack.learning.contact_features import contact_features
+
+    return np.column_stack([paper, contact_features(boxes, points, [(int(a), int(b)) for a, b in index])])

@@ -47,7 +47,7 @@ class SupportExamples:
 
     Attributes
     ----------
-    features : numpy.ndarray, shape (m, 19)
+    features : numpy.ndarray, shape (m, 19), or (m, 36) with the extended feature set
     labels : numpy.ndarray, shape (m,)
         1 for SUPP(X, Y), 0 otherwise.
     configuration : numpy.ndarray, shape (m,)
