@@ -107,3 +107,16 @@ def test_groups_must_match_the_rows(rng: np.random.Generator) -> None:
     features, labels = separable(rng)
     with pytest.raises(ValueError, match="groups has 3 labels for 160 rows"):
         SupportClassifier(cv=3, param_grid=SMALL_GRID).fit(features, labels, groups=[0, 1, 2])
+
+
+def test_cv_probabilities_are_out_of_fold(rng: np.random.Generator) -> None:
+    from sklearn.metrics import roc_auc_score
+
+    features, labels = rng.normal(size=(200, 5)), rng.integers(0, 2, 200)  # nothing to learn
+    grid = {"gb__learning_rate": [0.3], "gb__max_leaf_nodes": [31], "gb__max_iter": [200]}
+    model = SupportClassifier(learner="gradient_boosting", cv=4, param_grid=grid, random_state=0).fit(features, labels)
+    train_labels = labels[model.train_indices_]
+    assert model.cv_probabilities_.shape == train_labels.shape
+    in_sample = model.predict_proba(features[model.train_indices_])[:, 1]
+    assert roc_auc_score(train_labels, in_sample) > 0.95  # the trees memorise their rows
+    assert abs(roc_auc_score(train_labels, model.cv_probabilities_) - 0.5) < 0.15  # but not the held-out folds

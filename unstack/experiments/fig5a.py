@@ -3,7 +3,8 @@
 Trains a :class:`~unstack.learning.SupportClassifier` on ISets of a simulated data set
 (70/30 split, 10-fold cross-validation, as the paper) and reports the held-out confusion
 matrix, plus the recalls at the probability threshold that balances the two classes' errors
-on the *training* part (a threshold chosen without the validation data), since the paper's
+on the *training* part (out-of-fold probabilities, a threshold chosen without the validation
+data), since the paper's
 data set had 33 % SUPP relations and ours far fewer. The validation ROC curve says which
 not-SUPP recall any threshold reaches at the paper's SUPP recall: the paper's point beats us
 only if it lies above our curve (``fig5a.png`` draws both).
@@ -121,10 +122,10 @@ def fig5a(
     classifier = SupportClassifier(learner=learner, cv=cv, random_state=seed, n_jobs=n_jobs).fit(
         examples.features, examples.labels, groups=examples.configuration if split_by == "configuration" else None
     )
-    train_x, train_y = examples.features[classifier.train_indices_], examples.labels[classifier.train_indices_]
+    train_y = examples.labels[classifier.train_indices_]
     valid_x = examples.features[classifier.validation_indices_]
     valid_y = examples.labels[classifier.validation_indices_]
-    threshold = _balanced_threshold(train_y, classifier.predict_proba(train_x)[:, 1])
+    threshold = _balanced_threshold(train_y, classifier.cv_probabilities_)
     valid_p = classifier.predict_proba(valid_x)[:, 1]
     at_threshold = classification_report(valid_y, (valid_p >= threshold).astype(float))
     return {

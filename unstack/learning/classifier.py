@@ -42,12 +42,13 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from sklearn.base import BaseEstimator, ClassifierMixin
+from sklearn.base import BaseEstimator, ClassifierMixin, clone
 from sklearn.model_selection import (
     GridSearchCV,
     GroupShuffleSplit,
     StratifiedGroupKFold,
     StratifiedKFold,
+    cross_val_predict,
     train_test_split,
 )
 from sklearn.pipeline import Pipeline
@@ -89,7 +90,7 @@ def default_grid(name: str) -> dict[str, list[Any]]:
             "svc__estimator__gamma": [0.001, 0.003, 0.01, 0.03, 0.1],
         }
     if name == "gradient_boosting":
-        return {"gb__learning_rate": [0.05, 0.1], "gb__max_leaf_nodes": [7, 15]}
+        return {"gb__learning_rate": [0.05, 0.1], "gb__max_leaf_nodes": [7, 15], "gb__max_iter": [100, 300]}
     raise ValueError(f"unknown learner {name!r}; expected one of {', '.join(LEARNERS)}")
 
 
@@ -125,6 +126,11 @@ class SupportClassifier(ClassifierMixin, BaseEstimator):
         Rows of ``X`` in the training and the held-out part.
     grouped_ : bool
         Whether the split kept groups together.
+    cv_probabilities_ : numpy.ndarray
+        Out-of-fold P(SUPP) of each training row (``train_indices_`` order): the chosen
+        hyper-parameters cross-validated on the same folds. A threshold chosen on these
+        is not flattered by the model having seen the rows (in-sample probabilities of a
+        boosted model are far more confident than on new piles).
     n_features_in_ : int
     """
 
@@ -193,22 +199,26 @@ class SupportClassifier(ClassifierMixin, BaseEstimator):
             folds = max(2, min(folds, len(np.unique(group_labels[self.train_indices_]))))
         # the probability calibration runs inside each fold's training part: fewer folds for tiny data
         calibration_folds = max(2, min(5, smallest_class * (folds - 1) // folds))
+        splitter = (
+            StratifiedKFold(folds, shuffle=True, random_state=self.random_state)
+            if group_labels is None
+            else StratifiedGroupKFold(folds, shuffle=True, random_state=self.random_state)
+        )
+        train_groups = None if group_labels is None else group_labels[self.train_indices_]
         search = GridSearchCV(
             make_learner(self.learner, self.random_state, calibration_folds=calibration_folds),
             self.param_grid or default_grid(self.learner),
             scoring=self.scoring,
-            cv=(
-                StratifiedKFold(folds, shuffle=True, random_state=self.random_state)
-                if group_labels is None
-                else StratifiedGroupKFold(folds, shuffle=True, random_state=self.random_state)
-            ),
+            cv=splitter,
             n_jobs=self.n_jobs,
             refit=True,
         )
-        if group_labels is None:
-            search.fit(X_train, y_train)
-        else:
-            search.fit(X_train, y_train, groups=group_labels[self.train_indices_])
+        search.fit(X_train, y_train, groups=train_groups)
+        positive = list(search.best_estimator_.classes_).index(self.classes_[1])
+        self.cv_probabilities_ = cross_val_predict(
+            clone(search.best_estimator_), X_train, y_train, groups=train_groups, cv=splitter,
+            n_jobs=self.n_jobs, method="predict_proba",
+        )[:, positive]  # fmt: skip
         self.estimator_ = search.best_estimator_
         self.best_params_ = dict(search.best_params_)
         self.cv_score_ = float(search.best_score_)
