@@ -89,7 +89,7 @@ def test_fig5a_on_simulated_piles(small_dataset: Path, tmp_path: Path, split: st
     document = json.loads((tmp_path / "fig5a.json").read_text())
     matrix = np.array(document["validation"]["confusion_matrix"])
     assert matrix.sum() == document["validation"]["relations"]
-    assert 0.0 < document["balanced_threshold"] <= 1.0
+    assert 0.0 < document["balanced_threshold"] <= 1.0 and 0.0 < document["paper_recall_threshold"] <= 1.0
     assert document["split_by"] == split and document["features"]["feature_set"] == features
     roc = document["validation_roc"]
     assert 0.0 <= roc["not_supp_recall_at_paper_supp_recall"] <= 1.0 and 0.0 <= roc["auc"] <= 1.0
@@ -131,3 +131,14 @@ def test_unload_command_executes_every_order(small_dataset: Path, tmp_path: Path
         assert all(sorted(order) == sorted(orders[0]) and len(order) == pile["detected"] for order in orders)
         for run in pile["runs"].values():
             assert run["boxes_moved"] == sum(len(step["moved"]) for step in run["steps"])
+
+
+@pytest.mark.parametrize(("recall", "expected"), [(0.5, 0.8), (0.75, 0.6), (1.0, 0.3), (0.0, 0.9)])
+def test_recall_threshold_is_the_largest_reaching_the_recall(recall: float, expected: float) -> None:
+    from unstack.experiments.fig5a import _recall_threshold
+
+    truth = np.array([1, 1, 1, 1, 0, 0])
+    probability = np.array([0.9, 0.8, 0.6, 0.3, 0.95, 0.1])
+    threshold = _recall_threshold(truth, probability, recall)
+    assert threshold == expected
+    assert np.mean(probability[truth == 1] >= threshold) >= recall
