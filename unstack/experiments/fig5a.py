@@ -137,7 +137,7 @@ def fig5a(
     valid_x = examples.features[classifier.validation_indices_]
     valid_y = examples.labels[classifier.validation_indices_]
     threshold = _balanced_threshold(train_y, classifier.cv_probabilities_)
-    paper_threshold = _recall_threshold(train_y, classifier.cv_probabilities_, PAPER_FIG_5A["supp_recall"])
+    paper_threshold = _recall_threshold(train_y, classifier.cv_probabilities_, float(PAPER_FIG_5A["supp_recall"]))
     valid_p = classifier.predict_proba(valid_x)[:, 1]
     at_threshold = classification_report(valid_y, (valid_p >= threshold).astype(float))
     at_paper_threshold = classification_report(valid_y, (valid_p >= paper_threshold).astype(float))
