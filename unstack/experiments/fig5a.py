@@ -100,8 +100,9 @@ def plot_fig5a(result: dict[str, Any], output: str | os.PathLike[str]) -> None:
     axes.set_ylim(0.5, 1.0)
     axes.grid(alpha=0.3)
     axes.legend(loc="lower left")
-    axes.set_title(f"{result['relations']} relations, features {result['features']['feature_set']}, "
-                   f"split by {result['split_by']}", fontsize=9)  # fmt: skip
+    validation = result["validation"]
+    title = f"{validation['relations']} validation relations ({validation['supp']} SUPP), "
+    axes.set_title(title + f"features {result['features']['feature_set']}, split by {result['split_by']}", fontsize=9)
     figure.tight_layout()
     save_png(figure, output)
 
