@@ -46,6 +46,10 @@ def test_decisions_on_simulated_piles(small_dataset: Path) -> None:
         assert summary["mse_cost"] >= 0 and 0 <= summary["first_pick_right"] <= 1
     for rows in result["bins"].values():
         assert sum(row["isets"] for row in rows) == 12
+    for maker, differences in result["against_reasoner"].items():
+        gap = result["summary"][maker]["boxes_moved"] - result["summary"]["reasoner"]["boxes_moved"]
+        assert differences["boxes_moved"]["mean"] == pytest.approx(gap)
+        assert differences["boxes_moved"]["standard_error"] >= 0
     again = evaluate_decisions(small_dataset, load_model(default_model_path()), r=4, isets=12, seed=2)
     assert again["summary"] == result["summary"]
 
@@ -131,6 +135,10 @@ def test_unload_command_executes_every_order(small_dataset: Path, tmp_path: Path
         assert all(sorted(order) == sorted(orders[0]) and len(order) == pile["detected"] for order in orders)
         for run in pile["runs"].values():
             assert run["boxes_moved"] == sum(len(step["moved"]) for step in run["steps"])
+    highest = document["against_reasoner"]["highest"]["boxes_moved"]
+    assert highest["mean"] == pytest.approx(
+        document["summary"]["highest"]["boxes_moved_per_pile"] - document["summary"]["reasoner"]["boxes_moved_per_pile"]
+    )
 
 
 @pytest.mark.parametrize(("recall", "expected"), [(0.5, 0.8), (0.75, 0.6), (1.0, 0.3), (0.0, 0.9)])

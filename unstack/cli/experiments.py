@@ -186,15 +186,19 @@ def decisions(
     _write_json(folder / "decisions.json", result)
     plot_fig4(result, folder / "fig4.png")
     table = Table(title=f"{result['isets']} test ISets of {r} boxes ({data_dir})")
-    for column in ("decision maker", "MSE(cost)", "first pick right", "boxes moved > 2 cm", "displacement (m)"):
+    columns = ("decision maker", "MSE(cost)", "first pick right", "boxes moved > 2 cm", "moved - unstack's (± s.e.)",
+               "displacement (m)")  # fmt: skip
+    for column in columns:
         table.add_column(column, justify="right")
     for maker in DECISION_MAKERS:
         row = result["summary"][maker]
+        paired = result["against_reasoner"].get(maker, {}).get("boxes_moved")
         table.add_row(
             maker,
             f"{row['mse_cost']:.3f}",
             f"{100 * row['first_pick_right']:.1f} %",
             f"{row['boxes_moved']:.2f}",
+            f"{paired['mean']:+.2f} ± {paired['standard_error']:.2f}" if paired else "",
             f"{row['displacement_m']:.3f}",
         )
     Console().print(table)
@@ -267,6 +271,7 @@ def unload(
     for column in (
         "decision maker",
         "boxes moved > 2 cm per pile",
+        "minus unstack's (± s.e.)",
         "per pick",
         "picks moving nothing",
         "displacement (m)",
@@ -274,9 +279,11 @@ def unload(
         table.add_column(column, justify="right")
     for maker in UNLOADING_MAKERS:
         row = result["summary"][maker]
+        paired = result["against_reasoner"].get(maker, {}).get("boxes_moved")
         table.add_row(
             maker,
             f"{row['boxes_moved_per_pile']:.2f}",
+            f"{paired['mean']:+.2f} ± {paired['standard_error']:.2f}" if paired else "",
             f"{row['boxes_moved_per_pick']:.3f}",
             f"{100 * row['calm_picks']:.1f} %",
             f"{row['displacement_m_per_pile']:.3f}",

@@ -25,7 +25,9 @@ supports):
 * the share of ISets whose first pick has the minimum possible cost;
 * the physical disturbance of the pick, from the simulator's removal responses stored in the
   scene: boxes of the whole pile (not only the ISet) that moved more than 2 cm when the chosen
-  box was taken away, and the sum of their displacements.
+  box was taken away, and the sum of their displacements;
+* for every other decision maker, the paired difference (other minus unstack) of each score
+  over the same ISets, with its standard error (``against_reasoner``).
 
 Examples
 --------
@@ -44,7 +46,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["DECISION_MAKERS", "evaluate_decisions", "squared_regret"]
+__all__ = ["DECISION_MAKERS", "evaluate_decisions", "paired_difference", "squared_regret"]
 
 DECISION_MAKERS = ("reasoner", "priors", "highest", "free", "random")
 #: Displacement above which a box counts as disturbed (the ground truth's threshold).
@@ -54,6 +56,19 @@ DISTURBED = 0.02
 def squared_regret(costs: np.ndarray, choice: int) -> float:
     """``(DMC - MPC)^2`` of one pick (Eq. 14's term)."""
     return float((costs[choice] - costs.min()) ** 2)
+
+
+def paired_difference(other: np.ndarray, ours: np.ndarray) -> dict[str, float]:
+    """Mean of ``other - ours`` over the same cases, with its standard error.
+
+    Examples
+    --------
+    >>> paired_difference(np.array([1.0, 2.0, 3.0]), np.array([0.0, 2.0, 1.0]))
+    {'mean': 1.0, 'standard_error': 0.5773502691896258}
+    """
+    difference = np.asarray(other, dtype=np.float64) - np.asarray(ours, dtype=np.float64)
+    spread = float(difference.std(ddof=1) / np.sqrt(len(difference))) if len(difference) > 1 else float("nan")
+    return {"mean": float(difference.mean()), "standard_error": spread}
 
 
 @dataclass(frozen=True)
@@ -214,12 +229,21 @@ def evaluate_decisions(
         }
         for maker, values in scores.items()
     }
+    # the same ISets for every maker: paired differences say whether a gap is more than noise
+    measures = {"squared_regret": "mse_cost", "first_pick_right": "first_pick_right", "moved": "boxes_moved",
+                "displacement": "displacement_m"}  # fmt: skip
+    against_reasoner = {
+        maker: {name: paired_difference(scores[maker][key], scores["reasoner"][key]) for key, name in measures.items()}
+        for maker in DECISION_MAKERS
+        if maker != "reasoner"
+    }
     return {
         "data": str(data_dir),
         "r": r,
         "isets": len(results),
         "seed": seed,
         "summary": summary,
+        "against_reasoner": against_reasoner,
         "bins": _binned(results, scores),
         "classifier": {
             "success_rate": float(np.mean([s.success_rate for s in results])),

@@ -110,12 +110,24 @@ def unloading_experiment(
             "displacement_m_per_pile": float(np.mean([run["displacement_m"] for run in runs])),
             "calm_picks": float(sum(step["boxes_moved"] == 0 for run in runs for step in run["steps"]) / max(steps, 1)),
         }
+    from unstack.experiments.decisions import paired_difference
+
+    def per_pile(maker: str, key: str) -> np.ndarray:
+        return np.array([pile["runs"][maker][key] for pile in piles], dtype=np.float64)
+
+    against_reasoner = {  # the same piles for every maker: is a gap more than noise?
+        maker: {key: paired_difference(per_pile(maker, key), per_pile("reasoner", key))
+                for key in ("boxes_moved", "displacement_m")}
+        for maker in UNLOADING_MAKERS
+        if maker != "reasoner"
+    }  # fmt: skip
     return {
         "data": str(data_dir),
         "configs": len(piles),
         "time_limit": time_limit,
         "seed": seed,
         "summary": summary,
+        "against_reasoner": against_reasoner,
         "piles": piles,
     }
 
