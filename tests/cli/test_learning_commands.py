@@ -73,6 +73,16 @@ def test_decide_on_the_bundled_scene_with_the_default_model() -> None:
     assert decision["objects"] == ["b03", "b04", "b06", "b13", "b14"]
 
 
+def test_the_shipped_extended_model_by_name(tmp_path: Path) -> None:
+    result = unstack("probabilities", SCENE, "--model", "extended", "-o", str(tmp_path / "p.json"))
+    assert result.returncode == 0, result.stderr
+    metadata = json.loads((tmp_path / "p.json").read_text())["metadata"]
+    assert metadata["model"] == "shipped:extended-paper2.skops" and metadata["features"]["feature_set"] == "extended"
+    decided = unstack("decide", SCENE, "--model", "extended", "--json")
+    assert decided.returncode == 0, decided.stderr
+    assert json.loads(decided.stdout)["objects"] == ["b03", "b04", "b06", "b13", "b14"]
+
+
 def test_decide_on_a_scene_with_a_given_model(model: Path) -> None:
     result = unstack("decide", SCENE, "--model", str(model))
     assert result.returncode == 0, result.stderr

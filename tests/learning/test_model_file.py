@@ -93,3 +93,14 @@ def test_the_shipped_default_model_loads() -> None:
     assert model.metadata["learner"] == "svm" and model.features == FeatureSettings()
     validation = model.metadata["validation"]
     assert validation["relations"] > 500 and 0 <= validation["balanced_error_rate"] <= 0.5
+
+
+def test_the_shipped_extended_model_loads_and_was_split_by_pile() -> None:
+    from unstack.learning.model_file import bundled_model_path
+
+    model = load_model(bundled_model_path("extended"))
+    assert model.metadata["learner"] == "gradient_boosting"
+    assert model.features == FeatureSettings(feature_set="extended")
+    assert model.metadata["training"]["split_by"] == "configuration"
+    rows = np.random.default_rng(0).normal(size=(3, 36))
+    assert model.support_probability(rows).shape == (3,)

@@ -9,7 +9,7 @@ import click
 from rich.console import Console
 from rich.table import Table
 
-from unstack.cli.learning import FEATURES_HELP, ISETS_FROM_HELP
+from unstack.cli.learning import FEATURES_HELP, ISETS_FROM_HELP, MODEL_HELP
 from unstack.cli.progress import progress_bar
 from unstack.errors import UnstackError
 
@@ -158,7 +158,7 @@ def fig5a(
 @experiment.command()
 @click.argument("data_dir", type=click.Path(file_okay=False))
 @click.option("--out", required=True, type=click.Path(), help="Folder for decisions.json and fig4.png.")
-@click.option("--model", "model_path", default=None, help="Model file (default: the one shipped).")
+@click.option("--model", "model_path", default=None, help=MODEL_HELP)
 @click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
 @click.option("--isets", type=int, default=50, show_default=True, help="Test ISets (the paper: 493).")
 @click.option("--isets-from", "draw", type=click.Choice(["random", "neighbours"]), default="random",
@@ -240,7 +240,7 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
 @experiment.command()
 @click.argument("data_dir", type=click.Path(file_okay=False))
 @click.option("--out", required=True, type=click.Path(), help="Folder for unloading.json and unloading.png.")
-@click.option("--model", "model_path", default=None, help="Model file (default: the one shipped).")
+@click.option("--model", "model_path", default=None, help=MODEL_HELP)
 @click.option("--configs", type=click.IntRange(min=1), default=4, show_default=True, help="Piles (the first N).")
 @click.option("--time-limit", type=click.FloatRange(min=0.0, min_open=True), default=0.3, show_default=True,
               help="Seconds per decision of the plan (large groups are sampled).")  # fmt: skip

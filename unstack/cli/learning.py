@@ -16,18 +16,18 @@ __all__ = ["evaluate", "load_support_model", "metrics_view", "probabilities", "s
 
 
 def load_support_model(path: str | None) -> tuple[Any, str]:
-    """The model of ``--model``, or the one shipped with the package."""
-    from unstack.learning.model_file import default_model_path, load_model
+    """The model of ``--model``: a file, or the name of a shipped model (default: ``paper``)."""
+    from unstack.learning.model_file import BUNDLED_MODELS, bundled_model_path, load_model
 
-    if path is None:
-        default = default_model_path()
-        if not default.is_file():
-            raise ModelRequired(
-                f"no model given and the default model {default.name} is not installed; pass --model FILE "
-                "(make one with unstack train)"
-            )
-        return load_model(default), f"default:{default.name}"
-    return load_model(path), path
+    name = "paper" if path is None else path
+    if name not in BUNDLED_MODELS:
+        return load_model(name), name
+    shipped = bundled_model_path(name)
+    if not shipped.is_file():
+        raise ModelRequired(
+            f"the shipped model {shipped.name} is not installed; pass --model FILE (make one with unstack train)"
+        )
+    return load_model(shipped), f"{'default' if path is None else 'shipped'}:{shipped.name}"
 
 
 def scene_supports(scene: Any, model_path: str | None) -> Any:
@@ -62,6 +62,7 @@ def metrics_view(report: dict[str, Any], title: str) -> Group:
 
 
 ISETS_FROM_HELP = "How ISets are drawn: random detected boxes, or a detected box and its nearest neighbours."
+MODEL_HELP = "Model file, or a shipped model: paper (the default: the paper's SVM) or extended (better decisions)."
 FEATURES_HELP = "paper: the 19 numbers of Eq. 6; extended: those and 17 contact features (gaps, overlaps, cloud)."
 
 
@@ -209,7 +210,7 @@ def evaluate(
 
 @click.command()
 @click.argument("scene_file", type=str)
-@click.option("--model", "model_path", default=None, help="Model file (default: the model shipped with unstack).")
+@click.option("--model", "model_path", default=None, help=MODEL_HELP)
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None, help="Write the JSON here (atomically).")
 def probabilities(scene_file: str, model_path: str | None, output: str | None) -> None:
     """Support probabilities of a scene's detected boxes, as unstack.supports/1 JSON."""

@@ -16,6 +16,7 @@ from typing import Any
 import click
 from rich.console import Console
 
+from unstack.cli.learning import MODEL_HELP
 from unstack.errors import UnstackError
 
 __all__ = ["cli", "main"]
@@ -119,7 +120,7 @@ def cli() -> None:
     "-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON decision to this file (atomically)."
 )
 @_reasoning_options
-@click.option("--model", "model_path", default=None, help="Model for scene files (default: the one shipped).")
+@click.option("--model", "model_path", default=None, help=MODEL_HELP)
 def decide(file: str, as_json: bool, output: str | None, model_path: str | None, **reasoning: Any) -> None:
     """Print which box to unload first, the expected cost of every box and P(support | consistent).
 
@@ -179,7 +180,7 @@ def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str) 
 @click.option("--json", "as_json", is_flag=True, help="Print the plan as unstack.plan/1 JSON.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON plan to this file.")
 @_reasoning_options
-@click.option("--model", "model_path", default=None, help="Model for scene files (default: the one shipped).")
+@click.option("--model", "model_path", default=None, help=MODEL_HELP)
 def plan(file: str, as_json: bool, output: str | None, model_path: str | None, **reasoning: Any) -> None:
     """Order all detected boxes by repeated decisions: pick, remove from the set, decide again.
 

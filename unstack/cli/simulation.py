@@ -6,6 +6,7 @@ import re
 
 import click
 
+from unstack.cli.learning import MODEL_HELP
 from unstack.errors import UnstackError
 
 __all__ = ["parse_box_range", "render", "simulate"]
@@ -108,7 +109,7 @@ def simulate(
 @click.option("--title", default=None, help="Title of the picture (default: the file name).")
 @click.option("--probabilities", "show_probabilities", is_flag=True,
               help="Draw the learned P(X supports Y) of the detected boxes as arrows.")  # fmt: skip
-@click.option("--model", "model_path", default=None, help="Model for --probabilities (default: the one shipped).")
+@click.option("--model", "model_path", default=None, help=MODEL_HELP)
 def render(scene_file: str, output: str, title: str | None, show_probabilities: bool, model_path: str | None) -> None:
     """Draw a scene: oblique view and sensor view, boxes coloured by how many they support."""
     from pathlib import Path

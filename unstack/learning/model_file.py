@@ -38,10 +38,12 @@ from unstack.learning.classifier import SupportClassifier
 from unstack.learning.features import FeatureSettings
 
 __all__ = [
+    "BUNDLED_MODELS",
     "DEFAULT_MODEL",
     "MODEL_FORMAT",
     "InvalidModel",
     "SupportModel",
+    "bundled_model_path",
     "default_model_path",
     "load_model",
     "save_model",
@@ -50,6 +52,10 @@ __all__ = [
 MODEL_FORMAT = "unstack.model/1"
 #: File name of the model shipped with the package (``unstack/learning/models``).
 DEFAULT_MODEL = "default-paper2.skops"
+#: Models shipped with the package, by the name ``--model`` accepts: ``paper`` (the default:
+#: the paper's SVM and 19 features) and ``extended`` (gradient boosting on the extended
+#: features, split by pile; better decisions, see the results page).
+BUNDLED_MODELS = {"paper": DEFAULT_MODEL, "extended": "extended-paper2.skops"}
 
 
 #: scikit-learn types a model may hold beyond those skops trusts by default: the internals
@@ -182,4 +188,15 @@ def load_model(path: str | os.PathLike[str]) -> SupportModel:
 
 def default_model_path() -> Path:
     """Where the model shipped with the package lies."""
-    return Path(str(resources.files("unstack.learning") / "models" / DEFAULT_MODEL))
+    return bundled_model_path("paper")
+
+
+def bundled_model_path(name: str) -> Path:
+    """Where the shipped model called ``name`` (a key of :data:`BUNDLED_MODELS`) lies.
+
+    Examples
+    --------
+    >>> bundled_model_path("extended").name
+    'extended-paper2.skops'
+    """
+    return Path(str(resources.files("unstack.learning") / "models" / BUNDLED_MODELS[name]))
