@@ -51,21 +51,58 @@ def test_cloud_over_a_box_and_between_two(stack: list[Box]) -> None:
     assert row["cloud_in_pair_box"] == pytest.approx(0.75)
 
 
+def reference_cloud(bb_x: np.ndarray, bb_y: np.ndarray, points: np.ndarray) -> list[float]:
+    """The cloud columns written out with numpy masks, one pair at a time (the oracle)."""
+
+    def column(low: np.ndarray, high: np.ndarray) -> np.ndarray:
+        return (points[:, 0] >= low[0]) & (points[:, 0] <= high[0]) & (points[:, 1] >= low[1]) & (points[:, 1] <= high[1])
+
+    def above(bb: np.ndarray) -> tuple[float, float]:
+        over = column(bb[:2], bb[3:5]) & (points[:, 2] > bb[5] + 0.01)
+        return (float(points[over, 2].max() - bb[5]), float(over.mean())) if over.any() else (0.0, 0.0)
+
+    low, high = np.maximum(bb_x[:2], bb_y[:2]) - 0.05, np.minimum(bb_x[3:5], bb_y[3:5]) + 0.05
+    bottom, top = bb_x[5] + 0.01, bb_y[2] - 0.01
+    between = 0.0
+    if not (np.any(high <= low) or top <= bottom):
+        between = float((column(low, high) & (points[:, 2] > bottom) & (points[:, 2] < top)).mean())
+    pair_low, pair_high = np.minimum(bb_x[:3], bb_y[:3]), np.maximum(bb_x[3:], bb_y[3:])
+    in_pair_box = float(np.all((points >= pair_low) & (points <= pair_high), axis=1).mean())
+    (rise_x, share_x), (rise_y, share_y) = above(bb_x), above(bb_y)
+    return [between, rise_x, rise_y, share_x, share_y, in_pair_box]
+
+
 @settings(max_examples=40, deadline=None)
 @given(st.integers(0, 2**32 - 1))
-def test_cloud_shares_match_a_brute_force_count(seed: int) -> None:
+def test_cloud_columns_match_numpy_masks(seed: int) -> None:
+    from unstack.learning.features import bounding_boxes
+
     rng = np.random.default_rng(seed)
-    boxes = [Box(f"b{k}", rng.uniform(0.2, 0.6, 3), rng.uniform(0, 1.5, 3)) for k in range(3)]
+    turns = rng.normal(size=(4, 4))
+    turns /= np.linalg.norm(turns, axis=1, keepdims=True)
+    centres = rng.uniform([0.5, 0.5, 0.0], [1.0, 1.0, 1.5], size=(4, 3))  # close: footprints overlap
+    boxes = [Box(f"b{k}", rng.uniform(0.2, 0.6, 3), centres[k], turns[k]) for k in range(4)]
     points = rng.uniform(-0.2, 2.0, size=(500, 3))
-    rows = contact_features(boxes, points, [(0, 1), (2, 0)])
-    for row, (first, second) in zip(rows, [(0, 1), (2, 0)], strict=True):
-        low = np.minimum(boxes[first].position - boxes[first].size / 2, boxes[second].position - boxes[second].size / 2)
-        high = np.maximum(
-            boxes[first].position + boxes[first].size / 2, boxes[second].position + boxes[second].size / 2
-        )
-        inside = sum(all(low[a] <= p[a] <= high[a] for a in range(3)) for p in points)
-        assert named(row)["cloud_in_pair_box"] == pytest.approx(inside / len(points))
+    points[:20] = np.round(points[:20], 1)  # some points on faces and edges
+    pairs = [(0, 1), (1, 0), (2, 3), (3, 1)]
+    rows = contact_features(boxes, points, pairs)
+    bounds = bounding_boxes(boxes)
+    for row, (first, second) in zip(rows, pairs, strict=True):
+        assert row[10:16] == pytest.approx(reference_cloud(bounds[first], bounds[second], points), abs=1e-12)
         assert 0.0 <= named(row)["cloud_between"] <= 1.0
+
+
+@pytest.mark.parametrize("cell", [0.01, 0.3, 5.0])
+def test_counts_do_not_depend_on_the_grid(cell: float, monkeypatch: pytest.MonkeyPatch, rng: np.random.Generator) -> None:
+    import unstack.learning.contact_features as module
+
+    boxes = [Box(f"b{k}", [0.4, 0.3, 0.3], [0.2 * k, 0.1 * k, 0.15 + 0.3 * k]) for k in range(5)]
+    points = rng.uniform(-0.5, 2.0, size=(3000, 3))
+    pairs = [(i, j) for i in range(5) for j in range(5) if i != j]
+    expected = contact_features(boxes, points, pairs)
+    monkeypatch.setattr(module, "GRID_CELL", cell)
+    assert np.array_equal(contact_features(boxes, points, pairs), expected)
+    assert expected[:, 15].min() > 0  # every pair box holds points: the counts are not trivially 0
 
 
 def test_extended_set_appends_the_contact_features(stack: list[Box], rng: np.random.Generator) -> None:

@@ -70,6 +70,9 @@ CONTACT_FEATURE_NAMES: tuple[str, ...] = (
 )
 #: Widening of the column between two boxes in which cloud points count as "between" (metres).
 COLUMN_MARGIN = 0.05
+#: Side of the square xy columns the cloud is bucketed into for counting (metres; any value
+#: gives the same counts, this one the fastest measured on container clouds).
+GRID_CELL = 0.05
 #: Points closer than this to a box's top or bottom face belong to the face (metres).
 FACE_TOLERANCE = 0.01
 
@@ -96,34 +99,27 @@ def _geometry(bb_x: np.ndarray, bb_y: np.ndarray) -> np.ndarray:
     )
 
 
-def _in_footprint(points: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
-    inside: np.ndarray = (
-        (points[:, 0] >= low[0]) & (points[:, 0] <= high[0]) & (points[:, 1] >= low[1]) & (points[:, 1] <= high[1])
+def _cloud_queries(bounds: np.ndarray, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Closed query boxes ``low <= p <= high``: over each box, then between and around each pair.
+
+    Open bounds (strictly above a top, strictly between two faces) become closed ones by
+    moving them to the next float, so the counts are exact.
+    """
+    up, down = np.inf, -np.inf
+    above_low = np.column_stack([bounds[:, :2], np.nextafter(bounds[:, 5] + FACE_TOLERANCE, up)])
+    above_high = np.column_stack([bounds[:, 3:5], np.full(len(bounds), up)])
+    bb_x, bb_y = bounds[x], bounds[y]
+    between_low = np.column_stack(
+        [np.maximum(bb_x[:, :2], bb_y[:, :2]) - COLUMN_MARGIN, np.nextafter(bb_x[:, 5] + FACE_TOLERANCE, up)]
     )
-    return inside
-
-
-def _above(points: np.ndarray, bb: np.ndarray) -> tuple[float, float]:
-    """(rise of the highest point over the footprint above the top, share of points there)."""
-    over = _in_footprint(points, bb[:2], bb[3:5]) & (points[:, 2] > bb[5] + FACE_TOLERANCE)
-    if not over.any():
-        return 0.0, 0.0
-    return float(points[over, 2].max() - bb[5]), float(over.mean())
-
-
-def _between(points: np.ndarray, bb_x: np.ndarray, bb_y: np.ndarray) -> float:
-    low = np.maximum(bb_x[:2], bb_y[:2]) - COLUMN_MARGIN
-    high = np.minimum(bb_x[3:5], bb_y[3:5]) + COLUMN_MARGIN
-    bottom, top = bb_x[5] + FACE_TOLERANCE, bb_y[2] - FACE_TOLERANCE
-    if np.any(high <= low) or top <= bottom:
-        return 0.0
-    column = _in_footprint(points, low, high) & (points[:, 2] > bottom) & (points[:, 2] < top)
-    return float(column.mean())
-
-
-def _in_pair_box(points: np.ndarray, bb_x: np.ndarray, bb_y: np.ndarray) -> float:
-    low, high = np.minimum(bb_x[:3], bb_y[:3]), np.maximum(bb_x[3:], bb_y[3:])
-    return float(np.all((points >= low) & (points <= high), axis=1).mean())
+    between_high = np.column_stack(
+        [np.minimum(bb_x[:, 3:5], bb_y[:, 3:5]) + COLUMN_MARGIN, np.nextafter(bb_y[:, 2] - FACE_TOLERANCE, down)]
+    )
+    pair_low, pair_high = np.minimum(bb_x[:, :3], bb_y[:, :3]), np.maximum(bb_x[:, 3:], bb_y[:, 3:])
+    return (
+        np.ascontiguousarray(np.vstack([above_low, between_low, pair_low])),
+        np.ascontiguousarray(np.vstack([above_high, between_high, pair_high])),
+    )
 
 
 def contact_features(boxes: Sequence[Box], points: np.ndarray, pairs: Sequence[tuple[int, int]]) -> np.ndarray:
@@ -140,18 +136,19 @@ def contact_features(boxes: Sequence[Box], points: np.ndarray, pairs: Sequence[t
     points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     cloud = np.zeros((len(index), 7))
     if len(points):
-        above = np.array([_above(points, bb) for bb in bounds])
-        for row, (first, second) in enumerate(zip(x, y, strict=True)):
-            bb_x, bb_y = bounds[first], bounds[second]
-            cloud[row] = [
-                _between(points, bb_x, bb_y),
-                above[first, 0],
-                above[second, 0],
-                above[first, 1],
-                above[second, 1],
-                _in_pair_box(points, bb_x, bb_y),
-                0.0,
-            ]
+        from unstack.learning._contact_kernel import column_index, counts_in_boxes
+
+        low, high = _cloud_queries(bounds, x, y)
+        columns = column_index(points, GRID_CELL)
+        counts, highest = counts_in_boxes(*columns, GRID_CELL, low, high)
+        shares = counts / len(points)
+        n_boxes, n_pairs = len(bounds), len(index)
+        above_share = shares[:n_boxes]
+        rise = np.where(counts[:n_boxes] > 0, highest[:n_boxes] - bounds[:, 5], 0.0)
+        cloud[:, 0] = shares[n_boxes : n_boxes + n_pairs]  # empty queries (low > high) count nothing
+        cloud[:, 1], cloud[:, 2] = rise[x], rise[y]
+        cloud[:, 3], cloud[:, 4] = above_share[x], above_share[y]
+        cloud[:, 5] = shares[n_boxes + n_pairs :]
     low, high = np.minimum(bounds[x, :3], bounds[y, :3]), np.maximum(bounds[x, 3:], bounds[y, 3:])
     cloud[:, 6] = np.prod(high - low, axis=1)
     return np.column_stack([geometry, cloud])
