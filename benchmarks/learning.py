@@ -26,8 +26,8 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
-from unstack.learning.features import FeatureSettings, interest_points, pair_features
 from unstack.learning.contact_features import contact_features
+from unstack.learning.features import FeatureSettings, interest_points, pair_features
 from unstack.learning.model_file import bundled_model_path, default_model_path, load_model
 from unstack.scene import Box
 
