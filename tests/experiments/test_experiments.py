@@ -150,3 +150,23 @@ def test_recall_threshold_is_the_largest_reaching_the_recall(recall: float, expe
     threshold = _recall_threshold(truth, probability, recall)
     assert threshold == expected
     assert np.mean(probability[truth == 1] >= threshold) >= recall
+
+
+def test_unloading_resumes_from_its_checkpoints(
+    small_dataset: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import unstack.sim.unloading as simulator
+    from unstack.experiments.unloading import unloading_experiment
+
+    model = load_model(default_model_path())
+    first = unloading_experiment(small_dataset, model, configs=1, time_limit=0.1, checkpoints=tmp_path)
+    assert len(list(tmp_path.glob("*.json"))) == 1
+
+    def no_simulation(*_: object, **__: object) -> None:
+        raise AssertionError("a finished pile was simulated again")
+
+    monkeypatch.setattr(simulator, "execute_unloading", no_simulation)
+    again = unloading_experiment(small_dataset, model, configs=1, time_limit=0.1, checkpoints=tmp_path)
+    assert again == first
+    with pytest.raises(AssertionError, match="simulated again"):  # another seed is another run
+        unloading_experiment(small_dataset, model, configs=1, time_limit=0.1, seed=5, checkpoints=tmp_path)

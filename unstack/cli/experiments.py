@@ -38,6 +38,14 @@ def _out(out: str) -> Path:
     return folder
 
 
+def _paired(difference: dict[str, float | None] | None) -> str:
+    """``+0.16 ± 0.08``: a paired difference and its standard error (blank for unstack itself)."""
+    if difference is None:
+        return ""
+    error = difference["standard_error"]
+    return f"{difference['mean']:+.2f}" + ("" if error is None else f" ± {error:.2f}")
+
+
 def _write_json(path: Path, data: object) -> None:
     from unstack.jsonio import atomic_write_text
 
@@ -198,7 +206,7 @@ def decisions(
             f"{row['mse_cost']:.3f}",
             f"{100 * row['first_pick_right']:.1f} %",
             f"{row['boxes_moved']:.2f}",
-            f"{paired['mean']:+.2f} ± {paired['standard_error']:.2f}" if paired else "",
+            _paired(paired),
             f"{row['displacement_m']:.3f}",
         )
     Console().print(table)
@@ -250,7 +258,11 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
 def unload(
     data_dir: str, out: str, model_path: str | None, configs: int, time_limit: float, seed: int, full: bool
 ) -> None:
-    """Order every detected box of each pile and execute the orders in the simulator, box by box."""
+    """Order every detected box of each pile and execute the orders in the simulator, box by box.
+
+    Resumable: each pile's result is kept in OUT/unloading-piles as soon as it is done, and a
+    run started again with the same piles, model, time limit and seed reuses them.
+    """
     from unstack.cli.learning import load_support_model
     from unstack.experiments.unloading import UNLOADING_MAKERS, plot_unloading, unloading_experiment
     from unstack.sim.dataset import require_configurations
@@ -262,8 +274,9 @@ def unload(
     folder = _out(out)
     with progress_bar("piles") as report:
         result = unloading_experiment(
-            data_dir, model, configs=configs, time_limit=time_limit, seed=seed, progress=report
-        )
+            data_dir, model, configs=configs, time_limit=time_limit, seed=seed, progress=report,
+            checkpoints=folder / "unloading-piles",
+        )  # fmt: skip
     result["model"] = name
     _write_json(folder / "unloading.json", result)
     plot_unloading(result, folder / "unloading.png")
@@ -283,7 +296,7 @@ def unload(
         table.add_row(
             maker,
             f"{row['boxes_moved_per_pile']:.2f}",
-            f"{paired['mean']:+.2f} ± {paired['standard_error']:.2f}" if paired else "",
+            _paired(paired),
             f"{row['boxes_moved_per_pick']:.3f}",
             f"{100 * row['calm_picks']:.1f} %",
             f"{row['displacement_m_per_pile']:.3f}",

@@ -58,8 +58,8 @@ def squared_regret(costs: np.ndarray, choice: int) -> float:
     return float((costs[choice] - costs.min()) ** 2)
 
 
-def paired_difference(other: np.ndarray, ours: np.ndarray) -> dict[str, float]:
-    """Mean of ``other - ours`` over the same cases, with its standard error.
+def paired_difference(other: np.ndarray, ours: np.ndarray) -> dict[str, float | None]:
+    """Mean of ``other - ours`` over the same cases, with its standard error (None from one case).
 
     Examples
     --------
@@ -67,7 +67,7 @@ def paired_difference(other: np.ndarray, ours: np.ndarray) -> dict[str, float]:
     {'mean': 1.0, 'standard_error': 0.5773502691896258}
     """
     difference = np.asarray(other, dtype=np.float64) - np.asarray(ours, dtype=np.float64)
-    spread = float(difference.std(ddof=1) / np.sqrt(len(difference))) if len(difference) > 1 else float("nan")
+    spread = float(difference.std(ddof=1) / np.sqrt(len(difference))) if len(difference) > 1 else None
     return {"mean": float(difference.mean()), "standard_error": spread}
 
 

@@ -77,6 +77,36 @@ def unloading_orders(scene: Any, model: Any, *, time_limit: float, seed: int) ->
     }
 
 
+def _pile_key(path: Path, model: Any, time_limit: float, seed: int) -> dict[str, Any]:
+    """What a pile's result depends on: the scene file, the model, the time limit and the seed."""
+    import hashlib
+    import json
+
+    model_digest = hashlib.sha256(json.dumps(model.metadata, sort_keys=True, default=str).encode()).hexdigest()
+    return {
+        "scene": path.name,
+        "scene_sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
+        "model_sha256": model_digest,
+        "time_limit": time_limit,
+        "seed": seed,
+    }
+
+
+def _finished_pile(checkpoints: Path | None, key: dict[str, Any]) -> dict[str, Any] | None:
+    """The stored result of a pile run with the same key, if any (a damaged file is redone)."""
+    import json
+
+    if checkpoints is None:
+        return None
+    stored = checkpoints / f"{Path(key['scene']).stem}.json"
+    try:
+        document = json.loads(stored.read_text())
+    except (OSError, ValueError):
+        return None
+    result: dict[str, Any] | None = document.get("result") if document.get("key") == key else None
+    return result
+
+
 def unloading_experiment(
     data_dir: str | os.PathLike[str],
     model: Any,
@@ -85,19 +115,37 @@ def unloading_experiment(
     time_limit: float = 0.3,
     seed: int = 0,
     progress: Callable[[int, int], None] | None = None,
+    checkpoints: str | os.PathLike[str] | None = None,
 ) -> dict[str, Any]:
-    """Order and execute the detected boxes of the first ``configs`` piles of a data set."""
+    """Order and execute the detected boxes of the first ``configs`` piles of a data set.
+
+    ``checkpoints``: a folder where each pile's result is stored as soon as it is done; a run
+    that is stopped and started again with the same scenes, model, time limit and seed reuses
+    them (resumable). Results do not depend on resuming: each pile has its own seed.
+    """
+    import json
+
+    from unstack.jsonio import atomic_write_text
     from unstack.scene import load_scene
     from unstack.sim.dataset import require_configurations
     from unstack.sim.unloading import execute_unloading
 
     files = require_configurations(data_dir)[:configs]
+    folder = None if checkpoints is None else Path(checkpoints)
+    if folder is not None:
+        folder.mkdir(parents=True, exist_ok=True)
     piles: list[dict[str, Any]] = []
     for number, path in enumerate(files):
-        scene = load_scene(path)
-        orders = unloading_orders(scene, model, time_limit=time_limit, seed=seed + number)
-        executed = {maker: execute_unloading(scene, orders[maker]).to_dict() for maker in UNLOADING_MAKERS}
-        piles.append({"scene": path.name, "boxes": len(scene.boxes), "detected": len(scene.detected), "runs": executed})
+        key = _pile_key(path, model, time_limit, seed + number)
+        pile = _finished_pile(folder, key)
+        if pile is None:
+            scene = load_scene(path)
+            orders = unloading_orders(scene, model, time_limit=time_limit, seed=seed + number)
+            executed = {maker: execute_unloading(scene, orders[maker]).to_dict() for maker in UNLOADING_MAKERS}
+            pile = {"scene": path.name, "boxes": len(scene.boxes), "detected": len(scene.detected), "runs": executed}
+            if folder is not None:
+                atomic_write_text(folder / f"{path.stem}.json", json.dumps({"key": key, "result": pile}) + "\n")
+        piles.append(pile)
         if progress is not None:
             progress(number + 1, len(files))
     summary = {}
