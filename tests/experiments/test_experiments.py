@@ -125,9 +125,11 @@ def test_real7_command(small_dataset: Path, tmp_path: Path) -> None:
 
 def test_unload_command_executes_every_order(small_dataset: Path, tmp_path: Path) -> None:
     result = unstack("experiment", "unload", str(small_dataset), "--out", str(tmp_path), "--configs", "2",
-                     "--time-limit", "0.1")  # fmt: skip
+                     "--time-limit", "0.1", "--closed-loop")  # fmt: skip
     assert result.returncode == 0, result.stderr
     document = json.loads((tmp_path / "unloading.json").read_text())
+    assert document["makers"][-2:] == ["reasoner_closed_loop", "highest_closed_loop"]
+    assert set(document["summary"]) == set(document["makers"])
     assert (tmp_path / "unloading.png").read_bytes()[:4] == b"\x89PNG"
     assert document["configs"] == 2
     for pile in document["piles"]:

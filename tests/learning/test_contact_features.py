@@ -55,7 +55,9 @@ def reference_cloud(bb_x: np.ndarray, bb_y: np.ndarray, points: np.ndarray) -> l
     """The cloud columns written out with numpy masks, one pair at a time (the oracle)."""
 
     def column(low: np.ndarray, high: np.ndarray) -> np.ndarray:
-        return (points[:, 0] >= low[0]) & (points[:, 0] <= high[0]) & (points[:, 1] >= low[1]) & (points[:, 1] <= high[1])
+        return (
+            (points[:, 0] >= low[0]) & (points[:, 0] <= high[0]) & (points[:, 1] >= low[1]) & (points[:, 1] <= high[1])
+        )
 
     def above(bb: np.ndarray) -> tuple[float, float]:
         over = column(bb[:2], bb[3:5]) & (points[:, 2] > bb[5] + 0.01)
@@ -93,7 +95,9 @@ def test_cloud_columns_match_numpy_masks(seed: int) -> None:
 
 
 @pytest.mark.parametrize("cell", [0.01, 0.3, 5.0])
-def test_counts_do_not_depend_on_the_grid(cell: float, monkeypatch: pytest.MonkeyPatch, rng: np.random.Generator) -> None:
+def test_counts_do_not_depend_on_the_grid(
+    cell: float, monkeypatch: pytest.MonkeyPatch, rng: np.random.Generator
+) -> None:
     import unstack.learning.contact_features as module
 
     boxes = [Box(f"b{k}", [0.4, 0.3, 0.3], [0.2 * k, 0.1 * k, 0.15 + 0.3 * k]) for k in range(5)]

@@ -9,7 +9,7 @@ import pytest
 from unstack.errors import UnstackError
 from unstack.scene import Scene, load_scene
 from unstack.sim.dataset import list_configurations
-from unstack.sim.unloading import execute_unloading
+from unstack.sim.unloading import execute_policy, execute_unloading
 
 
 @pytest.fixture
@@ -42,3 +42,27 @@ def test_bad_orders_are_refused(pile: Scene, order: list[str]) -> None:
 def test_a_scene_without_simulation_settings(repo: Path) -> None:
     with pytest.raises(UnstackError, match=r"\$\.metadata\.settings: executing an order needs a simulated scene"):
         execute_unloading(load_scene(repo / "examples" / "scene3.json"), [])
+
+
+def test_a_closed_loop_senses_the_pile_before_each_pick(pile: Scene) -> None:
+    seen: list[Scene] = []
+
+    def lowest_first(current: Scene) -> str:
+        seen.append(current)
+        return min(current.detected, key=lambda box_id: current.box(box_id).position[2])
+
+    run = execute_policy(pile, lowest_first, pile.detected)
+    assert sorted(run.order) == sorted(pile.detected) and len(seen) == len(pile.detected)
+    for number, current in enumerate(seen):
+        assert set(current.detected) == set(pile.detected) - set(run.order[:number])  # boxes left to unload
+        assert len(current.boxes) == len(pile.boxes) - number and len(current.points) > 1000  # a new scan
+    taken = run.order[0]
+    assert not any(box.id == taken for box in seen[1].boxes)
+    moved_box = run.steps[0].moved[0] if run.steps[0].moved else None
+    if moved_box is not None:  # the next scene holds where the disturbed box went, not where it was
+        assert not (seen[1].box(moved_box).position == pile.box(moved_box).position).all()
+
+
+def test_a_policy_must_pick_a_box_left_to_unload(pile: Scene) -> None:
+    with pytest.raises(UnstackError, match="the policy picked 'nope', not one of the boxes left to unload"):
+        execute_policy(pile, lambda current: "nope", pile.detected)

@@ -255,8 +255,17 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of the sampler and the random order.")  # fmt: skip
 @click.option("--full", is_flag=True, help="Every configuration of the data set (overrides --configs).")
+@click.option("--closed-loop", is_flag=True,
+              help="Also unstack and highest-first sensing the pile again before each pick (3x slower).")  # fmt: skip
 def unload(
-    data_dir: str, out: str, model_path: str | None, configs: int, time_limit: float, seed: int, full: bool
+    data_dir: str,
+    out: str,
+    model_path: str | None,
+    configs: int,
+    time_limit: float,
+    seed: int,
+    full: bool,
+    closed_loop: bool,
 ) -> None:
     """Order every detected box of each pile and execute the orders in the simulator, box by box.
 
@@ -264,7 +273,7 @@ def unload(
     run started again with the same piles, model, time limit and seed reuses them.
     """
     from unstack.cli.learning import load_support_model
-    from unstack.experiments.unloading import UNLOADING_MAKERS, plot_unloading, unloading_experiment
+    from unstack.experiments.unloading import plot_unloading, unloading_experiment
     from unstack.sim.dataset import require_configurations
 
     found = len(require_configurations(data_dir))
@@ -275,7 +284,7 @@ def unload(
     with progress_bar("piles") as report:
         result = unloading_experiment(
             data_dir, model, configs=configs, time_limit=time_limit, seed=seed, progress=report,
-            checkpoints=folder / "unloading-piles",
+            checkpoints=folder / "unloading-piles", closed_loop=closed_loop,
         )  # fmt: skip
     result["model"] = name
     _write_json(folder / "unloading.json", result)
@@ -290,7 +299,7 @@ def unload(
         "displacement (m)",
     ):
         table.add_column(column, justify="right")
-    for maker in UNLOADING_MAKERS:
+    for maker in result["makers"]:
         row = result["summary"][maker]
         paired = result["against_reasoner"].get(maker, {}).get("boxes_moved")
         table.add_row(

@@ -18,7 +18,7 @@ Examples
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -27,7 +27,7 @@ import numpy as np
 from unstack.errors import UnstackError
 from unstack.scene import Scene
 
-__all__ = ["UnloadRun", "UnloadStep", "execute_unloading"]
+__all__ = ["UnloadRun", "UnloadStep", "execute_policy", "execute_unloading"]
 
 #: Seconds of simulation to let a rebuilt pile find its contacts before the first removal.
 RESETTLE_SECONDS = 0.5
@@ -107,12 +107,59 @@ def execute_unloading(scene: Scene, order: Sequence[str]) -> UnloadRun:
     -------
     UnloadRun
     """
-    from unstack.sim.ground_truth import PARKING, run_horizon
-    from unstack.sim.world import PhysicsWorld, rotation_angles_deg
-
     unknown = [box_id for box_id in order if box_id not in scene.box_ids]
     if unknown or len(set(order)) != len(order):
         raise UnstackError(f"{scene.source}: the order names unknown or repeated boxes: {unknown or list(order)}")
+    return _execute(scene, len(order), lambda number, _world, _in_place: order[number])
+
+
+def execute_policy(scene: Scene, policy: Callable[[Scene], str], boxes: Sequence[str]) -> UnloadRun:
+    """Unload ``boxes`` in a closed loop: before each pick, sense the pile again and ask ``policy``.
+
+    Before every removal the scene is rebuilt from the world as it is then: the poses of the
+    boxes still in place, a new point cloud from the scene's sensor, and as ``detected`` the
+    boxes of ``boxes`` not yet taken (the robot keeps track of what it detected). ``policy``
+    returns one of them. This is how a robot would run (the open-loop
+    :func:`execute_unloading` executes an order planned on the untouched pile).
+
+    Parameters
+    ----------
+    scene : Scene
+        A simulated scene.
+    policy : callable
+        ``policy(current_scene) -> box id`` among ``current_scene.detected``.
+    boxes : sequence of str
+        The boxes to unload (typically the scene's detected boxes).
+    """
+    from unstack.scene import Box
+    from unstack.sim.sensor import scan_pile
+
+    settings = _scene_settings(scene)
+    remaining = list(boxes)
+
+    def sense_and_pick(number: int, world: Any, in_place: list[str]) -> str:
+        positions, orientations = world.poses([world.boxes[scene.box_ids.index(box_id)] for box_id in in_place])
+        current_boxes = [
+            Box(box_id, scene.box(box_id).size, position, orientation, mass=scene.box(box_id).mass)
+            for box_id, position, orientation in zip(in_place, positions, orientations / np.linalg.norm(
+                orientations, axis=1, keepdims=True), strict=True)
+        ]  # fmt: skip
+        scan = scan_pile(world, settings.sensor, seed=number)
+        current = Scene(current_boxes, scan.points, remaining, metadata=scene.metadata, source=scene.source)
+        choice = policy(current)
+        if choice not in remaining:
+            raise UnstackError(f"{scene.source}: the policy picked {choice!r}, not one of the boxes left to unload")
+        remaining.remove(choice)
+        return choice
+
+    return _execute(scene, len(remaining), sense_and_pick)
+
+
+def _execute(scene: Scene, count: int, next_box: Callable[[int, Any, list[str]], str]) -> UnloadRun:
+    """Rebuild the pile, then ``count`` times: take out ``next_box(step, world, in_place)`` and measure."""
+    from unstack.sim.ground_truth import PARKING, run_horizon
+    from unstack.sim.world import PhysicsWorld, rotation_angles_deg
+
     settings = _scene_settings(scene)
     truth = settings.ground_truth
     with PhysicsWorld(settings, door=False) as world:
@@ -126,7 +173,10 @@ def execute_unloading(scene: Scene, order: Sequence[str]) -> UnloadRun:
         drift = float(np.max(np.linalg.norm(settled - start, axis=1), initial=0.0))
         in_place = list(scene.box_ids)
         steps = []
-        for number, box_id in enumerate(order):
+        order = []
+        for number in range(count):
+            box_id = next_box(number, world, list(in_place))
+            order.append(box_id)
             in_place.remove(box_id)
             watched = [bodies[other] for other in in_place]
             before, before_turn = world.poses(watched)
