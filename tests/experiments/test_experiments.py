@@ -125,7 +125,7 @@ def test_real7_command(small_dataset: Path, tmp_path: Path) -> None:
 
 def test_unload_command_executes_every_order(small_dataset: Path, tmp_path: Path) -> None:
     result = unstack("experiment", "unload", str(small_dataset), "--out", str(tmp_path), "--configs", "2",
-                     "--time-limit", "0.1", "--closed-loop")  # fmt: skip
+                     "--time-limit", "0.1", "--closed-loop", "--jobs", "2")  # fmt: skip
     assert result.returncode == 0, result.stderr
     document = json.loads((tmp_path / "unloading.json").read_text())
     assert document["makers"][-2:] == ["reasoner_closed_loop", "highest_closed_loop"]

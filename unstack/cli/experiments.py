@@ -257,6 +257,7 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
 @click.option("--full", is_flag=True, help="Every configuration of the data set (overrides --configs).")
 @click.option("--closed-loop", is_flag=True,
               help="Also unstack and highest-first sensing the pile again before each pick (3x slower).")  # fmt: skip
+@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Piles run in parallel.")
 def unload(
     data_dir: str,
     out: str,
@@ -266,6 +267,7 @@ def unload(
     seed: int,
     full: bool,
     closed_loop: bool,
+    jobs: int,
 ) -> None:
     """Order every detected box of each pile and execute the orders in the simulator, box by box.
 
@@ -284,7 +286,7 @@ def unload(
     with progress_bar("piles") as report:
         result = unloading_experiment(
             data_dir, model, configs=configs, time_limit=time_limit, seed=seed, progress=report,
-            checkpoints=folder / "unloading-piles", closed_loop=closed_loop,
+            checkpoints=folder / "unloading-piles", closed_loop=closed_loop, n_jobs=jobs,
         )  # fmt: skip
     result["model"] = name
     _write_json(folder / "unloading.json", result)
