@@ -75,6 +75,7 @@ def test_experiment_commands(small_dataset: Path, tmp_path: Path) -> None:
         (["decisions", "examples", "--out", "{tmp}", "--r", "1"], "expected --r >= 2 and --isets >= 1"),
         (["unload", "examples", "--out", "{tmp}"], "examples: expected a data set folder with config-NNNN.json"),
         (["fig5a", "{data}", "--out", "{tmp}", "--full"], "--full is the paper's size: 200 configurations and 10"),
+        (["unload", "{data}", "--out", "{tmp}", "--scheduler", "nowhere"], "expected an address like tcp://HOST:PORT"),
     ],
 )
 def test_experiment_bad_input(arguments: list[str], message: str, tmp_path: Path, small_dataset: Path) -> None:
@@ -172,3 +173,19 @@ def test_unloading_resumes_from_its_checkpoints(
     assert again == first
     with pytest.raises(AssertionError, match="simulated again"):  # another seed is another run
         unloading_experiment(small_dataset, model, configs=1, time_limit=0.1, seed=5, checkpoints=tmp_path)
+
+
+def test_unloading_runs_on_a_dask_cluster(small_dataset: Path) -> None:
+    from distributed import Client, LocalCluster
+
+    from unstack.experiments.unloading import unloading_experiment
+
+    model = load_model(default_model_path())
+    with (
+        LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster,
+        Client(cluster) as client,
+    ):
+        result = unloading_experiment(small_dataset, model, configs=2, time_limit=0.1, client=client)
+    assert [pile["scene"] for pile in result["piles"]] == ["config-0000.json", "config-0001.json"]
+    for pile in result["piles"]:
+        assert all(sorted(run["order"]) == sorted(pile["runs"]["highest"]["order"]) for run in pile["runs"].values())

@@ -258,6 +258,8 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
 @click.option("--closed-loop", is_flag=True,
               help="Also unstack and highest-first sensing the pile again before each pick (3x slower).")  # fmt: skip
 @click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Piles run in parallel.")
+@click.option("--scheduler", default=None,
+              help="Address of a dask.distributed scheduler (tcp://HOST:PORT): piles run on its workers.")  # fmt: skip
 def unload(
     data_dir: str,
     out: str,
@@ -268,6 +270,7 @@ def unload(
     full: bool,
     closed_loop: bool,
     jobs: int,
+    scheduler: str | None,
 ) -> None:
     """Order every detected box of each pile and execute the orders in the simulator, box by box.
 
@@ -282,12 +285,19 @@ def unload(
     if full:
         configs = found
     model, name = load_support_model(model_path)
+    from unstack.sim.dataset import connect_scheduler
+
+    client = connect_scheduler(scheduler) if scheduler else None  # fails in seconds, before any output
     folder = _out(out)
-    with progress_bar("piles") as report:
-        result = unloading_experiment(
-            data_dir, model, configs=configs, time_limit=time_limit, seed=seed, progress=report,
-            checkpoints=folder / "unloading-piles", closed_loop=closed_loop, n_jobs=jobs,
-        )  # fmt: skip
+    try:
+        with progress_bar("piles") as report:
+            result = unloading_experiment(
+                data_dir, model, configs=configs, time_limit=time_limit, seed=seed, progress=report,
+                checkpoints=folder / "unloading-piles", closed_loop=closed_loop, n_jobs=jobs, client=client,
+            )  # fmt: skip
+    finally:
+        if client is not None:
+            client.close()
     result["model"] = name
     _write_json(folder / "unloading.json", result)
     plot_unloading(result, folder / "unloading.png")

@@ -36,7 +36,7 @@ Examples
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -157,6 +157,15 @@ def _run_pile(
     return number, {"scene": path.name, "boxes": len(scene.boxes), "detected": len(scene.detected), "runs": executed}
 
 
+def _on_cluster(client: Any, arguments: list[tuple[Any, ...]]) -> Iterator[tuple[int, dict[str, Any]]]:
+    """Run the piles on a dask.distributed cluster, yielding results as they finish."""
+    from distributed import as_completed
+
+    futures = [client.submit(_run_pile, *task, pure=False) for task in arguments]
+    for future in as_completed(futures):  # type: ignore[no-untyped-call]
+        yield future.result()
+
+
 def unloading_experiment(
     data_dir: str | os.PathLike[str],
     model: Any,
@@ -168,6 +177,7 @@ def unloading_experiment(
     checkpoints: str | os.PathLike[str] | None = None,
     closed_loop: bool = False,
     n_jobs: int = 1,
+    client: Any = None,
 ) -> dict[str, Any]:
     """Order and execute the detected boxes of the first ``configs`` piles of a data set.
 
@@ -175,7 +185,8 @@ def unloading_experiment(
     that is stopped and started again with the same scenes, model, time limit and seed reuses
     them (resumable). Results do not depend on resuming: each pile has its own seed.
     ``closed_loop``: also run the :data:`CLOSED_LOOP_MAKERS` (about three times slower).
-    ``n_jobs``: piles run in parallel processes (the results do not depend on it).
+    ``n_jobs``: piles run in parallel processes; ``client``: on the workers of a
+    ``distributed.Client`` instead (the results do not depend on either).
     """
     import json
 
@@ -192,10 +203,14 @@ def unloading_experiment(
     todo = [number for number, pile in enumerate(piles) if pile is None]
     if progress is not None:
         progress(len(files) - len(todo), len(files))
-    tasks = (
-        delayed(_run_pile)(files[number], number, model, time_limit, seed + number, closed_loop) for number in todo
-    )
-    for number, pile in Parallel(n_jobs=n_jobs, return_as="generator_unordered")(tasks):
+    arguments = [(files[number], number, model, time_limit, seed + number, closed_loop) for number in todo]
+    if client is None:
+        results = Parallel(n_jobs=n_jobs, return_as="generator_unordered")(
+            delayed(_run_pile)(*task) for task in arguments
+        )
+    else:
+        results = _on_cluster(client, arguments)
+    for number, pile in results:
         piles[number] = pile
         if folder is not None:
             from unstack.jsonio import atomic_write_text

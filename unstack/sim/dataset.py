@@ -51,6 +51,7 @@ __all__ = [
     "DatasetConflict",
     "DatasetSummary",
     "SchedulerUnavailable",
+    "connect_scheduler",
     "list_configurations",
     "read_manifest",
     "require_configurations",
@@ -212,7 +213,7 @@ def _run_local(todo: list[int], settings: SimulationSettings, seed: int, jobs: i
     yield from parallel(delayed(simulate_configuration)(settings, seed=seed, index=index) for index in todo)
 
 
-def _connect(scheduler: str) -> Any:
+def connect_scheduler(scheduler: str) -> Any:
     """A dask.distributed client, or a one-line error within :data:`SCHEDULER_TIMEOUT`."""
     if not SCHEDULER_ADDRESS.match(scheduler):
         raise SchedulerUnavailable(f"--scheduler: expected an address like tcp://HOST:PORT, got {scheduler!r}")
@@ -287,7 +288,7 @@ def simulate_dataset(
     manifest = read_manifest(target) if target.is_dir() else None
     if manifest is not None:
         _check_same_dataset(target, manifest, settings, seed)
-    client = _connect(scheduler) if scheduler else None
+    client = connect_scheduler(scheduler) if scheduler else None
     target.mkdir(parents=True, exist_ok=True)
     _clean_temporaries(target)
     _write_manifest(target, settings, seed, configs)
