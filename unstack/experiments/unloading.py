@@ -192,6 +192,7 @@ def unloading_experiment(
 
     from joblib import Parallel, delayed
 
+    from unstack.jsonio import atomic_write_text
     from unstack.sim.dataset import require_configurations
 
     files = require_configurations(data_dir)[:configs]
@@ -213,8 +214,6 @@ def unloading_experiment(
     for number, pile in results:
         piles[number] = pile
         if folder is not None:
-            from unstack.jsonio import atomic_write_text
-
             stored = {"key": keys[number], "result": pile}
             atomic_write_text(folder / f"{files[number].stem}.json", json.dumps(stored) + "\n")
         if progress is not None:

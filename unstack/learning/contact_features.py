@@ -99,7 +99,9 @@ def _geometry(bb_x: np.ndarray, bb_y: np.ndarray) -> np.ndarray:
     )
 
 
-def _cloud_queries(bounds: np.ndarray, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _cloud_queries(
+    bounds: np.ndarray, x: np.ndarray, y: np.ndarray, pair_box: tuple[np.ndarray, np.ndarray]
+) -> tuple[np.ndarray, np.ndarray]:
     """Closed query boxes ``low <= p <= high``: over each box, then between and around each pair.
 
     Open bounds (strictly above a top, strictly between two faces) become closed ones by
@@ -115,7 +117,7 @@ def _cloud_queries(bounds: np.ndarray, x: np.ndarray, y: np.ndarray) -> tuple[np
     between_high = np.column_stack(
         [np.minimum(bb_x[:, 3:5], bb_y[:, 3:5]) + COLUMN_MARGIN, np.nextafter(bb_y[:, 2] - FACE_TOLERANCE, down)]
     )
-    pair_low, pair_high = np.minimum(bb_x[:, :3], bb_y[:, :3]), np.maximum(bb_x[:, 3:], bb_y[:, 3:])
+    pair_low, pair_high = pair_box
     return (
         np.ascontiguousarray(np.vstack([above_low, between_low, pair_low])),
         np.ascontiguousarray(np.vstack([above_high, between_high, pair_high])),
@@ -133,12 +135,13 @@ def contact_features(boxes: Sequence[Box], points: np.ndarray, pairs: Sequence[t
     x = np.array([row_of[int(value)] for value in index[:, 0]], dtype=np.int64)
     y = np.array([row_of[int(value)] for value in index[:, 1]], dtype=np.int64)
     geometry = _geometry(bounds[x], bounds[y])
+    pair_box = np.minimum(bounds[x, :3], bounds[y, :3]), np.maximum(bounds[x, 3:], bounds[y, 3:])
     points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     cloud = np.zeros((len(index), 7))
     if len(points):
         from unstack.learning._contact_kernel import column_index, counts_in_boxes
 
-        low, high = _cloud_queries(bounds, x, y)
+        low, high = _cloud_queries(bounds, x, y, pair_box)
         columns = column_index(points, GRID_CELL)
         counts, highest = counts_in_boxes(*columns, GRID_CELL, low, high)
         shares = counts / len(points)
@@ -149,6 +152,5 @@ def contact_features(boxes: Sequence[Box], points: np.ndarray, pairs: Sequence[t
         cloud[:, 1], cloud[:, 2] = rise[x], rise[y]
         cloud[:, 3], cloud[:, 4] = above_share[x], above_share[y]
         cloud[:, 5] = shares[n_boxes + n_pairs :]
-    low, high = np.minimum(bounds[x, :3], bounds[y, :3]), np.maximum(bounds[x, 3:], bounds[y, 3:])
-    cloud[:, 6] = np.prod(high - low, axis=1)
+    cloud[:, 6] = np.prod(pair_box[1] - pair_box[0], axis=1)
     return np.column_stack([geometry, cloud])
