@@ -8,6 +8,7 @@ import click
 
 from unstack.cli.learning import MODEL_HELP
 from unstack.errors import UnstackError
+from unstack.sim.settings import FAMILIES, SIZE_SETS
 
 __all__ = ["parse_box_range", "render", "simulate"]
 
@@ -32,14 +33,18 @@ def parse_box_range(text: str) -> tuple[int, int]:
 
 @click.command()
 @click.option("--configs", type=int, default=10, show_default=True, help="Configurations in the data set.")
-@click.option("--boxes", default="30-40", show_default=True, help="Boxes per configuration: COUNT or LOW-HIGH.")
-@click.option("--sizes", default="paper2", show_default=True, help="Box size set: paper2 (two sizes) or four.")
+@click.option("--family", type=click.Choice(list(FAMILIES)), default="dropped", show_default=True,
+              help="Pile family: " + "; ".join(f"{name}: {text}" for name, text in FAMILIES.items())
+              + ". --boxes, --sizes, --depth and --width override the family's values.")  # fmt: skip
+@click.option("--boxes", default=None, help="Boxes per configuration: COUNT or LOW-HIGH (default: the family's).")
+@click.option("--sizes", type=click.Choice(list(SIZE_SETS)), default=None,
+              help="Box size set (default: the family's).")  # fmt: skip
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the data set.")
 @click.option("--out", "out", required=True, type=click.Path(), help="Folder of the data set (created; resumable).")
 @click.option("--jobs", type=int, default=1, show_default=True, help="Worker processes on this machine.")
 @click.option("--scheduler", default=None, help="Address of a dask.distributed scheduler to run the tasks on.")
-@click.option("--depth", type=float, default=2.0, show_default=True, help="Container section depth along x (m).")
-@click.option("--width", type=float, default=2.35, show_default=True,
+@click.option("--depth", type=float, default=None, help="Container section depth along x (m; default: the family's).")
+@click.option("--width", type=float, default=None,
               help="Container section width along y (m); narrower sections stack the boxes higher.")  # fmt: skip
 @click.option("--horizon", type=float, default=1.0, show_default=True, help="Seconds simulated after each removal.")
 @click.option("--noise/--no-noise", default=False, show_default=True, help="Kinect-like depth noise.")
@@ -47,20 +52,24 @@ def parse_box_range(text: str) -> tuple[int, int]:
 @click.option(
     "--min-pixels", type=int, default=50, show_default=True, help="Visible pixels that make a box detectable."
 )
+@click.option("--viewpoint-jitter", type=float, default=0.0, show_default=True,
+              help="Move the sensor of each configuration by up to this much per axis (m).")  # fmt: skip
 def simulate(
     configs: int,
-    boxes: str,
-    sizes: str,
+    family: str,
+    boxes: str | None,
+    sizes: str | None,
     seed: int,
     out: str,
     jobs: int,
     scheduler: str | None,
-    depth: float,
-    width: float,
+    depth: float | None,
+    width: float | None,
     horizon: float,
     noise: bool,
     resolution: str,
     min_pixels: int,
+    viewpoint_jitter: float,
 ) -> None:
     """Simulate piles of boxes in a container: one unstack.scene/1 file per configuration.
 
@@ -71,22 +80,34 @@ def simulate(
     from dataclasses import replace
 
     from unstack.sim.dataset import simulate_dataset
-    from unstack.sim.settings import Container, GroundTruthSettings, SensorSettings, SimulationSettings
+    from unstack.sim.settings import Container, GroundTruthSettings, SensorSettings, family_settings
 
+    base = family_settings(family)
+    depth = base.container.depth if depth is None else depth
+    width = base.container.width if width is None else width
     match = re.fullmatch(r"(\d+)x(\d+)", resolution.strip())
     if not match or min(int(match.group(1)), int(match.group(2))) < 1:
         raise UnstackError(f"--resolution: expected WIDTHxHEIGHT in pixels (for example 640x480), got {resolution!r}")
-    if depth <= 0 or width <= 0 or horizon <= 0:
-        raise UnstackError(f"--depth, --width and --horizon must be positive, got {depth:g}, {width:g} and {horizon:g}")
+    if depth <= 0 or width <= 0 or horizon <= 0 or not 0.0 <= viewpoint_jitter <= 1.0:
+        raise UnstackError(
+            f"--depth, --width and --horizon must be positive and --viewpoint-jitter in [0, 1], got {depth:g}, "
+            f"{width:g}, {horizon:g} and {viewpoint_jitter:g}"
+        )
     if seed < 0:
         raise UnstackError(f"--seed must be a non-negative integer, got {seed}")
     sensor = replace(
-        SensorSettings(), width=int(match.group(1)), height=int(match.group(2)), noise=noise, min_pixels=min_pixels
+        SensorSettings(),
+        width=int(match.group(1)),
+        height=int(match.group(2)),
+        noise=noise,
+        min_pixels=min_pixels,
+        position_jitter=viewpoint_jitter,
     )
-    settings = SimulationSettings(
-        boxes=parse_box_range(boxes),
-        sizes=sizes,
-        container=Container(depth=depth, width=width),
+    settings = replace(
+        base,
+        boxes=base.boxes if boxes is None else parse_box_range(boxes),
+        sizes=base.sizes if sizes is None else sizes,
+        container=Container(depth=depth, width=width, height=base.container.height),
         ground_truth=GroundTruthSettings(horizon=horizon),
         sensor=sensor,
     )

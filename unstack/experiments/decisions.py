@@ -84,7 +84,7 @@ class _Iset:
 
 
 def free_pick(boxes: list[Any]) -> int:
-    from unstack.learning.features import bounding_boxes
+    from unstack.geometry import bounding_boxes
 
     bounds = bounding_boxes(boxes)
     free = []

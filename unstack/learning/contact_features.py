@@ -126,7 +126,7 @@ def _cloud_queries(
 
 def contact_features(boxes: Sequence[Box], points: np.ndarray, pairs: Sequence[tuple[int, int]]) -> np.ndarray:
     """The contact features of each ordered pair ``(X, Y)`` of box indices, shape (len(pairs), 17)."""
-    from unstack.learning.features import bounding_boxes
+    from unstack.geometry import bounding_boxes
 
     index = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
     used = np.unique(index)

@@ -48,6 +48,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from unstack.geometry import bounding_boxes
 from unstack.scene import Box
 
 __all__ = [
@@ -70,7 +71,7 @@ FEATURE_NAMES: tuple[str, ...] = (
     *(f"dbaf_y_{k}" for k in ("+x", "-x", "+y", "-y", "+z", "-z")),
 )
 #: Feature sets of ``FeatureSettings.feature_set``: Eq. 6 alone, or Eq. 6 and the contact features.
-FEATURE_SETS = ("paper", "extended")
+FEATURE_SETS = ("paper", "extended", "general")
 #: Interest points whose truncation ball covers more than this share of the cloud's
 #: bounding box make ``"auto"`` use the direct sum.
 KDTREE_MAX_COVER = 0.05
@@ -90,9 +91,11 @@ class FeatureSettings:
         How the DBAF sums are computed (see the module docstring).
     tolerance : float
         Largest neglected term of the ``kdtree`` method, relative to the largest term.
-    feature_set : {"paper", "extended"}
+    feature_set : {"paper", "extended", "general"}
         ``"paper"``: the 19 numbers of Eq. 6; ``"extended"``: those and the 17 contact
-        features (:mod:`unstack.learning.contact_features`).
+        features (:mod:`unstack.learning.contact_features`); ``"general"``: 18 features
+        that do not depend on how the cloud was sampled
+        (:mod:`unstack.learning.general_features`), without Eq. 6.
     """
 
     offset: float = 1.0
@@ -128,8 +131,11 @@ def feature_names(settings: FeatureSettings | None = None) -> tuple[str, ...]:
     (19, 36)
     """
     from unstack.learning.contact_features import CONTACT_FEATURE_NAMES
+    from unstack.learning.general_features import GENERAL_FEATURE_NAMES
 
     settings = settings or FeatureSettings()
+    if settings.feature_set == "general":
+        return GENERAL_FEATURE_NAMES
     return FEATURE_NAMES + (CONTACT_FEATURE_NAMES if settings.feature_set == "extended" else ())
 
 
@@ -144,31 +150,6 @@ def interest_points(boxes: Sequence[Box], offset: float = 1.0) -> np.ndarray:
     steps = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], dtype=np.float64)
     centroids = np.array([box.position for box in boxes], dtype=np.float64).reshape(-1, 1, 3)
     return centroids + offset * steps[None, :, :]
-
-
-def bounding_boxes(boxes: Sequence[Box]) -> np.ndarray:
-    """``[x_min, y_min, z_min, x_max, y_max, z_max]`` of each rotated cuboid, shape (n, 6).
-
-    Examples
-    --------
-    >>> quarter_turn = [0, 0, np.sin(np.pi / 4), np.cos(np.pi / 4)]
-    >>> bounding_boxes([Box("a", [2, 1, 1], [0, 0, 0], quarter_turn)]).round(6).tolist()
-    [[-0.5, -1.0, -0.5, 0.5, 1.0, 0.5]]
-    """
-    result = np.empty((len(boxes), 6))
-    for row, box in enumerate(boxes):
-        x, y, z, w = box.orientation_xyzw
-        rotation = np.array(
-            [
-                [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-            ]
-        )
-        half_extent = np.abs(rotation) @ (box.size / 2.0)
-        result[row, :3] = box.position - half_extent
-        result[row, 3:] = box.position + half_extent
-    return result
 
 
 def _normaliser(sigma: float, n_points: int) -> float:
@@ -264,10 +245,15 @@ def pair_features(
     """``F_XY`` (Eq. 6) for each ordered pair ``(X, Y)`` of box indices, shape (len(pairs), 19).
 
     With ``settings.feature_set == "extended"`` the 17 contact features follow: shape
-    (len(pairs), 36), columns named by :func:`feature_names`.
+    (len(pairs), 36); with ``"general"`` only the 18 general features; columns named by
+    :func:`feature_names`.
     """
     settings = settings or FeatureSettings()
     index = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    if settings.feature_set == "general":
+        from unstack.learning.general_features import general_features
+
+        return general_features(boxes, points, [(int(a), int(b)) for a, b in index])
     used = np.unique(index)
     local = {int(box): row for row, box in enumerate(used)}
     subset = [boxes[int(box)] for box in used]

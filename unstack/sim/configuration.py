@@ -17,7 +17,7 @@ Examples
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -27,9 +27,15 @@ from unstack.scene import Box, Scene
 from unstack.sim.ground_truth import RemovalResponse, removal_responses, support_labels, transitivity_violations
 from unstack.sim.piles import Pile, build_pile
 from unstack.sim.sensor import scan_pile
-from unstack.sim.settings import SimulationSettings
+from unstack.sim.settings import SensorSettings, SimulationSettings
 
-__all__ = ["SimulatedConfiguration", "config_name", "configuration_seed", "simulate_configuration"]
+__all__ = [
+    "SimulatedConfiguration",
+    "config_name",
+    "configuration_seed",
+    "jittered_sensor",
+    "simulate_configuration",
+]
 
 #: Re-settling rounds for a pile that creeps before it is rejected and rebuilt.
 CREEP_RESETTLES = 2
@@ -72,6 +78,27 @@ def configuration_seed(seed: int, index: int) -> np.random.SeedSequence:
 
 #: Packages whose versions a simulated scene and a data set record.
 SIMULATION_PACKAGES = ("unstack", "pybullet", "numpy")
+
+
+def jittered_sensor(sensor: SensorSettings, seed: np.random.SeedSequence | int) -> SensorSettings:
+    """The sensor moved by its ``position_jitter`` (uniform per axis), its target by half as much.
+
+    Examples
+    --------
+    >>> from unstack.sim.settings import SensorSettings
+    >>> jittered_sensor(SensorSettings(), 0) == SensorSettings()
+    True
+    >>> moved = jittered_sensor(SensorSettings(position_jitter=0.2), 0)
+    >>> bool(max(abs(a - b) for a, b in zip(moved.position, SensorSettings().position)) <= 0.2)
+    True
+    """
+    if sensor.position_jitter == 0.0:
+        return sensor
+    rng = np.random.default_rng(seed)
+    shift = rng.uniform(-sensor.position_jitter, sensor.position_jitter, size=(2, 3)) * np.array([[1.0], [0.5]])
+    position = tuple(float(value) for value in np.asarray(sensor.position) + shift[0])
+    target = tuple(float(value) for value in np.asarray(sensor.target) + shift[1])
+    return replace(sensor, position=position, target=target)  # type: ignore[arg-type]
 
 
 def _creep_free_responses(pile: Pile, settings: SimulationSettings) -> tuple[RemovalResponse, int] | None:
@@ -118,10 +145,15 @@ def simulate_configuration(settings: SimulationSettings, *, seed: int, index: in
                 continue
             response, resettles = found
             clock = time.process_time()
-            scan = scan_pile(pile.world, settings.sensor, seed=pile_seed.spawn(1)[0])
+            scan_seed, jitter_seed = pile_seed.spawn(2)
+            sensor = jittered_sensor(settings.sensor, jitter_seed)
+            scan = scan_pile(pile.world, sensor, seed=scan_seed)
             timings["scan"] = time.process_time() - clock
             positions, orientations = pile.world.poses([box.body for box in pile.boxes])
             scene = _scene(settings, seed, index, attempt, resettles, pile, response, scan, positions, orientations)
+            if sensor != settings.sensor:
+                scene.metadata["simulation"]["sensor_position"] = list(sensor.position)
+                scene.metadata["simulation"]["sensor_target"] = list(sensor.target)
             return SimulatedConfiguration(index, scene, scan.point_boxes, timings)
     raise InvalidSettings(
         f"configuration {index}: none of {MAX_PILES} piles of {count} boxes both took all its boxes and "

@@ -1,4 +1,4 @@
-"""Piles of boxes dropped into a container section (§V-A).
+"""Piles of boxes in a container section (§V-A): dropped in waves, or stacked as walls.
 
 Boxes fall in waves behind a temporary door wall: each wave's boxes start just above the
 boxes under them, at the lowest of several random spots whose bounding circles do not
@@ -6,6 +6,13 @@ overlap, with a random yaw and roll and pitch up to ``max_tilt_deg``. After the 
 pile settles, the door is taken away, the pile settles again, boxes that fell out of the
 container are deleted, and the missing ones are dropped again (door back in place) until
 the pile has the requested number of boxes.
+
+Walls (``arrangement="wall"``) are loaded as trailers are: columns of boxes standing side
+by side across the container, rows of columns from the back wall towards the door, each box
+placed on the one under it with a small random offset and yaw, a few centimetres of gap
+between columns, columns of random height; a share of the boxes (``fallen_share``) is
+dropped in front of the wall instead, tumbling as boxes that fell off it. The wall then
+settles with the door open.
 
 Examples
 --------
@@ -26,7 +33,7 @@ import numpy as np
 from unstack.sim.settings import InvalidSettings, SimulationSettings
 from unstack.sim.world import PhysicsWorld
 
-__all__ = ["Pile", "PileBox", "build_pile", "random_orientation_xyzw"]
+__all__ = ["Pile", "PileBox", "build_pile", "build_wall", "random_orientation_xyzw"]
 
 #: Vertical gap between the top of the pile and the lowest point of a dropped box (m).
 DROP_GAP = 0.05
@@ -37,6 +44,12 @@ WALL_MARGIN = 0.02
 DOOR_MARGIN = 0.2
 #: Random spots tried for each dropped box; the lowest one that keeps clear of the wave wins.
 CANDIDATES = 12
+#: Largest gap between two columns of a wall, and between two rows (metres).
+WALL_GAP = 0.06
+#: Largest horizontal offset of a stacked box from the centre of the one under it (metres).
+WALL_OFFSET = 0.04
+#: Largest yaw of a stacked box away from the container's axes (degrees).
+WALL_YAW_DEG = 4.0
 
 
 @dataclass
@@ -182,6 +195,8 @@ def build_pile(settings: SimulationSettings, *, count: int, seed: int | np.rando
     InvalidSettings
         The container cannot hold ``count`` boxes within ``max_refills`` rounds.
     """
+    if settings.pile.arrangement == "wall":
+        return build_wall(settings, count=count, seed=seed)
     rng = np.random.default_rng(seed)
     world = PhysicsWorld(settings, door=True)
     pile = Pile(world)
@@ -207,6 +222,112 @@ def build_pile(settings: SimulationSettings, *, count: int, seed: int | np.rando
             f"could not pile {count} boxes of size set {settings.sizes!r} into the container "
             f"within {settings.pile.max_refills} refills (got {len(pile.boxes)})"
         )
+    except BaseException:
+        world.close()
+        raise
+
+
+def _yaw_xyzw(yaw: float) -> np.ndarray:
+    return np.array([0.0, 0.0, np.sin(yaw / 2.0), np.cos(yaw / 2.0)])
+
+
+def _wall_layout(
+    settings: SimulationSettings, count: int, rng: np.random.Generator
+) -> list[tuple[np.ndarray, np.ndarray, float]]:
+    """Sizes, centres and yaws of ``count`` stacked boxes, back row first, bottom up."""
+    container = settings.container
+    sizes = settings.box_sizes()
+    placed: list[tuple[np.ndarray, np.ndarray, float]] = []
+    row_back = container.depth - WALL_MARGIN
+    while len(placed) < count:
+        row_depth = 0.0
+        y_cursor = -container.width / 2.0 + WALL_MARGIN
+        while len(placed) < count:
+            size = sizes[rng.integers(len(sizes))].copy()
+            turned = bool(rng.integers(2))
+            footprint = size[[1, 0]] if turned else size[:2]
+            if y_cursor + footprint[1] > container.width / 2.0 - WALL_MARGIN:
+                break
+            if row_back - footprint[0] < DOOR_MARGIN:
+                raise InvalidSettings(
+                    f"a wall of {count} boxes of size set {settings.sizes!r} does not fit a {container.depth} m section"
+                )
+            centre_y = y_cursor + footprint[1] / 2.0
+            centre_x = row_back - footprint[0] / 2.0
+            levels = int(rng.integers(1, 1 + max(1, int(container.height // float(size[2])))))
+            top = 0.0
+            for level in range(levels):
+                if len(placed) >= count:
+                    break
+                box_size = size if level == 0 else sizes[rng.integers(len(sizes))].copy()
+                if top + box_size[2] > container.height - WALL_MARGIN:
+                    break
+                yaw = (np.pi / 2.0 if turned else 0.0) + np.radians(rng.uniform(-WALL_YAW_DEG, WALL_YAW_DEG))
+                offset = rng.uniform(-WALL_OFFSET, WALL_OFFSET, size=2) if level else np.zeros(2)
+                centre = np.array([centre_x + offset[0], centre_y + offset[1], top + box_size[2] / 2.0 + 0.002])
+                footprint_depth = box_size[1] if turned else box_size[0]
+                centre[0] = min(centre[0], container.depth - WALL_MARGIN - footprint_depth / 2.0)
+                placed.append((box_size, centre, float(yaw)))
+                top += float(box_size[2]) + 0.002
+            row_depth = max(row_depth, float(footprint[0]))
+            y_cursor += float(footprint[1]) + float(rng.uniform(0.0, WALL_GAP))
+        row_back -= row_depth + float(rng.uniform(0.0, WALL_GAP))
+    return placed
+
+
+def build_wall(settings: SimulationSettings, *, count: int, seed: int | np.random.SeedSequence) -> Pile:
+    """Stack ``count`` boxes as a wall from the back of the section, drop some in front, settle.
+
+    Parameters
+    ----------
+    settings : SimulationSettings
+        ``settings.pile.fallen_share`` of the boxes (in expectation) fall in front.
+    count : int
+        Boxes in the finished pile.
+    seed : int or numpy.random.SeedSequence
+
+    Returns
+    -------
+    Pile
+        Settled, door open; boxes that left the container are replaced by dropped ones.
+
+    Raises
+    ------
+    InvalidSettings
+        The section cannot hold the wall.
+
+    Examples
+    --------
+    >>> from unstack.sim.settings import family_settings
+    >>> with build_wall(family_settings("wall"), count=8, seed=2) as pile:
+    ...     len(pile.boxes)
+    8
+    """
+    rng = np.random.default_rng(seed)
+    fallen = int(rng.binomial(count, settings.pile.fallen_share)) if count > 2 else 0
+    world = PhysicsWorld(settings, door=False)
+    pile = Pile(world)
+    try:
+        for size, centre, yaw in _wall_layout(settings, count - fallen, rng):
+            mass = float(rng.uniform(*settings.pile.mass_range))
+            body = world.add_box(size, centre, _yaw_xyzw(yaw), mass=mass)
+            pile.boxes.append(PileBox(body, size.copy(), mass))
+        world.settle()
+        world.close_door()
+        for round_index in range(settings.pile.max_refills + 1):
+            while len(pile.boxes) < count:
+                if _drop_wave(world, pile, count - len(pile.boxes), rng) == 0:
+                    break
+                world.settle()
+            world.open_door()
+            world.settle()
+            if _delete_fallen(world, pile):
+                world.settle()
+            if len(pile.boxes) == count:
+                pile.refills = round_index
+                return pile
+            world.close_door()
+        raise InvalidSettings(f"could not stack a wall of {count} boxes within {settings.pile.max_refills} refills")
     except BaseException:
         world.close()
         raise

@@ -25,6 +25,8 @@ import numpy as np
 from unstack.errors import UnstackError
 
 __all__ = [
+    "ARRANGEMENTS",
+    "FAMILIES",
     "SIZE_SETS",
     "Container",
     "GroundTruthSettings",
@@ -32,6 +34,7 @@ __all__ = [
     "PileSettings",
     "SensorSettings",
     "SimulationSettings",
+    "family_settings",
 ]
 
 #: Named box-size sets: full edge lengths in metres. ``paper2`` are the paper's two sizes
@@ -39,7 +42,11 @@ __all__ = [
 SIZE_SETS: dict[str, tuple[tuple[float, float, float], ...]] = {
     "paper2": ((0.6, 0.4, 0.4), (0.4, 0.3, 0.3)),
     "four": ((0.6, 0.4, 0.4), (0.4, 0.3, 0.3), (0.5, 0.5, 0.3), (0.3, 0.3, 0.2)),
+    "mixed": ((0.8, 0.6, 0.5), (0.6, 0.4, 0.4), (0.4, 0.3, 0.3), (0.5, 0.5, 0.3), (0.3, 0.2, 0.2), (0.25, 0.25, 0.15)),
 }
+#: How a pile is made: boxes dropped in waves (the paper's piles), or stacked in columns and
+#: rows from the back wall towards the door, as trailers are loaded (see :mod:`unstack.sim.piles`).
+ARRANGEMENTS = ("dropped", "wall")
 
 
 class InvalidSettings(UnstackError):
@@ -94,6 +101,12 @@ class PileSettings:
         Cap on one settling phase (seconds of simulated time).
     max_refills : int
         Rounds of "drop, open the door, delete the boxes that fell out" before giving up.
+    arrangement : {"dropped", "wall"}
+        Dropped in waves, or stacked in columns and rows from the back wall (a key of
+        :data:`ARRANGEMENTS`).
+    fallen_share : float
+        For walls: the expected share of boxes that are not stacked but dropped in front
+        of the wall (fallen boxes).
     """
 
     wave_size: int = 6
@@ -107,6 +120,8 @@ class PileSettings:
     settle_windows: int = 2
     settle_max_time: float = 6.0
     max_refills: int = 6
+    arrangement: str = "dropped"
+    fallen_share: float = 0.1
 
 
 @dataclass(frozen=True)
@@ -160,6 +175,9 @@ class SensorSettings:
         ``(a, b, c)`` of that model (metres), from Nguyen, Izadi and Lovell (2012).
     min_pixels : int
         A box is detectable when at least this many pixels see it.
+    position_jitter : float
+        Each configuration moves the sensor by a uniform offset of up to this much along
+        each axis (metres), and its target by half as much: viewpoint variation.
     """
 
     position: tuple[float, float, float] = (-2.8, 0.0, 1.3)
@@ -172,6 +190,7 @@ class SensorSettings:
     noise: bool = False
     noise_coefficients: tuple[float, float, float] = (0.0012, 0.0019, 0.4)
     min_pixels: int = 50
+    position_jitter: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -201,6 +220,14 @@ class SimulationSettings:
             raise InvalidSettings(f"box counts must be positive, got {low}-{high}")
         if low > high:
             raise InvalidSettings(f"box range {low}-{high} is reversed; expected LOW-HIGH with LOW <= HIGH")
+        if self.pile.arrangement not in ARRANGEMENTS:
+            raise InvalidSettings(
+                f"unknown arrangement {self.pile.arrangement!r}; expected one of {', '.join(ARRANGEMENTS)}"
+            )
+        if not 0.0 <= self.pile.fallen_share < 1.0:
+            raise InvalidSettings(f"fallen_share must be in [0, 1), got {self.pile.fallen_share}")
+        if not 0.0 <= self.sensor.position_jitter <= 1.0:
+            raise InvalidSettings(f"sensor position jitter must be in [0, 1] m, got {self.sensor.position_jitter}")
         if self.sizes not in SIZE_SETS:
             raise InvalidSettings(f"unknown size set {self.sizes!r}; expected one of {', '.join(SIZE_SETS)}")
         container = self.container
@@ -258,3 +285,42 @@ def json_ready(value: Any) -> Any:
     if isinstance(value, list | tuple):
         return [json_ready(item) for item in value]
     return value
+
+
+#: Pile families: name -> (what it is, the settings that make it). ``unstack simulate
+#: --family NAME`` starts from these; explicit options override them.
+FAMILIES: dict[str, str] = {
+    "dropped": "the paper's piles: 30-40 boxes of two sizes dropped into a 2 m section",
+    "four": "20-30 boxes of four sizes dropped into a 2 m section",
+    "stacked": "10-16 boxes of four sizes dropped into a narrow 1.0 m x 1.2 m section: high stacks",
+    "wall": "20-36 boxes of four sizes stacked in columns and rows from the back wall, as trailers are loaded, "
+    "with gaps between columns and some fallen boxes in front",
+    "mixed": "20-30 boxes of six sizes (large and small) and masses of 2-25 kg dropped into a 2 m section",
+}
+
+
+def family_settings(family: str) -> SimulationSettings:
+    """The simulation settings of a pile family (a key of :data:`FAMILIES`).
+
+    Examples
+    --------
+    >>> family_settings("wall").pile.arrangement
+    'wall'
+    >>> family_settings("stacked").container.width
+    1.2
+    """
+    if family == "dropped":
+        return SimulationSettings()
+    if family == "four":
+        return SimulationSettings(boxes=(20, 30), sizes="four")
+    if family == "stacked":
+        return SimulationSettings(boxes=(10, 16), sizes="four", container=Container(depth=1.0, width=1.2))
+    if family == "wall":
+        return SimulationSettings(
+            boxes=(20, 36),
+            sizes="four",
+            pile=PileSettings(arrangement="wall", max_tilt_deg=3.0),
+        )
+    if family == "mixed":
+        return SimulationSettings(boxes=(20, 30), sizes="mixed", pile=PileSettings(mass_range=(2.0, 25.0)))
+    raise InvalidSettings(f"unknown pile family {family!r}; expected one of {', '.join(FAMILIES)}")

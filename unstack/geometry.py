@@ -1,0 +1,230 @@
+"""Box geometry in the world frame: rotations, corners, bounding boxes, footprints.
+
+Part of the data model: the learning features, the plausibility checks, the hidden-load
+estimate and the synthetic clouds all measure boxes with these functions. A box's
+*footprint* is the convex polygon its corners cover seen from above (a rectangle for an
+upright box, a hexagon for a tilted one).
+
+Examples
+--------
+>>> from unstack.scene import Box
+>>> floor_box = Box("a", [0.6, 0.4, 0.4], [1.0, 0.0, 0.2])
+>>> top_box = Box("b", [0.4, 0.3, 0.3], [1.0, 0.1, 0.55])
+>>> round(footprint_overlap_area(footprint(floor_box), footprint(top_box)), 4)
+0.1
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from unstack.scene import Box
+
+__all__ = [
+    "bounding_boxes",
+    "box_corners",
+    "convex_hull_2d",
+    "footprint",
+    "footprint_overlap_area",
+    "points_in_box",
+    "polygon_area",
+    "polygon_distance",
+    "rotation_matrix",
+    "tilt_deg",
+]
+
+#: Corner signs of a cuboid, in a fixed order (x fastest).
+_CORNER_SIGNS = np.array([[sx, sy, sz] for sz in (-1, 1) for sy in (-1, 1) for sx in (-1, 1)], dtype=np.float64)
+
+
+def rotation_matrix(orientation_xyzw: np.ndarray) -> np.ndarray:
+    """The 3 x 3 rotation of a unit quaternion ``[x, y, z, w]``.
+
+    Examples
+    --------
+    >>> rotation_matrix(np.array([0.0, 0.0, 0.0, 1.0])).tolist()
+    [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    """
+    x, y, z, w = (float(value) for value in orientation_xyzw)
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def box_corners(box: Box) -> np.ndarray:
+    """The eight corners of a box in the world frame, shape (8, 3).
+
+    Examples
+    --------
+    >>> from unstack.scene import Box
+    >>> box_corners(Box("a", [2, 2, 2], [0, 0, 1]))[:, 2].tolist()
+    [0.0, 0.0, 0.0, 0.0, 2.0, 2.0, 2.0, 2.0]
+    """
+    local = _CORNER_SIGNS * (box.size / 2.0)
+    corners: np.ndarray = local @ rotation_matrix(box.orientation_xyzw).T + box.position
+    return corners
+
+
+def bounding_boxes(boxes: Sequence[Box]) -> np.ndarray:
+    """``[x_min, y_min, z_min, x_max, y_max, z_max]`` of each rotated cuboid, shape (n, 6).
+
+    Examples
+    --------
+    >>> from unstack.scene import Box
+    >>> quarter_turn = [0, 0, np.sin(np.pi / 4), np.cos(np.pi / 4)]
+    >>> bounding_boxes([Box("a", [2, 1, 1], [0, 0, 0], quarter_turn)]).round(6).tolist()
+    [[-0.5, -1.0, -0.5, 0.5, 1.0, 0.5]]
+    """
+    result = np.empty((len(boxes), 6))
+    for row, box in enumerate(boxes):
+        half_extent = np.abs(rotation_matrix(box.orientation_xyzw)) @ (box.size / 2.0)
+        result[row, :3] = box.position - half_extent
+        result[row, 3:] = box.position + half_extent
+    return result
+
+
+def tilt_deg(box: Box) -> float:
+    """How far the box is from standing on a face: the angle between the world's z axis and
+    the nearest of the box's axes (degrees, 0 for an upright box, up to about 54.7).
+
+    Examples
+    --------
+    >>> from unstack.scene import Box
+    >>> tilt_deg(Box("a", [1, 1, 1], [0, 0, 0]))
+    0.0
+    """
+    rotation = rotation_matrix(box.orientation_xyzw)
+    cosine = float(np.max(np.abs(rotation[2, :])))
+    return float(np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0))))
+
+
+def convex_hull_2d(points: np.ndarray) -> np.ndarray:
+    """Counter-clockwise convex hull of 2-D points (Andrew's monotone chain), shape (k, 2).
+
+    Examples
+    --------
+    >>> convex_hull_2d(np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0.5, 0.5]])).tolist()
+    [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+    """
+    unique = np.unique(np.round(np.asarray(points, dtype=np.float64), 12), axis=0)
+    if len(unique) <= 2:
+        return unique
+
+    def cross(o: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+        return float((a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]))
+
+    lower: list[np.ndarray] = []
+    for point in unique:
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], point) <= 0:
+            lower.pop()
+        lower.append(point)
+    upper: list[np.ndarray] = []
+    for point in unique[::-1]:
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], point) <= 0:
+            upper.pop()
+        upper.append(point)
+    return np.array(lower[:-1] + upper[:-1])
+
+
+def footprint(box: Box) -> np.ndarray:
+    """The convex polygon a box covers seen from above, counter-clockwise, shape (k, 2)."""
+    return convex_hull_2d(box_corners(box)[:, :2])
+
+
+def polygon_area(polygon: np.ndarray) -> float:
+    """Area of a simple polygon (shoelace formula); 0 for fewer than three vertices.
+
+    Examples
+    --------
+    >>> polygon_area(np.array([[0, 0], [2, 0], [2, 1], [0, 1]]))
+    2.0
+    """
+    if len(polygon) < 3:
+        return 0.0
+    x, y = polygon[:, 0], polygon[:, 1]
+    return float(abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))) / 2.0)
+
+
+def _clip(subject: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Sutherland-Hodgman: the part of ``subject`` left of the directed edge a -> b."""
+    if len(subject) == 0:
+        return subject
+    edge = b - a
+    side = edge[0] * (subject[:, 1] - a[1]) - edge[1] * (subject[:, 0] - a[0])
+    output: list[np.ndarray] = []
+    for k in range(len(subject)):
+        current, previous = subject[k], subject[k - 1]
+        side_current, side_previous = side[k], side[k - 1]
+        if side_current >= 0:
+            if side_previous < 0:
+                output.append(previous + (current - previous) * side_previous / (side_previous - side_current))
+            output.append(current)
+        elif side_previous >= 0:
+            output.append(previous + (current - previous) * side_previous / (side_previous - side_current))
+    return np.array(output).reshape(-1, 2)
+
+
+def footprint_overlap_area(first: np.ndarray, second: np.ndarray) -> float:
+    """Area of the intersection of two convex counter-clockwise polygons.
+
+    Examples
+    --------
+    >>> square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float)
+    >>> footprint_overlap_area(square, square + 0.5)
+    0.25
+    """
+    clipped = np.asarray(first, dtype=np.float64)
+    for k in range(len(second)):
+        clipped = _clip(clipped, second[k - 1], second[k])
+        if len(clipped) == 0:
+            return 0.0
+    return polygon_area(clipped)
+
+
+def _point_segment_distances(points: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    edges = ends - starts
+    lengths = np.maximum(np.einsum("ij,ij->i", edges, edges), 1e-18)
+    offsets = points[:, None, :] - starts[None, :, :]
+    along = np.clip(np.einsum("pij,ij->pi", offsets, edges) / lengths, 0.0, 1.0)
+    nearest = starts[None, :, :] + along[..., None] * edges[None, :, :]
+    distances: np.ndarray = np.linalg.norm(points[:, None, :] - nearest, axis=-1)
+    return distances
+
+
+def polygon_distance(first: np.ndarray, second: np.ndarray) -> float:
+    """Distance between two convex polygons (0 when they overlap or touch).
+
+    Examples
+    --------
+    >>> square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float)
+    >>> polygon_distance(square, square + [3.0, 0.0])
+    2.0
+    """
+    if footprint_overlap_area(first, second) > 0.0:
+        return 0.0
+    distances = [
+        _point_segment_distances(a, b, np.roll(b, -1, axis=0)).min() for a, b in ((first, second), (second, first))
+    ]
+    return float(min(distances))
+
+
+def points_in_box(points: np.ndarray, box: Box, *, margin: float = 0.0) -> np.ndarray:
+    """Which points lie inside the box grown by ``margin`` on every side (boolean mask).
+
+    Examples
+    --------
+    >>> from unstack.scene import Box
+    >>> points_in_box(np.array([[0, 0, 0.5], [0, 0, 1.2]]), Box("a", [1, 1, 1], [0, 0, 0.5])).tolist()
+    [True, False]
+    """
+    local = (np.asarray(points, dtype=np.float64) - box.position) @ rotation_matrix(box.orientation_xyzw)
+    inside: np.ndarray = np.all(np.abs(local) <= box.size / 2.0 + margin, axis=1)
+    return inside
