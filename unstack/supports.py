@@ -42,6 +42,10 @@ class Supports:
         ``P(SUPP(objects[i], objects[j]))``; 0 and 1 are hard evidence; diagonal 0.
     masses : array-like, shape (n,), optional
         Box masses in kg, for the mass-weighted cost.
+    hidden_load : array-like, shape (n,), optional
+        Expected number of *undetected* boxes resting on each box (what the point cloud
+        shows on it that no detected box explains; see :mod:`unstack.hidden_load`). The
+        ``load`` cost counts it; 0 when not given.
     metadata : dict, optional
         Free-form provenance, kept when saving.
     source : str, optional
@@ -58,6 +62,7 @@ class Supports:
     masses: np.ndarray | None = None
     metadata: dict[str, Any] = field(default_factory=dict)
     source: str = "<array>"
+    hidden_load: np.ndarray | None = None
 
     def __init__(
         self,
@@ -66,6 +71,8 @@ class Supports:
         masses: Any = None,
         metadata: dict[str, Any] | None = None,
         source: str = "<array>",
+        *,
+        hidden_load: Any = None,
     ) -> None:
         ids = check_ids(objects, source=source)
         matrix = check_probability_matrix(probabilities, len(ids), source=source)
@@ -76,6 +83,20 @@ class Supports:
                 masses, len(ids), positive=True, source=source, path="$.masses", error=InvalidSupports
             )
             mass_vector.setflags(write=False)
+        load_vector = None
+        if hidden_load is not None:
+            load_vector = check_vector(
+                hidden_load, len(ids), source=source, path="$.hidden_load", error=InvalidSupports
+            )
+            negative = np.flatnonzero(load_vector < 0)
+            if negative.size:
+                raise InvalidSupports(
+                    source,
+                    f"$.hidden_load[{negative[0]}]",
+                    f"expected a non-negative number, got {load_vector[negative[0]]}",
+                )
+            load_vector.setflags(write=False)
+        object.__setattr__(self, "hidden_load", load_vector)
         object.__setattr__(self, "objects", ids)
         object.__setattr__(self, "probabilities", matrix)
         object.__setattr__(self, "masses", mass_vector)
@@ -109,7 +130,15 @@ class Supports:
         """
         order = [self.index(object_id) for object_id in object_ids]
         masses = None if self.masses is None else self.masses[order]
-        return Supports(list(object_ids), self.probabilities[np.ix_(order, order)], masses, self.metadata, self.source)
+        load = None if self.hidden_load is None else self.hidden_load[order]
+        return Supports(
+            list(object_ids),
+            self.probabilities[np.ix_(order, order)],
+            masses,
+            self.metadata,
+            self.source,
+            hidden_load=load,
+        )
 
     def to_dict(self) -> dict[str, Any]:
         """The ``unstack.supports/1`` JSON object."""
@@ -120,6 +149,8 @@ class Supports:
         }
         if self.masses is not None:
             data["masses"] = self.masses.tolist()
+        if self.hidden_load is not None:
+            data["hidden_load"] = self.hidden_load.tolist()
         if self.metadata:
             data["metadata"] = self.metadata
         return data
@@ -139,6 +170,7 @@ class Supports:
             data.get("masses"),
             data.get("metadata"),
             source=document.source,
+            hidden_load=data.get("hidden_load"),
         )
 
 

@@ -41,7 +41,7 @@ def test_render_writes_a_png(dataset: Path, tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("arguments", "message"),
     [
-        (["--sizes", "paper3"], "unknown size set 'paper3'; expected one of paper2, four"),
+        (["--sizes", "paper3"], "'paper3' is not one of 'paper2', 'four', 'mixed'"),
         (["--boxes", "40-30"], "box range 40-30 is reversed"),
         (["--boxes", "many"], "--boxes: expected COUNT or LOW-HIGH (for example 30-40), got 'many'"),
         (["--boxes", "500-600"], "600 boxes of size set 'paper2' do not fit"),

@@ -18,6 +18,7 @@ from rich.console import Console
 
 from unstack.cli.learning import MODEL_HELP
 from unstack.errors import UnstackError
+from unstack.reasoner.costs import COSTS, DEFAULT_COST
 
 __all__ = ["cli", "main"]
 
@@ -83,10 +84,11 @@ def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
         ),
         click.option(
             "--cost",
-            type=click.Choice(["count", "mass"]),
-            default="count",
+            type=click.Choice(list(COSTS)),
+            default=DEFAULT_COST,
             show_default=True,
-            help="count: number of supported boxes (Eq. 11); mass: their total mass (needs masses).",
+            help="load: Eq. 11's count with each box counted with the undetected load the cloud shows on it; "
+            "count: number of supported boxes (Eq. 11 exactly); mass: their total mass (needs masses).",
         ),
         click.option(
             "--time-limit",

@@ -52,7 +52,7 @@ def parse_box_range(text: str) -> tuple[int, int]:
 @click.option(
     "--min-pixels", type=int, default=50, show_default=True, help="Visible pixels that make a box detectable."
 )
-@click.option("--viewpoint-jitter", type=float, default=0.0, show_default=True,
+@click.option("--viewpoint-jitter", type=click.FloatRange(0.0, 1.0), default=0.0, show_default=True,
               help="Move the sensor of each configuration by up to this much per axis (m).")  # fmt: skip
 def simulate(
     configs: int,
@@ -88,11 +88,8 @@ def simulate(
     match = re.fullmatch(r"(\d+)x(\d+)", resolution.strip())
     if not match or min(int(match.group(1)), int(match.group(2))) < 1:
         raise UnstackError(f"--resolution: expected WIDTHxHEIGHT in pixels (for example 640x480), got {resolution!r}")
-    if depth <= 0 or width <= 0 or horizon <= 0 or not 0.0 <= viewpoint_jitter <= 1.0:
-        raise UnstackError(
-            f"--depth, --width and --horizon must be positive and --viewpoint-jitter in [0, 1], got {depth:g}, "
-            f"{width:g}, {horizon:g} and {viewpoint_jitter:g}"
-        )
+    if depth <= 0 or width <= 0 or horizon <= 0:
+        raise UnstackError(f"--depth, --width and --horizon must be positive, got {depth:g}, {width:g} and {horizon:g}")
     if seed < 0:
         raise UnstackError(f"--seed must be a non-negative integer, got {seed}")
     sensor = replace(

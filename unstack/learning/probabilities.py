@@ -65,6 +65,8 @@ def scene_support_probabilities(
         values = np.clip(model.support_probability(features), PROBABILITY_FLOOR, 1.0 - PROBABILITY_FLOOR)
         rows, columns = np.nonzero(~np.eye(n, dtype=bool))
         probabilities[rows, columns] = values
+    from unstack.hidden_load import hidden_load
+
     masses = [scene.boxes[k].mass for k in detected]
     metadata = {
         "scene": scene.source,
@@ -79,4 +81,5 @@ def scene_support_probabilities(
         masses=masses if all(mass is not None for mass in masses) else None,
         metadata=metadata,
         source=scene.source,
+        hidden_load=hidden_load(scene, objects),
     )

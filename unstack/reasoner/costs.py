@@ -2,8 +2,14 @@
 
 Eq. 11 charges unloading box ``X_j`` with the boxes it supports. The cost is additive over
 the supported boxes, so its expectation needs only the conditional marginals:
-``EC(A_j) = sum_Y w_Y P(S_jY = 1 | consistent)`` with ``w_Y = 1`` (``"count"``, the paper)
-or ``w_Y`` = the mass of Y (``"mass"``).
+``EC(A_j) = own_j + sum_Y w_Y P(S_jY = 1 | consistent)`` with
+
+* ``"count"`` (Eq. 11 exactly, the paper): ``w_Y = 1``, ``own_j = 0``;
+* ``"mass"``: ``w_Y`` = the mass of Y, ``own_j = 0``;
+* ``"load"`` (the default): every box counted with the undetected load resting on it,
+  ``w_Y = 1 + h_Y`` and ``own_j = h_j``, where ``h`` is :attr:`Supports.hidden_load`
+  (what the cloud shows on a box that no detected box explains, see
+  :mod:`unstack.hidden_load`). Without a hidden load it equals ``"count"``.
 
 Examples
 --------
@@ -19,16 +25,22 @@ import numpy as np
 from unstack.errors import UnstackError
 from unstack.supports import Supports
 
-__all__ = ["COSTS", "cost_weights", "expected_costs"]
+__all__ = ["COSTS", "DEFAULT_COST", "cost_weights", "expected_costs", "own_costs"]
 
 #: The cost models: what unloading a box first costs for each box it supports.
-COSTS = ("count", "mass")
+COSTS = ("load", "count", "mass")
+#: The cost a decision uses unless told otherwise.
+DEFAULT_COST = "load"
 
 
 def cost_weights(supports: Supports, cost: str) -> np.ndarray:
-    """Per-box weight of the cost model: ones for ``"count"``, the masses for ``"mass"``."""
+    """Per-box weight of the cost model: ones for ``"count"``, the masses for ``"mass"``,
+    one plus the hidden load for ``"load"``."""
     if cost == "count":
         return np.ones(supports.n_objects)
+    if cost == "load":
+        weights: np.ndarray = 1.0 + own_costs(supports, cost)
+        return weights
     if cost == "mass":
         if supports.masses is None:
             raise UnstackError(
@@ -39,7 +51,23 @@ def cost_weights(supports: Supports, cost: str) -> np.ndarray:
     raise UnstackError(f"unknown cost {cost!r}; expected one of {', '.join(COSTS)}")
 
 
-def expected_costs(marginals: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """``EC(A_j) = sum_Y weights[Y] * marginals[j, Y]`` (Eqs. 11 and 13)."""
+def own_costs(supports: Supports, cost: str) -> np.ndarray:
+    """What unloading each box costs whatever it supports among the detected boxes: its
+    hidden load for ``"load"``, 0 otherwise.
+
+    Examples
+    --------
+    >>> supports = Supports(["a", "b"], [[0, 0.5], [0.2, 0]], hidden_load=[1.0, 0.0])
+    >>> own_costs(supports, "load").tolist(), own_costs(supports, "count").tolist()
+    ([1.0, 0.0], [0.0, 0.0])
+    """
+    if cost == "load" and supports.hidden_load is not None:
+        load: np.ndarray = np.asarray(supports.hidden_load, dtype=np.float64)
+        return load
+    return np.zeros(supports.n_objects)
+
+
+def expected_costs(marginals: np.ndarray, weights: np.ndarray, own: np.ndarray | None = None) -> np.ndarray:
+    """``EC(A_j) = own[j] + sum_Y weights[Y] * marginals[j, Y]`` (Eqs. 11 and 13)."""
     result: np.ndarray = marginals @ weights
-    return result
+    return result if own is None else result + own

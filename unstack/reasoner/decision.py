@@ -31,7 +31,7 @@ import numpy as np
 from unstack.errors import UnstackError
 from unstack.reasoner.components import support_components
 from unstack.reasoner.confidence import choice_probability
-from unstack.reasoner.costs import cost_weights, expected_costs
+from unstack.reasoner.costs import DEFAULT_COST, cost_weights, expected_costs, own_costs
 from unstack.reasoner.marginals import EXACT_MAX_BOXES
 from unstack.reasoner.pruning import Evidence, propagate_evidence
 from unstack.reasoner.sampling import DEFAULT_TIME_LIMIT, SAMPLING_MAX_BOXES, SampledMarginals
@@ -88,7 +88,7 @@ class Decision:
     method : str
         ``"exact"``, ``"sat"`` or ``"approx"`` (the method of the largest group).
     cost : str
-        ``"count"`` or ``"mass"``.
+        ``"load"``, ``"count"`` or ``"mass"``.
     consistent_worlds : int or None
         Number of consistent worlds of non-zero probability, when the method counted them.
     ties : tuple of str
@@ -292,7 +292,7 @@ def decide(
     supports: Supports,
     *,
     method: str = "auto",
-    cost: str = "count",
+    cost: str = DEFAULT_COST,
     max_boxes: int | None = None,
     time_limit: float | None = None,
     samples: int | None = None,
@@ -310,8 +310,11 @@ def decide(
         ``approx``: Markov chain Monte Carlo over consistent worlds, with standard errors
         (up to 63 boxes per group); ``auto``: per group of linked boxes, SAT up to 5
         boxes, exact up to 8 (7 when ``time_limit`` is under 10 s), sampling above.
-    cost : {"count", "mass"}
-        Eq. 11 (number of supported boxes) or their total mass (needs masses).
+    cost : {"load", "count", "mass"}
+        ``load`` (the default): Eq. 11's count with every box counted together with the
+        undetected load the cloud shows on it (``supports.hidden_load``; equal to ``count``
+        without it); ``count``: Eq. 11 exactly (number of supported boxes); ``mass``: their
+        total mass (needs masses). See :mod:`unstack.reasoner.costs`.
     max_boxes : int, optional
         Override the exact methods' size limit.
     time_limit : float, optional
@@ -366,7 +369,7 @@ def decide(
         if result.sampled is not None:
             covariance[block] = result.sampled.errors_of(weights[group])[1]
         worlds = None if worlds is None or result.worlds is None else worlds * result.worlds
-    costs = expected_costs(marginals, weights)
+    costs = expected_costs(marginals, weights, own_costs(supports, cost))
     choice, ties = choose(supports.objects, costs)
     largest = int(np.argmax([len(group) for group in groups]))
     return Decision(

@@ -18,6 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+from unstack.reasoner.costs import DEFAULT_COST
 from unstack.reasoner.decision import Decision, decide
 from unstack.supports import Supports
 
@@ -75,7 +76,7 @@ class Plan:
         }
 
 
-def unloading_plan(supports: Supports, *, method: str = "auto", cost: str = "count", **sampling: Any) -> Plan:
+def unloading_plan(supports: Supports, *, method: str = "auto", cost: str = DEFAULT_COST, **sampling: Any) -> Plan:
     """Order every box by repeated minimum-EC decisions (see the module docstring).
 
     ``sampling``: ``time_limit``, ``samples``, ``seed`` of :func:`~unstack.reasoner.decision.decide`,

@@ -1,0 +1,140 @@
+"""Load that nobody detected: what the point cloud shows resting on a detected box.
+
+Eq. 11 counts only detected boxes, so a detected box carrying an undetected one costs as
+little as a free box -- although the cloud shows the load. For each detected box X this
+module estimates the expected number of undetected boxes resting on it, from the points
+over X's footprint that no detected box explains (points inside a detected box grown by
+:data:`EXPLAINED_MARGIN` are explained; a ceiling -- the highest points, spread wide -- is
+dropped first):
+
+* the points over X's footprint swept :data:`FRONT_REACH` towards the door (a box resting
+  on X that is deeper than X shows its front face in front of X's footprint);
+* the lowest unexplained point above X's top must lie within one typical box height (plus
+  :data:`STACK_GAP`) of it -- a box resting on X whose front face is not seen still shows
+  its top there;
+* ``coverage``: the share of :data:`COVERAGE_BIN`-wide bins across X's width (world y, as
+  the sensor at the door sees it) holding an unexplained point within :data:`LOAD_BAND` of
+  the lowest one -- how much of X's top carries something;
+* ``rise``: how high the unexplained material reaches, going up without a vertical gap
+  wider than :data:`STACK_GAP`;
+* the estimate ``coverage * max(1, rise / typical box height)``, the typical height being
+  the median height of the detected boxes: one layer of load per box height.
+
+It is geometric and needs no model; what it measures on simulated piles is on the
+generalisation page of the docs.
+
+Examples
+--------
+>>> from unstack.scene import Box, Scene
+>>> from unstack.clouds import surface_cloud
+>>> boxes = [Box("loaded", [0.4, 0.4, 0.3], [1.0, -0.4, 0.15]), Box("unseen", [0.4, 0.4, 0.3], [1.0, -0.4, 0.45]),
+...          Box("free", [0.4, 0.4, 0.3], [1.0, 0.4, 0.15])]
+>>> scene = Scene(boxes, surface_cloud(boxes, viewpoint=[-2.0, 0.0, 1.5], seed=0), ["loaded", "free"])
+>>> hidden_load(scene).round(1).tolist()
+[1.0, 0.0]
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from unstack.geometry import bounding_boxes, box_corners, convex_hull_2d, footprint, points_in_box
+from unstack.scene import Scene
+
+__all__ = ["EXPLAINED_MARGIN", "LOAD_BAND", "STACK_GAP", "hidden_load"]
+
+#: Points within this distance of a detected box belong to it (metres).
+EXPLAINED_MARGIN = 0.02
+#: Points up to this far above the lowest unexplained point count as resting on the box (metres).
+LOAD_BAND = 0.15
+#: A vertical gap wider than this ends the material stacked on a box (metres).
+STACK_GAP = 0.08
+#: Points closer than this to a box's top belong to the top face (metres).
+FACE_TOLERANCE = 0.015
+#: Unexplained material higher than this above a box is not counted (metres).
+MAX_RISE = 1.5
+#: Width of the bins across a box in which coverage is counted (metres).
+COVERAGE_BIN = 0.04
+#: The footprint is swept this far towards the door (-x) before looking for load (metres).
+FRONT_REACH = 0.08
+#: The highest points of the cloud are a ceiling when they spread over more than this (metres) ...
+CEILING_SPREAD = 1.0
+#: ... within this height (metres).
+CEILING_THICKNESS = 0.05
+
+
+def _over(polygon: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Points whose vertical projection falls on a convex counter-clockwise polygon."""
+    edges = np.roll(polygon, -1, axis=0) - polygon
+    offsets = points[None, :, :2] - polygon[:, None, :]
+    cross = edges[:, None, 0] * offsets[..., 1] - edges[:, None, 1] * offsets[..., 0]
+    inside: np.ndarray = np.all(cross >= -1e-9, axis=0)
+    return inside
+
+
+def _without_ceiling(points: np.ndarray) -> np.ndarray:
+    """Drop a ceiling: the highest points, when they spread over more than
+    :data:`CEILING_SPREAD` in both x and y (a plane no box is)."""
+    if len(points) == 0:
+        return points
+    highest = float(points[:, 2].max())
+    near_top = points[:, 2] > highest - CEILING_THICKNESS
+    spread = np.ptp(points[near_top, :2], axis=0)
+    if np.all(spread > CEILING_SPREAD):
+        return points[~near_top]
+    return points
+
+
+def _load_on(column: np.ndarray, top: float, low_y: float, high_y: float, typical_height: float) -> float:
+    """The estimate for one box from the unexplained points over it (see the module docstring)."""
+    heights = column[:, 2] - top
+    above = np.sort(heights[(heights > FACE_TOLERANCE) & (heights <= MAX_RISE)])
+    if len(above) == 0 or above[0] > typical_height + STACK_GAP:
+        return 0.0  # nothing over the box, or only far above it (not resting on it)
+    jumps = np.flatnonzero(np.diff(above) > STACK_GAP)
+    rise = float(above[jumps[0]] if len(jumps) else above[-1])
+    first = float(above[0])
+    band = column[(heights >= first) & (heights <= first + LOAD_BAND)]
+    bins = max(1, int(np.ceil((high_y - low_y) / COVERAGE_BIN)))
+    occupied = np.unique(np.clip(((band[:, 1] - low_y) / (high_y - low_y) * bins).astype(int), 0, bins - 1))
+    return len(occupied) / bins * max(1.0, rise / typical_height)
+
+
+def hidden_load(scene: Scene, detected: Sequence[str] | None = None) -> np.ndarray:
+    """Expected number of undetected boxes resting on each detected box, in ``scene.detected`` order.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its detected boxes' poses and its point cloud are used; undetected boxes' poses
+        are not (a robot does not know them).
+    detected : sequence of str, optional
+        Box ids to treat as the detected ones instead of ``scene.detected`` (an ISet).
+
+    Returns
+    -------
+    numpy.ndarray, shape (len(detected),)
+        Non-negative; 0 where the cloud shows nothing unexplained on a box.
+    """
+    boxes = [scene.box(box_id) for box_id in (scene.detected if detected is None else detected)]
+    points = scene.points
+    result = np.zeros(len(boxes))
+    if len(points) == 0 or not boxes:
+        return result
+    explained = np.zeros(len(points), dtype=bool)
+    for box in boxes:
+        explained |= points_in_box(points, box, margin=EXPLAINED_MARGIN)
+    free_points = _without_ceiling(points[~explained])
+    typical_height = float(np.median([np.ptp(box_corners(box)[:, 2]) for box in boxes]))
+    bounds = bounding_boxes(boxes)
+    for k, box in enumerate(boxes):
+        low, high = bounds[k, :2] - [FRONT_REACH, 0.0], bounds[k, 3:5]
+        column = free_points[np.all((free_points[:, :2] >= low) & (free_points[:, :2] <= high), axis=1)]
+        if len(column) == 0:
+            continue
+        polygon = footprint(box)
+        swept = convex_hull_2d(np.vstack([polygon, polygon - [FRONT_REACH, 0.0]]))
+        result[k] = _load_on(column[_over(swept, column)], bounds[k, 5], low[1], high[1], typical_height)
+    return result
