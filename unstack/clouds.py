@@ -26,7 +26,7 @@ from unstack.errors import UnstackError
 from unstack.geometry import rotation_matrix
 from unstack.scene import Box
 
-__all__ = ["surface_cloud"]
+__all__ = ["NOMINAL_VIEWPOINT", "surface_cloud", "vary_cloud"]
 
 #: Face normals of a cuboid in its own frame, and the two axes spanning each face.
 _FACES = [(axis, sign, [k for k in range(3) if k != axis]) for axis in range(3) for sign in (-1.0, 1.0)]
@@ -130,3 +130,51 @@ def surface_cloud(
     if depth_noise > 0:
         cloud = eye + directions * (ranges + rng.normal(0.0, depth_noise, size=len(ranges)))[:, None]
     return np.ascontiguousarray(cloud, dtype=np.float64)
+
+
+#: Where :func:`vary_cloud` assumes the sensor was when it adds depth noise (the project's
+#: default sensor position).
+NOMINAL_VIEWPOINT = (-2.8, 0.0, 1.3)
+
+
+def vary_cloud(
+    points: np.ndarray,
+    rng: np.random.Generator,
+    *,
+    keep_range: tuple[float, float] = (0.05, 1.0),
+    max_depth_noise: float = 0.01,
+    max_holes: int = 4,
+    viewpoint: Sequence[float] = NOMINAL_VIEWPOINT,
+) -> np.ndarray:
+    """The same scene as another sensor might see it: sparser, noisier, with holes.
+
+    Keeps a share of the points drawn log-uniformly from ``keep_range``, adds a normal
+    error of up to ``max_depth_noise`` metres along the rays from ``viewpoint``, and cuts up
+    to ``max_holes`` balls (radius 0.05-0.25 m, around random points) out of the cloud --
+    faces that returned nothing. Used to train models that do not lean on one sensor.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> cloud = rng.uniform(0, 1, size=(10_000, 3))
+    >>> varied = vary_cloud(cloud, np.random.default_rng(1))
+    >>> 0 < len(varied) <= len(cloud)
+    True
+    """
+    if len(points) == 0:
+        return points
+    low, high = keep_range
+    share = float(np.exp(rng.uniform(np.log(low), np.log(high))))
+    kept = points[rng.random(len(points)) < share]
+    for _ in range(int(rng.integers(0, max_holes + 1))):
+        if len(kept) == 0:
+            break
+        centre = kept[rng.integers(len(kept))]
+        kept = kept[np.linalg.norm(kept - centre, axis=1) > rng.uniform(0.05, 0.25)]
+    sigma = float(rng.uniform(0.0, max_depth_noise))
+    if sigma > 0 and len(kept):
+        eye = np.asarray(viewpoint, dtype=np.float64)
+        rays = kept - eye
+        ranges = np.linalg.norm(rays, axis=1, keepdims=True)
+        kept = eye + rays / ranges * (ranges + rng.normal(0.0, sigma, size=ranges.shape))
+    return np.ascontiguousarray(kept, dtype=np.float64)

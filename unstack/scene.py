@@ -33,6 +33,37 @@ __all__ = ["SCENE_FORMAT", "Box", "Scene", "load_points", "load_scene"]
 SCENE_FORMAT = "unstack.scene/1"
 
 
+def _check_edges(size: np.ndarray, source: str, path: str) -> np.ndarray:
+    """Refuse box edges no carton has (the unit is metres)."""
+    from unstack.plausibility import MAX_BOX_EDGE, MIN_BOX_EDGE
+
+    for k, edge in enumerate(size):
+        if not MIN_BOX_EDGE <= edge <= MAX_BOX_EDGE:
+            raise InvalidScene(
+                source,
+                f"{path}[{k}]",
+                f"expected a box edge between {MIN_BOX_EDGE} and {MAX_BOX_EDGE} m (unstack works in metres), "
+                f"got {edge:g}",
+            )
+    return size
+
+
+def _check_coordinates(values: np.ndarray, source: str, path: str) -> np.ndarray:
+    """Refuse coordinates farther than :data:`unstack.plausibility.MAX_COORDINATE` from the origin."""
+    from unstack.plausibility import MAX_COORDINATE
+
+    far = np.argwhere(np.abs(values) > MAX_COORDINATE)
+    if far.size:
+        where = "".join(f"[{k}]" for k in far[0])
+        raise InvalidScene(
+            source,
+            f"{path}{where}",
+            f"expected a coordinate within {MAX_COORDINATE:g} m of the origin (unstack works in metres), "
+            f"got {values[tuple(far[0])]:g}",
+        )
+    return values
+
+
 @dataclass(frozen=True, eq=False)
 class Box:
     """A carton box: a cuboid with a pose.
@@ -77,8 +108,20 @@ class Box:
         if not isinstance(id, str) or not id:
             raise InvalidScene(source, f"{path}.id", f"expected a non-empty string id, got {id!r}")
         object.__setattr__(self, "id", id)
-        object.__setattr__(self, "size", check_vector(size, 3, positive=True, source=source, path=f"{path}.size"))
-        object.__setattr__(self, "position", check_vector(position, 3, source=source, path=f"{path}.position"))
+        object.__setattr__(
+            self,
+            "size",
+            _check_edges(
+                check_vector(size, 3, positive=True, source=source, path=f"{path}.size"), source, f"{path}.size"
+            ),
+        )
+        object.__setattr__(
+            self,
+            "position",
+            _check_coordinates(
+                check_vector(position, 3, source=source, path=f"{path}.position"), source, f"{path}.position"
+            ),
+        )
         object.__setattr__(
             self,
             "orientation_xyzw",
@@ -133,6 +176,21 @@ def load_points(
     except Exception as error:  # noqa: BLE001 - any reader failure is the file's fault
         raise InvalidScene(source, json_path, f"cannot read point cloud {file.name!r}: {error}") from None
     return check_points(array, source=source, path=json_path)
+
+
+def _refuse_overlaps(boxes: tuple[Box, ...], source: str) -> None:
+    """Two boxes cannot share more than half of the smaller one's volume."""
+    from unstack.plausibility import REFUSED_OVERLAP, overlapping_pairs
+
+    pairs = overlapping_pairs(boxes, REFUSED_OVERLAP)
+    if pairs:
+        i, j, share = pairs[0]
+        raise InvalidScene(
+            source,
+            f"$.boxes[{j}]",
+            f"box {boxes[j].id!r} shares {100 * share:.0f} % of the smaller one's volume with box {boxes[i].id!r} "
+            f"($.boxes[{i}]); expected boxes that overlap by at most {100 * REFUSED_OVERLAP:.0f} %",
+        )
 
 
 @dataclass(frozen=True, eq=False)
@@ -201,8 +259,9 @@ class Scene:
                 i, j = bad[0]
                 raise InvalidScene(source, f"$.ground_truth.support[{i}][{j}]", f"expected 0 or 1, got {truth[i, j]}")
             truth.setflags(write=False)
-        cloud = check_points(points, source=source, path=points_path)
+        cloud = _check_coordinates(check_points(points, source=source, path=points_path), source, points_path)
         cloud.setflags(write=False)
+        _refuse_overlaps(boxes, source)
         object.__setattr__(self, "boxes", boxes)
         object.__setattr__(self, "points", cloud)
         object.__setattr__(self, "detected", detected_ids)

@@ -11,6 +11,8 @@ from rich.table import Table
 from rich.text import Text
 
 from unstack.errors import ModelRequired, UnstackError
+from unstack.learning.features import FEATURE_SETS
+from unstack.learning.training_data import ISET_DRAWS
 
 __all__ = ["evaluate", "load_support_model", "metrics_view", "probabilities", "scene_supports", "train"]
 
@@ -63,52 +65,76 @@ def metrics_view(report: dict[str, Any], title: str) -> Group:
 
 ISETS_FROM_HELP = "How ISets are drawn: random detected boxes, or a detected box and its nearest neighbours."
 MODEL_HELP = "Model file, or a shipped model: paper (the default: the paper's SVM) or extended (better decisions)."
-FEATURES_HELP = "paper: the 19 numbers of Eq. 6; extended: those and 17 contact features (gaps, overlaps, cloud)."
+FEATURES_HELP = (
+    "paper: the 19 numbers of Eq. 6; extended: those and 17 contact features (gaps, overlaps, cloud); "
+    "general: 18 features that do not depend on how the cloud was sampled (oriented geometry, cloud coverage)."
+)
+#: Configuration numbers of the n-th data set of a training run start at n times this.
+CONFIGURATION_OFFSET = 100_000
 
 
-def _examples(data_dir: str, r: int, isets: int, seed: int, jobs: int, settings: Any, draw: str = "random") -> Any:
-    from unstack.learning.training_data import dataset_examples
+def _examples(
+    data_dirs: str | tuple[str, ...],
+    r: int,
+    isets: int,
+    seed: int,
+    jobs: int,
+    settings: Any,
+    draw: str = "random",
+    vary_clouds: bool = False,
+) -> Any:
+    from dataclasses import replace
+
+    from unstack.learning.training_data import SupportExamples, dataset_examples
     from unstack.sim.dataset import require_configurations
 
-    require_configurations(data_dir)  # before any progress bar: the error is the only line
+    folders = (data_dirs,) if isinstance(data_dirs, str) else data_dirs
+    for folder in folders:
+        require_configurations(folder)  # before any progress bar: the error is the only line
     from unstack.cli.progress import progress_bar
 
-    with progress_bar("features") as report:
-        examples = dataset_examples(
-            data_dir, r=r, isets=isets, seed=seed, settings=settings, n_jobs=jobs, progress=report, draw=draw
-        )
+    parts = []
+    for number, folder in enumerate(folders):
+        with progress_bar(f"features {folder}" if len(folders) > 1 else "features") as report:
+            part = dataset_examples(folder, r=r, isets=isets, seed=seed + number, settings=settings, n_jobs=jobs,
+                                    progress=report, draw=draw, vary_clouds=vary_clouds)  # fmt: skip
+        parts.append(replace(part, configuration=part.configuration + number * CONFIGURATION_OFFSET))
+    examples = SupportExamples.concatenate(parts)
     if len(examples.labels) == 0:
-        raise UnstackError(f"{data_dir}: no ISet of at least 2 detected boxes; nothing to learn from")
+        raise UnstackError(f"{', '.join(folders)}: no ISet of at least 2 detected boxes; nothing to learn from")
     return examples
 
 
 @click.command()
-@click.argument("data_dir", type=click.Path(file_okay=False))
+@click.argument("data_dirs", nargs=-1, required=True, type=click.Path(file_okay=False))
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Model file to write.")
 @click.option("--learner", type=click.Choice(["svm", "gradient_boosting", "calibrated_svm"]), default="svm",
               show_default=True, help="svm: RBF SVM with LIBSVM probabilities (the paper).")  # fmt: skip
 @click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
 @click.option("--isets", type=int, default=3, show_default=True, help="ISets drawn per configuration.")
-@click.option("--isets-from", "draw", type=click.Choice(["random", "neighbours"]), default="random",
+@click.option("--isets-from", "draw", type=click.Choice(list(ISET_DRAWS)), default="random",
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
+@click.option("--vary-clouds/--same-clouds", default=False, show_default=True,
+              help="Show each ISet its cloud as another sensor might: sparser, noisier, with holes.")  # fmt: skip
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets, the split and the folds.")
 @click.option("--split-by", type=click.Choice(["pairs", "configuration"]), default="pairs", show_default=True,
               help="pairs: the paper's split of the relations; configuration: whole piles on one side.")  # fmt: skip
 @click.option("--cv", type=int, default=10, show_default=True, help="Cross-validation folds on the training part.")
 @click.option("--validation-size", type=float, default=0.3, show_default=True, help="Share held out for validation.")
-@click.option("--features", "feature_set", type=click.Choice(["paper", "extended"]), default="paper",
+@click.option("--features", "feature_set", type=click.Choice(list(FEATURE_SETS)), default="paper",
               show_default=True, help=FEATURES_HELP)  # fmt: skip
 @click.option("--offset", type=float, default=1.0, show_default=True, help="d: interest-point offset (m).")
 @click.option("--sigma", type=float, default=0.5, show_default=True, help="Width of the DBAF's Gaussian (m).")
 @click.option("--jobs", type=int, default=1, show_default=True, help="Parallel processes.")
 @click.option("--json", "as_json", is_flag=True, help="Print the training report as JSON.")
 def train(
-    data_dir: str,
+    data_dirs: tuple[str, ...],
     output: str,
     learner: str,
     r: int,
     isets: int,
     draw: str,
+    vary_clouds: bool,
     seed: int,
     split_by: str,
     cv: int,
@@ -119,7 +145,10 @@ def train(
     jobs: int,
     as_json: bool,
 ) -> None:
-    """Train the support classifier on a simulated data set (unstack simulate) and save it."""
+    """Train the support classifier on simulated data sets (unstack simulate) and save it.
+
+    Several DATA_DIRS (pile families, say) are pooled; their piles stay whole in the split.
+    """
     from unstack.learning.classifier import SupportClassifier
     from unstack.learning.features import FeatureSettings
     from unstack.learning.model_file import SupportModel, save_model
@@ -129,7 +158,7 @@ def train(
     if r < 2 or isets < 1 or cv < 2 or jobs < 1 or not 0.0 <= validation_size < 1.0:
         raise UnstackError("expected --r >= 2, --isets >= 1, --cv >= 2, --jobs >= 1 and 0 <= --validation-size < 1")
     settings = FeatureSettings(offset=offset, sigma=sigma, feature_set=feature_set)
-    examples = _examples(data_dir, r, isets, seed, jobs, settings, draw)
+    examples = _examples(data_dirs, r, isets, seed, jobs, settings, draw, vary_clouds)
     console = Console(stderr=as_json)
     console.print(
         f"{len(examples.labels)} relations ({int(examples.labels.sum())} SUPP) from "
@@ -138,12 +167,14 @@ def train(
     classifier = SupportClassifier(
         learner=learner, cv=cv, validation_size=validation_size, n_jobs=jobs, random_state=seed
     ).fit(examples.features, examples.labels, groups=examples.configuration if split_by == "configuration" else None)
-    manifest = read_manifest(data_dir) or {}
+    manifests = [read_manifest(folder) or {} for folder in data_dirs]
+    single = len(data_dirs) == 1
     training = {
-        "data": str(data_dir),
-        "fingerprint": dataset_fingerprint(data_dir),
-        "simulation_seed": manifest.get("seed"),
-        "simulation_settings": manifest.get("settings"),
+        "data": str(data_dirs[0]) if single else [str(folder) for folder in data_dirs],
+        "fingerprint": dataset_fingerprint(data_dirs[0]) if single else [dataset_fingerprint(f) for f in data_dirs],
+        "simulation_seed": manifests[0].get("seed") if single else [m.get("seed") for m in manifests],
+        "simulation_settings": manifests[0].get("settings") if single else [m.get("settings") for m in manifests],
+        "vary_clouds": vary_clouds,
         "seed": seed,
         "r": r,
         "isets_per_configuration": isets,
@@ -153,7 +184,7 @@ def train(
         "supp": int(examples.labels.sum()),
         "validation_size": validation_size,
     }
-    model = SupportModel.from_classifier(classifier, settings, training=training)
+    model = SupportModel.from_classifier(classifier, settings, training=training, training_features=examples.features)
     save_model(model, output)
     report = {"model": output, "learner": learner, "features": settings.to_dict(),
               **{k: model.metadata[k] for k in ("best_params", "cv_score")},

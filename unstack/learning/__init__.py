@@ -10,12 +10,38 @@ Examples
 19
 """
 
-from unstack.learning.classifier import LEARNERS, SupportClassifier
-from unstack.learning.features import FEATURE_NAMES, FeatureSettings, dbaf, pair_features
-from unstack.learning.metrics import average_entropy, balanced_error_rate, classification_report
-from unstack.learning.model_file import InvalidModel, SupportModel, default_model_path, load_model, save_model
-from unstack.learning.probabilities import scene_support_probabilities
-from unstack.learning.training_data import SupportExamples, dataset_examples, scene_examples
+from importlib import import_module
+from typing import Any
+
+#: Where each public name lives: imported on first use, so that importing a light module of
+#: the package (the feature names, say) does not import scikit-learn.
+_HOMES = {
+    "LEARNERS": "classifier",
+    "SupportClassifier": "classifier",
+    "FEATURE_NAMES": "features",
+    "FeatureSettings": "features",
+    "dbaf": "features",
+    "pair_features": "features",
+    "average_entropy": "metrics",
+    "balanced_error_rate": "metrics",
+    "classification_report": "metrics",
+    "InvalidModel": "model_file",
+    "SupportModel": "model_file",
+    "default_model_path": "model_file",
+    "load_model": "model_file",
+    "save_model": "model_file",
+    "scene_support_probabilities": "probabilities",
+    "SupportExamples": "training_data",
+    "dataset_examples": "training_data",
+    "scene_examples": "training_data",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _HOMES:
+        return getattr(import_module(f"unstack.learning.{_HOMES[name]}"), name)
+    raise AttributeError(f"module 'unstack.learning' has no attribute {name!r}")
+
 
 __all__ = [
     "FEATURE_NAMES",

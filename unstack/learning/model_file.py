@@ -41,10 +41,12 @@ __all__ = [
     "BUNDLED_MODELS",
     "DEFAULT_MODEL",
     "MODEL_FORMAT",
+    "RANGE_MARGIN",
     "InvalidModel",
     "SupportModel",
     "bundled_model_path",
     "default_model_path",
+    "feature_ranges",
     "load_model",
     "save_model",
 ]
@@ -92,9 +94,18 @@ class SupportModel:
 
     @classmethod
     def from_classifier(
-        cls, classifier: SupportClassifier, features: FeatureSettings, *, training: dict[str, Any]
+        cls,
+        classifier: SupportClassifier,
+        features: FeatureSettings,
+        *,
+        training: dict[str, Any],
+        training_features: np.ndarray | None = None,
     ) -> SupportModel:
-        """Wrap a fitted :class:`SupportClassifier`."""
+        """Wrap a fitted :class:`SupportClassifier`.
+
+        With ``training_features`` (the rows it was trained on) the model keeps the range
+        of each feature (:func:`feature_ranges`) to tell when an input lies outside it.
+        """
         from unstack.provenance import package_versions
 
         versions = package_versions("unstack", "scikit-learn", "numpy", "skops")
@@ -107,7 +118,33 @@ class SupportModel:
             "training": training,
             "versions": versions,
         }
+        if training_features is not None:
+            from unstack.learning.features import feature_names
+
+            metadata["feature_ranges"] = feature_ranges(training_features, feature_names(features))
         return cls(classifier.estimator_, features, metadata)
+
+    def out_of_range(self, features: np.ndarray) -> list[tuple[int, str, float, float, float]]:
+        """Rows of ``features`` outside the training range: ``(row, feature, value, low, high)``.
+
+        A value counts as outside when it lies beyond the training range's 0.5 and 99.5
+        percentiles by more than :data:`RANGE_MARGIN` of the range's width. Empty for a
+        model that does not keep its ranges.
+        """
+        ranges = self.metadata.get("feature_ranges")
+        if not ranges or len(features) == 0:
+            return []
+        from unstack.learning.features import feature_names
+
+        names = feature_names(self.features)
+        low = np.array([ranges[name][0] for name in names])
+        high = np.array([ranges[name][1] for name in names])
+        margin = RANGE_MARGIN * np.maximum(high - low, 1e-9)
+        outside = (features < low - margin) | (features > high + margin)
+        return [
+            (int(row), names[int(column)], float(features[row, column]), float(low[column]), float(high[column]))
+            for row, column in np.argwhere(outside)
+        ]
 
     def support_probability(self, features: np.ndarray) -> np.ndarray:
         """P(SUPP) for each row of ``F_XY``."""
@@ -116,6 +153,23 @@ class SupportModel:
         classes = list(self.estimator.classes_)
         probability: np.ndarray = self.estimator.predict_proba(features)[:, classes.index(1)]
         return probability
+
+
+#: How far beyond its training range (a share of the range's width) a feature may go
+#: before the input counts as out of distribution.
+RANGE_MARGIN = 0.1
+
+
+def feature_ranges(features: np.ndarray, names: tuple[str, ...]) -> dict[str, list[float]]:
+    """The 0.5 and 99.5 percentiles of each feature column, by name.
+
+    Examples
+    --------
+    >>> feature_ranges(np.arange(201.0).reshape(-1, 1), ("x",))
+    {'x': [1.0, 199.0]}
+    """
+    low, high = np.percentile(features, [0.5, 99.5], axis=0)
+    return {name: [float(a), float(b)] for name, a, b in zip(names, low, high, strict=True)}
 
 
 def _plain(value: Any) -> Any:

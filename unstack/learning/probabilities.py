@@ -32,6 +32,28 @@ __all__ = ["PROBABILITY_FLOOR", "scene_support_probabilities"]
 PROBABILITY_FLOOR = 1e-6
 
 
+#: Out-of-distribution features named one by one in a warning, before "and N more".
+NAMED_OUT_OF_RANGE = 3
+
+
+def _out_of_distribution(
+    source: str, model: SupportModel, features: np.ndarray, pairs: list[tuple[str, str]]
+) -> list[str]:
+    """One warning naming the pairs and features outside the model's training range."""
+    outside = model.out_of_range(features)
+    if not outside:
+        return []
+    named = "; ".join(
+        f"({pairs[row][0]!r}, {pairs[row][1]!r}) {name} = {value:.3g} outside [{low:.3g}, {high:.3g}]"
+        for row, name, value, low, high in outside[:NAMED_OUT_OF_RANGE]
+    )
+    more = f" and {len(outside) - NAMED_OUT_OF_RANGE} more" if len(outside) > NAMED_OUT_OF_RANGE else ""
+    return [
+        f"{source}: out of distribution: features of {len({row for row, *_ in outside})} of {len(pairs)} box pairs "
+        f"lie outside the model's training range: {named}{more}; the probabilities there are extrapolated"
+    ]
+
+
 def scene_support_probabilities(
     scene: Scene, model: SupportModel, *, model_name: str = "", boxes: Sequence[str] | None = None
 ) -> Supports:
@@ -50,7 +72,10 @@ def scene_support_probabilities(
     Returns
     -------
     Supports
-        With masses when every detected box has one.
+        With masses when every detected box has one, the hidden load of every box
+        (:mod:`unstack.hidden_load`), and in ``metadata["warnings"]`` what is doubtful:
+        the scene's plausibility warnings (:func:`unstack.plausibility.scene_warnings`)
+        and features outside the model's training range (out of distribution).
     """
     if len(scene.points) == 0:
         warnings.warn(f"{scene.source}: the point cloud is empty; the DBAF features are 0", stacklevel=2)
@@ -60,11 +85,17 @@ def scene_support_probabilities(
     n = len(detected)
     pairs = [(detected[i], detected[j]) for i in range(n) for j in range(n) if i != j]
     probabilities = np.zeros((n, n))
+    from unstack.plausibility import scene_warnings
+
+    doubts = scene_warnings(scene)
     if pairs:
         features = pair_features(scene.boxes, scene.points, pairs, model.features)
         values = np.clip(model.support_probability(features), PROBABILITY_FLOOR, 1.0 - PROBABILITY_FLOOR)
         rows, columns = np.nonzero(~np.eye(n, dtype=bool))
         probabilities[rows, columns] = values
+        doubts += _out_of_distribution(
+            scene.source, model, features, [(objects[i], objects[j]) for i, j in zip(rows, columns, strict=True)]
+        )
     from unstack.hidden_load import hidden_load
 
     masses = [scene.boxes[k].mass for k in detected]
@@ -74,6 +105,7 @@ def scene_support_probabilities(
         "learner": model.metadata.get("learner"),
         "features": model.features.to_dict(),
         "clipped_to": [PROBABILITY_FLOOR, 1.0 - PROBABILITY_FLOOR],
+        "warnings": doubts,
     }
     return Supports(
         objects,

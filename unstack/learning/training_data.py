@@ -83,8 +83,9 @@ class SupportExamples:
 #: detected box and its nearest detected boxes (centroid distance), as a detector sees a
 #: patch of the pile. ``unstack experiment fig5a paper-test --isets-from neighbours --isets 2``
 #: (paper-test: ``unstack simulate --configs 100 --seed 1``) draws 1,007 SUPP among 4,000
-#: relations (25 %); random ISets of the training piles hold 8.9 % (paper: 33 %).
-ISET_DRAWS = ("random", "neighbours")
+#: relations (25 %); random ISets of the training piles hold 8.9 % (paper: 33 %). ``mixed``
+#: draws each ISet one way or the other at random.
+ISET_DRAWS = ("random", "neighbours", "mixed")
 
 
 def sample_isets(
@@ -131,6 +132,9 @@ def sample_isets(
         raise UnstackError("neighbour ISets need the centroid of every detected box")
     result = []
     for _ in range(isets):
+        if draw == "mixed" and rng.random() < 0.5:
+            result.append(sorted(rng.choice(list(detected), size=size, replace=False).tolist()))
+            continue
         centre = int(rng.integers(len(detected)))
         distances = np.linalg.norm(positions - positions[centre], axis=1)
         nearest = np.argsort(distances, kind="stable")[:size]
@@ -153,8 +157,13 @@ def scene_examples(
     settings: FeatureSettings | None = None,
     configuration: int = 0,
     draw: str = "random",
+    vary_clouds: bool = False,
 ) -> SupportExamples:
-    """Examples of one scene with ground truth (``draw``: see :data:`ISET_DRAWS`)."""
+    """Examples of one scene with ground truth (``draw``: see :data:`ISET_DRAWS`).
+
+    With ``vary_clouds`` each ISet sees the cloud as another sensor might
+    (:func:`unstack.clouds.vary_cloud`: sparser, noisier, with holes).
+    """
     if scene.ground_truth is None:
         raise UnstackError(f"{scene.source}: $.ground_truth: training needs scenes with a ground-truth support matrix")
     rng = np.random.default_rng(seed)
@@ -163,7 +172,12 @@ def scene_examples(
     drawn = sample_isets(scene.detected, r=r, isets=isets, rng=rng, draw=draw, positions=detected_positions(scene))
     for iset_index, iset in enumerate(drawn):
         pairs = [(index[x], index[y]) for x in iset for y in iset if x != y]
-        features = pair_features(scene.boxes, scene.points, pairs, settings)
+        points = scene.points
+        if vary_clouds:
+            from unstack.clouds import vary_cloud
+
+            points = vary_cloud(points, rng)
+        features = pair_features(scene.boxes, points, pairs, settings)
         labels = np.array([scene.ground_truth[x, y] for x, y in pairs], dtype=np.int64)
         parts.append(
             SupportExamples(
@@ -178,14 +192,28 @@ def scene_examples(
 
 
 def _one_file(
-    path: Path, r: int, isets: int, seed: int, settings: FeatureSettings, configuration: int, draw: str
+    path: Path,
+    r: int,
+    isets: int,
+    seed: int,
+    settings: FeatureSettings,
+    configuration: int,
+    draw: str,
+    vary_clouds: bool,
 ) -> SupportExamples:
     scene = load_scene(path)
     if len(scene.points) == 0:
         warnings.warn(f"{path}: the point cloud is empty; its DBAF features are 0", stacklevel=2)
     child = np.random.SeedSequence(seed, spawn_key=(configuration,))
     return scene_examples(
-        scene, r=r, isets=isets, seed=child, settings=settings, configuration=configuration, draw=draw
+        scene,
+        r=r,
+        isets=isets,
+        seed=child,
+        settings=settings,
+        configuration=configuration,
+        draw=draw,
+        vary_clouds=vary_clouds,
     )
 
 
@@ -213,10 +241,12 @@ def dataset_examples(
     n_jobs: int = 1,
     progress: Callable[[int, int], None] | None = None,
     draw: str = "random",
+    vary_clouds: bool = False,
 ) -> SupportExamples:
     """Examples of every scene of a simulated data set folder (``config-NNNN.json``).
 
-    ``draw``: how ISets are drawn (see :data:`ISET_DRAWS`).
+    ``draw``: how ISets are drawn (see :data:`ISET_DRAWS`); ``vary_clouds``: see
+    :func:`scene_examples`.
 
     ISets are seeded per configuration, so the examples do not depend on ``n_jobs``.
     """
@@ -228,7 +258,10 @@ def dataset_examples(
     settings = settings or FeatureSettings()
     if draw not in ISET_DRAWS:
         raise UnstackError(f"unknown ISet draw {draw!r}; expected one of {', '.join(ISET_DRAWS)}")
-    tasks = (delayed(_one_file)(path, r, isets, seed, settings, int(path.stem.split("-")[1]), draw) for path in files)
+    tasks = (
+        delayed(_one_file)(path, r, isets, seed, settings, int(path.stem.split("-")[1]), draw, vary_clouds)
+        for path in files
+    )
     parts: list[SupportExamples] = []
     for part in Parallel(n_jobs=n_jobs, return_as="generator")(tasks):
         parts.append(part)
