@@ -82,6 +82,7 @@ def _examples(
     settings: Any,
     draw: str = "random",
     vary_clouds: bool = False,
+    pose_noise: float = 0.0,
 ) -> Any:
     from dataclasses import replace
 
@@ -97,7 +98,8 @@ def _examples(
     for number, folder in enumerate(folders):
         with progress_bar(f"features {folder}" if len(folders) > 1 else "features") as report:
             part = dataset_examples(folder, r=r, isets=isets, seed=seed + number, settings=settings, n_jobs=jobs,
-                                    progress=report, draw=draw, vary_clouds=vary_clouds)  # fmt: skip
+                                    progress=report, draw=draw, vary_clouds=vary_clouds,
+                                    pose_noise=pose_noise)  # fmt: skip
         parts.append(replace(part, configuration=part.configuration + number * CONFIGURATION_OFFSET))
     examples = SupportExamples.concatenate(parts)
     if len(examples.labels) == 0:
@@ -116,6 +118,8 @@ def _examples(
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
 @click.option("--vary-clouds/--same-clouds", default=False, show_default=True,
               help="Show each ISet its cloud as another sensor might: sparser, noisier, with holes.")  # fmt: skip
+@click.option("--pose-noise", type=click.FloatRange(0.0, 0.1), default=0.0, show_default=True,
+              help="Show each ISet its boxes as a detector reports them: errors of this many metres.")  # fmt: skip
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets, the split and the folds.")
 @click.option("--split-by", type=click.Choice(["pairs", "configuration"]), default="pairs", show_default=True,
               help="pairs: the paper's split of the relations; configuration: whole piles on one side.")  # fmt: skip
@@ -135,6 +139,7 @@ def train(
     isets: int,
     draw: str,
     vary_clouds: bool,
+    pose_noise: float,
     seed: int,
     split_by: str,
     cv: int,
@@ -158,7 +163,7 @@ def train(
     if r < 2 or isets < 1 or cv < 2 or jobs < 1 or not 0.0 <= validation_size < 1.0:
         raise UnstackError("expected --r >= 2, --isets >= 1, --cv >= 2, --jobs >= 1 and 0 <= --validation-size < 1")
     settings = FeatureSettings(offset=offset, sigma=sigma, feature_set=feature_set)
-    examples = _examples(data_dirs, r, isets, seed, jobs, settings, draw, vary_clouds)
+    examples = _examples(data_dirs, r, isets, seed, jobs, settings, draw, vary_clouds, pose_noise)
     console = Console(stderr=as_json)
     console.print(
         f"{len(examples.labels)} relations ({int(examples.labels.sum())} SUPP) from "
@@ -175,6 +180,7 @@ def train(
         "simulation_seed": manifests[0].get("seed") if single else [m.get("seed") for m in manifests],
         "simulation_settings": manifests[0].get("settings") if single else [m.get("settings") for m in manifests],
         "vary_clouds": vary_clouds,
+        "pose_noise": pose_noise,
         "seed": seed,
         "r": r,
         "isets_per_configuration": isets,

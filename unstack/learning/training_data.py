@@ -28,7 +28,7 @@ import numpy as np
 
 from unstack.errors import UnstackError
 from unstack.learning.features import FeatureSettings, pair_features
-from unstack.scene import Scene, load_scene
+from unstack.scene import Box, Scene, load_scene
 
 __all__ = [
     "ISET_DRAWS",
@@ -36,6 +36,7 @@ __all__ = [
     "dataset_examples",
     "dataset_fingerprint",
     "detected_positions",
+    "detector_poses",
     "sample_isets",
     "scene_examples",
 ]
@@ -142,6 +143,31 @@ def sample_isets(
     return result
 
 
+#: Yaw error of :func:`detector_poses` per metre of position error (degrees per metre).
+YAW_PER_METRE = 200.0
+
+
+def detector_poses(boxes: Sequence[Box], noise: float, rng: np.random.Generator) -> list[Box]:
+    """The boxes as a detector might report them: normal position errors of ``noise`` metres
+    across (x, y) and half of it vertically, yaw errors of ``YAW_PER_METRE * noise`` degrees.
+
+    Examples
+    --------
+    >>> moved = detector_poses([Box("a", [0.4, 0.4, 0.3], [1.0, 0.0, 0.15])], 0.01, np.random.default_rng(0))
+    >>> bool(np.linalg.norm(moved[0].position - [1.0, 0.0, 0.15]) < 0.1)
+    True
+    """
+    from scipy.spatial.transform import Rotation
+
+    result = []
+    for box in boxes:
+        shift = rng.normal(0.0, noise, size=3) * [1.0, 1.0, 0.5]
+        yaw = Rotation.from_euler("z", rng.normal(0.0, YAW_PER_METRE * noise), degrees=True)
+        orientation = (yaw * Rotation.from_quat(box.orientation_xyzw)).as_quat()
+        result.append(Box(box.id, box.size, box.position + shift, orientation, box.mass))
+    return result
+
+
 def detected_positions(scene: Scene) -> np.ndarray:
     """Centroids of the scene's detected boxes, in ``scene.detected`` order."""
     index = {box_id: k for k, box_id in enumerate(scene.box_ids)}
@@ -158,11 +184,15 @@ def scene_examples(
     configuration: int = 0,
     draw: str = "random",
     vary_clouds: bool = False,
+    pose_noise: float = 0.0,
 ) -> SupportExamples:
     """Examples of one scene with ground truth (``draw``: see :data:`ISET_DRAWS`).
 
     With ``vary_clouds`` each ISet sees the cloud as another sensor might
-    (:func:`unstack.clouds.vary_cloud`: sparser, noisier, with holes).
+    (:func:`unstack.clouds.vary_cloud`: sparser, noisier, with holes). With ``pose_noise``
+    (metres) each ISet's boxes are seen as a box detector reports them
+    (:func:`detector_poses`): a simulated pile's boxes interpenetrate by fractions of a
+    millimetre, a detector's are a centimetre off either way.
     """
     if scene.ground_truth is None:
         raise UnstackError(f"{scene.source}: $.ground_truth: training needs scenes with a ground-truth support matrix")
@@ -177,7 +207,8 @@ def scene_examples(
             from unstack.clouds import vary_cloud
 
             points = vary_cloud(points, rng)
-        features = pair_features(scene.boxes, points, pairs, settings)
+        boxes = detector_poses(scene.boxes, pose_noise, rng) if pose_noise > 0 else scene.boxes
+        features = pair_features(boxes, points, pairs, settings)
         labels = np.array([scene.ground_truth[x, y] for x, y in pairs], dtype=np.int64)
         parts.append(
             SupportExamples(
@@ -200,6 +231,7 @@ def _one_file(
     configuration: int,
     draw: str,
     vary_clouds: bool,
+    pose_noise: float,
 ) -> SupportExamples:
     scene = load_scene(path)
     if len(scene.points) == 0:
@@ -214,6 +246,7 @@ def _one_file(
         configuration=configuration,
         draw=draw,
         vary_clouds=vary_clouds,
+        pose_noise=pose_noise,
     )
 
 
@@ -242,11 +275,12 @@ def dataset_examples(
     progress: Callable[[int, int], None] | None = None,
     draw: str = "random",
     vary_clouds: bool = False,
+    pose_noise: float = 0.0,
 ) -> SupportExamples:
     """Examples of every scene of a simulated data set folder (``config-NNNN.json``).
 
-    ``draw``: how ISets are drawn (see :data:`ISET_DRAWS`); ``vary_clouds``: see
-    :func:`scene_examples`.
+    ``draw``: how ISets are drawn (see :data:`ISET_DRAWS`); ``vary_clouds`` and
+    ``pose_noise``: see :func:`scene_examples`.
 
     ISets are seeded per configuration, so the examples do not depend on ``n_jobs``.
     """
@@ -259,7 +293,7 @@ def dataset_examples(
     if draw not in ISET_DRAWS:
         raise UnstackError(f"unknown ISet draw {draw!r}; expected one of {', '.join(ISET_DRAWS)}")
     tasks = (
-        delayed(_one_file)(path, r, isets, seed, settings, int(path.stem.split("-")[1]), draw, vary_clouds)
+        delayed(_one_file)(path, r, isets, seed, settings, int(path.stem.split("-")[1]), draw, vary_clouds, pose_noise)
         for path in files
     )
     parts: list[SupportExamples] = []
