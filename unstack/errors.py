@@ -15,6 +15,7 @@ Examples
 from __future__ import annotations
 
 __all__ = [
+    "InvalidArgument",
     "InvalidFile",
     "InvalidScene",
     "InvalidSupports",
@@ -29,6 +30,18 @@ __all__ = [
 
 class UnstackError(Exception):
     """Root of every error unstack raises for a user's mistake or an impossible request."""
+
+
+class InvalidArgument(UnstackError, ValueError):
+    """A function argument out of its domain (a negative time limit, an unknown method name).
+
+    Also a :class:`ValueError`, so callers that catch the standard exception still catch it.
+
+    Examples
+    --------
+    >>> isinstance(InvalidArgument("samples must be at least 1, got 0"), ValueError)
+    True
+    """
 
 
 class InvalidFile(UnstackError):

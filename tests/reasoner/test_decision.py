@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -153,3 +154,70 @@ def test_explicit_exact_method_keeps_its_limit(rng: np.random.Generator) -> None
 def test_unknown_method_is_rejected() -> None:
     with pytest.raises(UnstackError, match="unknown method 'fast'"):
         decide(Supports(["a"], [[0.0]]), method="fast")
+
+
+def test_ranking_puts_the_choice_first_then_ties_then_by_cost() -> None:
+    from unstack.reasoner.decision import decide as decide_supports
+
+    p = np.zeros((4, 4))
+    p[3, 0] = 0.5  # d may support a: EC(d) = 0.5, the others 0 (tied; smallest id "a" wins)
+    decision = decide_supports(Supports(["c", "a", "b", "d"], p), cost="count")
+    assert [box for box, _, _ in decision.ranking()] == ["a", "b", "c", "d"]
+    assert decision.ranking()[0][0] == decision.choice
+    assert [error for _, _, error in decision.ranking()] == [0.0] * 4
+
+
+def test_the_json_is_canonical_and_timing_only_on_request() -> None:
+    import json
+
+    import jsonschema
+
+    from unstack.jsonio import load_schema
+    from unstack.reasoner.decision import decide as decide_supports
+
+    rng = np.random.default_rng(3)
+    p = rng.uniform(0.05, 0.95, (10, 10))
+    np.fill_diagonal(p, 0.0)
+    supports = Supports([f"b{i}" for i in range(10)], p)
+    first = decide_supports(supports, method="approx", samples=512, seed=7).to_dict()
+    second = decide_supports(supports, method="approx", samples=512, seed=7).to_dict()
+    assert json.dumps(first) == json.dumps(second)
+    assert "timing" not in first and "seconds" not in first and "seconds" not in first["sampling"]
+    timed = decide_supports(supports, samples=512, seed=7).to_dict(timing=True)
+    assert set(timed["timing"]) == {"seconds", "sampling_seconds"}
+    for document in (first, timed):
+        jsonschema.validate(document, load_schema("unstack.decision/1"))
+
+
+def test_warnings_come_from_the_supports_metadata() -> None:
+    from unstack.reasoner.decision import decide as decide_supports
+
+    supports = Supports(["a", "b"], [[0, 0.2], [0.7, 0]], metadata={"warnings": ["box a floats 0.3 m above b"]})
+    decision = decide_supports(supports)
+    assert decision.warnings == ("box a floats 0.3 m above b",)
+    assert decision.to_dict()["warnings"] == ["box a floats 0.3 m above b"]
+
+
+def test_a_contradiction_names_the_file(tmp_path: Path) -> None:
+    from unstack.errors import NoConsistentWorld
+    from unstack.reasoner.decision import decide as decide_supports
+    from unstack.supports import load_supports
+
+    file = tmp_path / "contradiction.json"
+    Supports(["a", "b", "c"], [[0, 1, 0], [0, 0, 1], [0, 0, 0]]).save(file)
+    with pytest.raises(NoConsistentWorld, match=r"contradiction\.json: no consistent world: P\(SUPP\(a, b\)\) = 1"):
+        decide_supports(load_supports(file))
+
+
+def test_default_budget_is_a_number_of_sweeps_reproducible_for_a_seed() -> None:
+    from unstack.reasoner.decision import decide as decide_supports
+    from unstack.reasoner.sampling import DEFAULT_SAMPLES
+
+    rng = np.random.default_rng(5)
+    p = rng.uniform(0.05, 0.95, (9, 9))
+    np.fill_diagonal(p, 0.0)
+    supports = Supports([f"b{i}" for i in range(9)], p)
+    first, second = (decide_supports(supports, seed=11) for _ in range(2))
+    assert first.sampling is not None and first.sampling["samples"] == [DEFAULT_SAMPLES]
+    np.testing.assert_array_equal(first.expected_costs, second.expected_costs)
+    np.testing.assert_array_equal(first.expected_cost_errors, second.expected_cost_errors)

@@ -65,12 +65,23 @@ def test_worlds_breaking_near_certain_relations_stay_representable() -> None:
 def test_partition_below_the_guard_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None:
     import unstack.reasoner.marginals as marginals_module
 
-    probabilities = np.full((3, 3), 1e-200)
+    probabilities = np.full((6, 6), 1e-200)  # 6 boxes: the compiled walk (float64 weights)
     probabilities[0, 1] = probabilities[1, 2] = 1 - 1e-16
     np.fill_diagonal(probabilities, 0.0)
     monkeypatch.setattr(marginals_module, "SMALLEST_PARTITION", 1e-10)  # the real guard is 1e-280
-    with pytest.raises(NumericalRangeError, match=r"too extreme for float64.*--method sat"):
+    with pytest.raises(NumericalRangeError, match=r"too extreme for float64.*method 'sat'"):
         exact_marginals(probabilities)
+
+
+def test_small_groups_work_in_log_space_below_the_guard(monkeypatch: pytest.MonkeyPatch) -> None:
+    import unstack.reasoner.marginals as marginals_module
+
+    probabilities = np.full((3, 3), 1e-200)
+    probabilities[0, 1] = probabilities[1, 2] = 1 - 1e-16
+    np.fill_diagonal(probabilities, 0.0)
+    monkeypatch.setattr(marginals_module, "SMALLEST_PARTITION", 1e-10)
+    result = exact_marginals(probabilities)
+    np.testing.assert_allclose(result.marginals, brute_force(probabilities)[0], atol=1e-12)
 
 
 def test_size_limit_is_a_clear_error() -> None:

@@ -111,10 +111,16 @@ def test_time_limit_bounds_the_run(rng: np.random.Generator) -> None:
 def test_bad_arguments_are_refused(rng: np.random.Generator) -> None:
     with pytest.raises(TooLarge, match="64 linked boxes: the sampler holds at most 63 boxes"):
         sampled_marginals(np.zeros((64, 64)), samples=10)
-    with pytest.raises(UnstackError, match="chains, tries and samples must be at least 1"):
+    with pytest.raises(UnstackError, match="samples must be at least 1, got 0"):
         sampled_marginals(np.zeros((3, 3)), samples=0)
-    with pytest.raises(UnstackError, match="the seed must be a non-negative integer, got -2"):
+    with pytest.raises(UnstackError, match="seed must be at least 0, got -2"):
         sampled_marginals(np.zeros((3, 3)), samples=10, seed=-2)
+    with pytest.raises(ValueError, match="time_limit must be a positive, finite number of seconds, got nan"):
+        sampled_marginals(np.zeros((3, 3)), time_limit=float("nan"))
+    with pytest.raises(ValueError, match="chains must be at least 1, got 0"):
+        sampled_marginals(np.zeros((3, 3)), samples=10, chains=0)
+    with pytest.raises(ValueError, match=r"probabilities\[0\]\[1\]: expected a probability in \[0, 1\], got 2.0"):
+        sampled_marginals(np.array([[0, 2.0], [0, 0]]), samples=10)
 
 
 def test_convergence_is_near_one_when_chains_agree(rng: np.random.Generator) -> None:

@@ -11,6 +11,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from unstack.threads import PARALLEL_KERNELS
+
 
 def column_index(points: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Points sorted by (column, z), the first row of each column, the grid origin and its shape."""
@@ -24,7 +26,7 @@ def column_index(points: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarra
 
 
 @njit(cache=True, parallel=True)
-def counts_in_boxes(
+def _counts_in_boxes(
     points: np.ndarray,
     starts: np.ndarray,
     origin: np.ndarray,
@@ -69,4 +71,19 @@ def counts_in_boxes(
                         highest = max(highest, z)
         counts[q] = count
         top[q] = highest
+    return counts, top
+
+
+def counts_in_boxes(
+    points: np.ndarray,
+    starts: np.ndarray,
+    origin: np.ndarray,
+    shape: np.ndarray,
+    cell: float,
+    low: np.ndarray,
+    high: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The compiled counts, holding :data:`unstack.threads.PARALLEL_KERNELS` (safe from any thread)."""
+    with PARALLEL_KERNELS:
+        counts, top = _counts_in_boxes(points, starts, origin, shape, cell, low, high)
     return counts, top

@@ -5,9 +5,11 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from unstack.threads import PARALLEL_KERNELS
+
 
 @njit(cache=True, parallel=True, fastmath=False)
-def gaussian_sums(
+def _gaussian_sums(
     points: np.ndarray, queries: np.ndarray, inverse_two_variance: float
 ) -> np.ndarray:  # pragma: no cover
     """``sum_k exp(-||q - p_k||^2 * inverse_two_variance)`` for every query point q."""
@@ -21,4 +23,11 @@ def gaussian_sums(
             dz = points[k, 2] - qz
             total += np.exp(-(dx * dx + dy * dy + dz * dz) * inverse_two_variance)
         sums[q] = total
+    return sums
+
+
+def gaussian_sums(points: np.ndarray, queries: np.ndarray, inverse_two_variance: float) -> np.ndarray:
+    """The compiled sum, holding :data:`unstack.threads.PARALLEL_KERNELS` (safe from any thread)."""
+    with PARALLEL_KERNELS:
+        sums: np.ndarray = _gaussian_sums(points, queries, inverse_two_variance)
     return sums

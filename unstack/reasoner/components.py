@@ -26,7 +26,6 @@ Examples
 
 from __future__ import annotations
 
-import networkx as nx
 import numpy as np
 
 __all__ = ["support_components"]
@@ -37,10 +36,19 @@ def support_components(probabilities: np.ndarray) -> list[np.ndarray]:
 
     Groups are sorted by their smallest index; indices inside a group are increasing.
     """
-    n = probabilities.shape[0]
-    graph = nx.Graph()
-    graph.add_nodes_from(range(n))
-    rows, columns = np.nonzero((probabilities > 0) | (probabilities.T > 0))
-    graph.add_edges_from((int(i), int(j)) for i, j in zip(rows, columns, strict=True) if i < j)
-    groups = [np.array(sorted(group), dtype=np.int64) for group in nx.connected_components(graph)]
-    return sorted(groups, key=lambda group: int(group[0]))
+    linked = (probabilities > 0) | (probabilities.T > 0)
+    n = linked.shape[0]
+    unseen = np.ones(n, dtype=bool)
+    groups = []
+    for start in range(n):
+        if not unseen[start]:
+            continue
+        members = np.zeros(n, dtype=bool)
+        members[start] = True
+        frontier = members.copy()
+        while frontier.any():
+            frontier = linked[frontier].any(axis=0) & ~members
+            members |= frontier
+        unseen &= ~members
+        groups.append(np.flatnonzero(members).astype(np.int64))
+    return groups

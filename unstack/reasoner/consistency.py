@@ -16,10 +16,12 @@ False
 from __future__ import annotations
 
 from itertools import permutations
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from unstack.reasoner.variables import SupportVariables
+if TYPE_CHECKING:  # the SAT encoding loads python-sat; the counts must not
+    from unstack.reasoner.variables import SupportVariables
 
 __all__ = ["PREORDER_COUNTS", "is_transitive", "transitivity_clauses"]
 
@@ -44,6 +46,7 @@ def transitivity_clauses(variables: SupportVariables) -> list[list[int]]:
 
     Examples
     --------
+    >>> from unstack.reasoner.variables import SupportVariables
     >>> len(transitivity_clauses(SupportVariables(["a", "b", "c"])))
     6
     """

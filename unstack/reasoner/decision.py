@@ -28,19 +28,19 @@ from typing import Any
 
 import numpy as np
 
-from unstack.errors import UnstackError
+from unstack.errors import InvalidArgument, NoConsistentWorld, UnstackError
+from unstack.reasoner.arguments import check_budget, check_choice, check_count, check_seed
 from unstack.reasoner.components import support_components
 from unstack.reasoner.confidence import choice_probability
-from unstack.reasoner.costs import DEFAULT_COST, cost_weights, expected_costs, own_costs
+from unstack.reasoner.costs import COSTS, DEFAULT_COST, cost_weights, expected_costs, own_costs
 from unstack.reasoner.marginals import EXACT_MAX_BOXES
 from unstack.reasoner.pruning import Evidence, propagate_evidence
-from unstack.reasoner.sampling import DEFAULT_TIME_LIMIT, SAMPLING_MAX_BOXES, SampledMarginals
-from unstack.reasoner.worlds import SAT_MAX_BOXES
+from unstack.reasoner.sampling import SAMPLING_MAX_BOXES, SampledMarginals
 from unstack.supports import Supports
 
 __all__ = [
-    "AUTO_SAT_MAX_BOXES",
     "DECISION_FORMAT",
+    "DEFAULT_COST",
     "METHODS",
     "TIE_TOLERANCE",
     "Decision",
@@ -51,11 +51,6 @@ __all__ = [
 DECISION_FORMAT = "unstack.decision/1"
 #: Reasoning methods: ``exact`` (weighted preorder counting), ``sat`` (list worlds).
 METHODS = ("auto", "exact", "sat", "approx")
-#: ``auto`` lists worlds with SAT up to this size and uses the exact engine above it.
-#: Measured end to end (``unstack decide --json``, best of 3, 2-core machine): SAT 0.41 s
-#: vs exact 0.81 s at n = 5 (loading numba's cached engine dominates), SAT 5.2 s vs
-#: exact 0.96 s at n = 6.
-AUTO_SAT_MAX_BOXES = 5
 #: With a time limit below this (seconds), ``auto`` samples groups of 8 boxes instead of
 #: counting them (exact n = 8 dense: 2.6 s on a quiet 2-core machine, 4.1 s loaded).
 AUTO_EXACT8_SECONDS = 10.0
@@ -99,7 +94,7 @@ class Decision:
     evidence : Evidence
         Hard evidence after propagation.
     seconds : float
-        Wall time of the reasoning.
+        Wall time of the reasoning (not in the canonical JSON; see :meth:`to_dict`).
     component_methods : tuple of str
         The method of each group in ``components``.
     expected_cost_errors : numpy.ndarray, shape (n,)
@@ -109,7 +104,19 @@ class Decision:
     choice_probability : float
         Probability that ``choice`` has the smallest true EC (1.0 when every EC is exact).
     sampling : dict or None
-        How the sampled groups were run (chains, samples, burn-in, acceptance, seed, seconds).
+        How the sampled groups were run (chains, samples, burn-in, acceptance, seed).
+    warnings : tuple of str
+        Doubts about the input the decision rests on (for a scene: plausibility and
+        out-of-distribution warnings from the support model), one sentence each.
+    sampling_seconds : float
+        Wall time of the sampled groups (0 when none was sampled).
+
+    Examples
+    --------
+    >>> from unstack.supports import Supports
+    >>> decision = decide(Supports(["top", "bottom"], [[0.0, 0.1], [0.9, 0.0]]))
+    >>> [(box, round(cost, 3), error) for box, cost, error in decision.ranking()]
+    [('top', 0.1, 0.0), ('bottom', 0.9, 0.0)]
     """
 
     objects: tuple[str, ...]
@@ -128,9 +135,58 @@ class Decision:
     marginal_errors: np.ndarray | None = None
     choice_probability: float = 1.0
     sampling: dict[str, Any] | None = None
+    warnings: tuple[str, ...] = ()
+    sampling_seconds: float = 0.0
 
-    def to_dict(self) -> dict[str, Any]:
-        """The ``unstack.decision/1`` JSON object."""
+    def ranking(self) -> list[tuple[str, float, float]]:
+        """Every box with its expected cost and that cost's standard error, best first.
+
+        The choice comes first, then the boxes tied with it (by id), then the rest by
+        expected cost (ties by id), as :func:`choose` orders them.
+
+        Returns
+        -------
+        list of (str, float, float)
+            ``(box, EC, standard error)``; the error is 0 where the EC is exact.
+
+        Examples
+        --------
+        >>> from unstack.supports import Supports
+        >>> decide(Supports(["a", "b"], [[0, 0.2], [0.7, 0]])).ranking()[0][0]
+        'a'
+        """
+        errors = self.expected_cost_errors if self.expected_cost_errors is not None else np.zeros(len(self.objects))
+        tied = set(self.ties)
+
+        def key(i: int) -> tuple[int, float, str]:
+            box = self.objects[i]
+            return (0, 0.0, box) if box in tied else (1, float(self.expected_costs[i]), box)
+
+        order = sorted(range(len(self.objects)), key=key)
+        return [(self.objects[i], float(self.expected_costs[i]), float(errors[i])) for i in order]
+
+    def to_dict(self, *, timing: bool = False) -> dict[str, Any]:
+        """The ``unstack.decision/1`` JSON object.
+
+        Parameters
+        ----------
+        timing : bool
+            Add ``"timing"`` (wall-clock seconds of the reasoning and of the sampling).
+            Without it the object is canonical: the same input, method and seed give the
+            same object on any machine, at any load.
+
+        Returns
+        -------
+        dict
+            JSON-ready (lists, floats, strings), valid against ``decision-1.schema.json``.
+
+        Examples
+        --------
+        >>> from unstack.supports import Supports
+        >>> document = decide(Supports(["a", "b"], [[0, 0.2], [0.7, 0]])).to_dict()
+        >>> document["format"], document["choice"], "timing" in document
+        ('unstack.decision/1', 'a', False)
+        """
         data: dict[str, Any] = {
             "format": DECISION_FORMAT,
             "objects": list(self.objects),
@@ -155,18 +211,36 @@ class Decision:
             "forced": [list(pair) for pair in self.evidence.forced],
             "forbidden": [list(pair) for pair in self.evidence.forbidden],
         }
-        data["seconds"] = round(self.seconds, 6)
+        data["warnings"] = list(self.warnings)
+        if timing:
+            data["timing"] = {"seconds": round(self.seconds, 6), "sampling_seconds": round(self.sampling_seconds, 6)}
         return data
 
 
 def choose(objects: tuple[str, ...], costs: np.ndarray) -> tuple[str, tuple[str, ...]]:
     """Pick the minimum-EC box; ties (within :data:`TIE_TOLERANCE`) go to the smallest id.
 
+    Parameters
+    ----------
+    objects : tuple of str
+        Box ids.
+    costs : numpy.ndarray, shape (n,)
+        Expected cost of each box.
+
+    Returns
+    -------
+    choice : str
+    ties : tuple of str
+        Every box within the tolerance of the minimum, by id.
+
     Examples
     --------
     >>> choose(("b", "a", "c"), np.array([0.5, 0.5, 0.7]))
     ('a', ('a', 'b'))
     """
+    costs = np.asarray(costs, dtype=np.float64)
+    if costs.shape != (len(objects),) or len(objects) == 0 or not np.all(np.isfinite(costs)):
+        raise InvalidArgument(f"expected one finite cost per object ({len(objects)}), got shape {costs.shape}")
     lowest = float(np.min(costs))
     tolerance = TIE_TOLERANCE * max(1.0, abs(lowest))
     tied = tuple(sorted(objects[i] for i in np.flatnonzero(costs <= lowest + tolerance)))
@@ -175,8 +249,6 @@ def choose(objects: tuple[str, ...], costs: np.ndarray) -> tuple[str, tuple[str,
 
 def _group_methods(method: str, sizes: list[int], n: int, time_limit: float | None) -> list[str]:
     """The method of each group of linked boxes (``sizes``: boxes per group, of ``n``)."""
-    if method not in METHODS:
-        raise UnstackError(f"unknown method {method!r}; expected one of {', '.join(METHODS)}")
     if method != "auto":
         return [method] * len(sizes)
     exact_limit = EXACT_MAX_BOXES
@@ -184,9 +256,7 @@ def _group_methods(method: str, sizes: list[int], n: int, time_limit: float | No
         exact_limit = min(exact_limit, 7)
     methods = []
     for size in sizes:
-        if size <= AUTO_SAT_MAX_BOXES:
-            methods.append("sat")
-        elif size <= exact_limit:
+        if size <= exact_limit:
             methods.append("exact")
         elif size <= SAMPLING_MAX_BOXES:
             methods.append("approx")
@@ -227,19 +297,19 @@ def _group_marginals(
     probabilities = evidence.probabilities[np.ix_(group, group)]
     exact_errors = np.zeros_like(probabilities)
     if method == "sat":
-        from unstack.reasoner.worlds import enumerate_worlds
+        from unstack.reasoner.worlds import SAT_MAX_BOXES, enumerate_worlds
 
         objects = [supports.objects[i] for i in group]
         world_set = enumerate_worlds(Supports(objects, probabilities), max_boxes=max_boxes or SAT_MAX_BOXES)
         return _GroupResult(world_set.marginals(), len(world_set), exact_errors)
     if method == "approx":
-        from unstack.reasoner.sampling import sampled_marginals
+        from unstack.reasoner.sampling import _sampled_marginals
 
-        result = sampled_marginals(probabilities, **sampling)
+        result = _sampled_marginals(np.ascontiguousarray(probabilities), **sampling)
         return _GroupResult(result.marginals, None, result.standard_errors, result)
-    from unstack.reasoner.marginals import exact_marginals
+    from unstack.reasoner.marginals import _exact_marginals
 
-    exact = exact_marginals(probabilities, max_boxes=max_boxes or EXACT_MAX_BOXES)
+    exact = _exact_marginals(probabilities, max_boxes=max_boxes or EXACT_MAX_BOXES)
     return _GroupResult(exact.marginals, exact.consistent_worlds, exact_errors)
 
 
@@ -260,7 +330,7 @@ def _time_share(deadline: float | None, group: np.ndarray, waiting: int) -> floa
 
 
 def _sampling_summary(results: list[_GroupResult], seed: int | None) -> dict[str, Any] | None:
-    """What the sampled groups ran: chains, samples, burn-in, acceptance, seconds."""
+    """What the sampled groups ran: chains, samples, burn-in, acceptance (no wall-clock time)."""
     sampled = [result.sampled for result in results if result.sampled is not None]
     if not sampled:
         return None
@@ -270,7 +340,6 @@ def _sampling_summary(results: list[_GroupResult], seed: int | None) -> dict[str
         "burn_in": sampled[0].burn_in,
         "acceptance": [round(result.acceptance, 4) for result in sampled],
         "seed": seed,
-        "seconds": round(sum(result.seconds for result in sampled), 6),
     }
     slowest = min(result.acceptance for result in sampled)
     worst_rhat = max(float(np.max(result.convergence_of(np.ones(result.marginals.shape[0])))) for result in sampled)
@@ -286,6 +355,26 @@ def _sampling_summary(results: list[_GroupResult], seed: int | None) -> dict[str
             "standard errors are too small; sample longer"
         )
     return summary
+
+
+def _propagate(supports: Supports) -> Evidence:
+    """Hard evidence of ``supports``; a contradiction names the file it came from."""
+    try:
+        return propagate_evidence(supports.objects, supports.probabilities)
+    except NoConsistentWorld as error:
+        if supports.source in ("", "<array>"):
+            raise
+        raise NoConsistentWorld(f"{supports.source}: {error}", error.conflict) from None
+
+
+def _model_warnings(supports: Supports) -> tuple[str, ...]:
+    """The warning sentences a support model left in the metadata (``"warnings"``)."""
+    found = supports.metadata.get("warnings", [])
+    if isinstance(found, str):
+        return (found,)
+    if not isinstance(found, list | tuple):
+        return ()
+    return tuple(str(item) for item in found)
 
 
 def decide(
@@ -305,11 +394,12 @@ def decide(
     supports : Supports
         Detected boxes and ``P(SUPP(X, Y))`` for every ordered pair.
     method : {"auto", "exact", "sat", "approx"}
-        ``exact``: weighted counting of preorders (no world list, up to 8 boxes by
-        default); ``sat``: list the consistent worlds with CaDiCaL (up to 6 boxes);
-        ``approx``: Markov chain Monte Carlo over consistent worlds, with standard errors
-        (up to 63 boxes per group); ``auto``: per group of linked boxes, SAT up to 5
-        boxes, exact up to 8 (7 when ``time_limit`` is under 10 s), sampling above.
+        ``exact``: weighted counting of preorders (no world list; a table of every preorder
+        up to 5 boxes, a compiled walk up to 8 by default); ``sat``: list the consistent
+        worlds with CaDiCaL (up to 6 boxes); ``approx``: Markov chain Monte Carlo over
+        consistent worlds, with standard errors (up to 63 boxes per group); ``auto``: per
+        group of linked boxes, exact up to 8 boxes (7 when ``time_limit`` is under 10 s),
+        sampling above.
     cost : {"load", "count", "mass"}
         ``load`` (the default): Eq. 11's count with every box counted together with the
         undetected load the cloud shows on it (``supports.hidden_load``; equal to ``count``
@@ -318,10 +408,12 @@ def decide(
     max_boxes : int, optional
         Override the exact methods' size limit.
     time_limit : float, optional
-        Seconds for the whole decision: the sampled groups share what the exact ones leave
-        (default 1 s unless ``samples`` is given).
+        Seconds for the whole decision: the sampled groups share what the exact ones leave.
+        Not reproducible (the sweeps that fit depend on the machine's load).
     samples : int, optional
-        Recorded sweeps per sampled group (reproducible for a ``seed``).
+        Recorded sweeps per sampled group (default
+        :data:`~unstack.reasoner.sampling.DEFAULT_SAMPLES` when ``time_limit`` is not
+        given either); reproducible for a ``seed``.
     seed : int, optional
         Seed of the sampler and of the choice probability.
 
@@ -331,22 +423,41 @@ def decide(
 
     Raises
     ------
+    InvalidArgument
+        Not a :class:`~unstack.supports.Supports`, an unknown method or cost, or a budget,
+        seed or size limit out of its domain (NaN, negative, zero).
     NoConsistentWorld
-        Hard evidence contradicts transitivity (the message names the relations).
+        Hard evidence contradicts transitivity (the message names the file and the relations).
     TooLarge
         The scene is beyond the method's limit.
+
+    Examples
+    --------
+    >>> from unstack.supports import Supports
+    >>> decide(Supports(["top", "bottom"], [[0.0, 0.1], [0.9, 0.0]]), method="sat").choice
+    'top'
     """
     start = time.perf_counter()
-    if seed is not None and seed < 0:
-        raise UnstackError(f"the seed must be a non-negative integer, got {seed}")
+    if not isinstance(supports, Supports):
+        raise InvalidArgument(
+            f"expected Supports, got {type(supports).__name__}; a Scene gets its probabilities from "
+            "a model with unstack.decide or unstack.support_probabilities"
+        )
+    check_choice(method, "method", METHODS)
+    check_choice(cost, "cost", COSTS)
+    if max_boxes is not None:
+        check_count(max_boxes, "max_boxes")
+    if time_limit is not None:
+        time_limit = check_budget(time_limit, "time_limit")
+    if samples is not None:
+        samples = check_count(samples, "samples")
+    seed = check_seed(seed)
     n = supports.n_objects
     weights = cost_weights(supports, cost)
-    evidence = propagate_evidence(supports.objects, supports.probabilities)
+    evidence = _propagate(supports)
     groups = support_components(evidence.probabilities)
     methods = _group_methods(method, [len(group) for group in groups], n, time_limit)
     seeds = _group_seeds(len(groups), seed)
-    if time_limit is None and samples is None:
-        time_limit = DEFAULT_TIME_LIMIT
     deadline = None if time_limit is None else start + time_limit
     waiting = sum(len(group) for group, method in zip(groups, methods, strict=True) if method == "approx")
     marginals = np.zeros((n, n))
@@ -389,4 +500,6 @@ def decide(
         ties=ties,
         evidence=evidence,
         seconds=time.perf_counter() - start,
+        warnings=_model_warnings(supports),
+        sampling_seconds=sum(result.sampled.seconds for result in results if result.sampled is not None),
     )

@@ -33,7 +33,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from unstack.errors import NumericalRangeError, TooLarge
+from unstack.reasoner.arguments import check_count, check_matrix
 from unstack.reasoner.consistency import PREORDER_COUNTS
+from unstack.reasoner.small import SMALL_MAX_BOXES, small_marginals
+from unstack.threads import PARALLEL_KERNELS
 
 __all__ = ["EXACT_MAX_BOXES", "ExactMarginals", "exact_marginals"]
 
@@ -126,15 +129,24 @@ def exact_marginals(probabilities: np.ndarray, *, max_boxes: int = EXACT_MAX_BOX
 
     Raises
     ------
+    InvalidArgument
+        Not a square matrix of probabilities with a zero diagonal, or ``max_boxes`` below 1.
     TooLarge
         More than ``max_boxes`` boxes.
     NumericalRangeError
         No consistent world keeps a representable weight.
+
+    Examples
+    --------
+    >>> exact_marginals([[0, 0.9], [0.2, 0]]).consistent_worlds
+    4
     """
-    from numba import parallel_chunksize
+    return _exact_marginals(check_matrix(probabilities), check_count(max_boxes, "max_boxes"))
 
-    from unstack.reasoner import _insertion_kernels as kernels
 
+def _exact_marginals(probabilities: np.ndarray, max_boxes: int = EXACT_MAX_BOXES) -> ExactMarginals:
+    """:func:`exact_marginals` on checked arguments: the table path up to
+    :data:`~unstack.reasoner.small.SMALL_MAX_BOXES` boxes, the compiled walk above."""
     n = probabilities.shape[0]
     if n > max_boxes:
         raise TooLarge(
@@ -142,11 +154,18 @@ def exact_marginals(probabilities: np.ndarray, *, max_boxes: int = EXACT_MAX_BOX
             f"(n = {max_boxes + 1} has {PREORDER_COUNTS[max_boxes + 1]:.2g} consistent worlds; "
             f"n = 8 takes seconds, each further box about 100 times longer)"
         )
+    if n <= SMALL_MAX_BOXES:
+        marginals, worlds, log_partition = small_marginals(probabilities)
+        return ExactMarginals(marginals, worlds, log_partition)
+    from numba import parallel_chunksize
+
+    from unstack.reasoner import _insertion_kernels as kernels
+
     tables = _level_weights(np.ascontiguousarray(probabilities, dtype=np.float64))
     depth = min(_split_depth(n), n - 1)
     tasks = kernels.collect_tasks(n, depth, PREORDER_COUNTS[depth], *tables)
     task_weight, task_downs, task_above, task_ups, task_sizes, path_downs, path_ups = tasks
-    with parallel_chunksize(1):
+    with PARALLEL_KERNELS, parallel_chunksize(1):
         subtree_sums, down_table, up_table, world_count = kernels.run_tasks(
             n, depth, task_weight, task_downs, task_above, task_ups, task_sizes, *tables
         )
@@ -158,7 +177,7 @@ def exact_marginals(probabilities: np.ndarray, *, max_boxes: int = EXACT_MAX_BOX
     if not partition > SMALLEST_PARTITION:
         raise NumericalRangeError(
             "the probabilities are too extreme for float64 weighted counting "
-            f"(partition function {partition:.3g}); use --method sat, which works in log space"
+            f"(partition function {partition:.3g}); use the SAT method (method 'sat'), which works in log space"
         )
     marginals = np.zeros((n, n))
     for j in range(1, n):

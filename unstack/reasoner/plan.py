@@ -51,12 +51,28 @@ class Plan:
     steps: tuple[PlanStep, ...]
 
     @property
+    def warnings(self) -> tuple[str, ...]:
+        """Doubts about the input (those of the first decision: the input's own warnings)."""
+        return self.steps[0].decision.warnings if self.steps else ()
+
+    @property
     def order(self) -> list[str]:
         """Box ids in unloading order."""
         return [step.choice for step in self.steps]
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``unstack.plan/1`` JSON object."""
+        """The ``unstack.plan/1`` JSON object (canonical: no wall-clock time).
+
+        Returns
+        -------
+        dict
+
+        Examples
+        --------
+        >>> from unstack.supports import Supports
+        >>> unloading_plan(Supports(["a", "b"], [[0, 0.2], [0.7, 0]])).to_dict()["order"]
+        ['a', 'b']
+        """
         return {
             "format": PLAN_FORMAT,
             "objects": list(self.objects),
@@ -73,20 +89,57 @@ class Plan:
                 }
                 for step in self.steps
             ],
+            "warnings": list(self.warnings),
         }
 
 
-def unloading_plan(supports: Supports, *, method: str = "auto", cost: str = DEFAULT_COST, **sampling: Any) -> Plan:
+def unloading_plan(
+    supports: Supports,
+    *,
+    method: str = "auto",
+    cost: str = DEFAULT_COST,
+    time_limit: float | None = None,
+    samples: int | None = None,
+    seed: int | None = None,
+) -> Plan:
     """Order every box by repeated minimum-EC decisions (see the module docstring).
 
-    ``sampling``: ``time_limit``, ``samples``, ``seed`` of :func:`~unstack.reasoner.decision.decide`,
-    applied to each step.
+    Parameters
+    ----------
+    supports : Supports
+        The detected boxes and their support probabilities.
+    method, cost, time_limit, samples, seed
+        As in :func:`~unstack.reasoner.decision.decide`, applied to each step (so with a
+        seed and no ``time_limit`` the plan is reproducible).
+
+    Returns
+    -------
+    Plan
+
+    Raises
+    ------
+    InvalidArgument
+        An argument out of its domain (checked before the first step).
+
+    Examples
+    --------
+    >>> from unstack.supports import Supports
+    >>> unloading_plan(Supports(["a", "b"], [[0, 0.2], [0.7, 0]])).order
+    ['a', 'b']
     """
-    remaining = list(supports.objects)
-    steps = []
-    while remaining:
-        decision = decide(supports.subset(remaining), method=method, cost=cost, **sampling)
+    remaining = list(supports.objects) if isinstance(supports, Supports) else []
+    steps: list[PlanStep] = []
+    while True:
+        decision = decide(
+            supports.subset(remaining) if steps else supports,
+            method=method,
+            cost=cost,
+            time_limit=time_limit,
+            samples=samples,
+            seed=seed,
+        )
         chosen = decision.objects.index(decision.choice)
         steps.append(PlanStep(decision.choice, float(decision.expected_costs[chosen]), tuple(remaining), decision))
         remaining.remove(decision.choice)
-    return Plan(supports.objects, tuple(steps))
+        if not remaining:
+            return Plan(supports.objects, tuple(steps))

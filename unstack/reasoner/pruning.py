@@ -3,7 +3,8 @@
 Probabilities of exactly 1 force a relation and of exactly 0 forbid it. Transitivity
 propagates both, and one pass reaches the fixed point:
 
-* forced: the transitive closure of the forced relations (computed with networkx);
+* forced: the transitive closure of the forced relations (Warshall's algorithm on a boolean
+  matrix; no graph library, so ``unstack decide`` stays light);
 * forbidden: ``SUPP(A, B)`` is forbidden when some ``C`` (``C = A`` or C forced to support
   A) and some ``D`` (``D = B`` or B forced to support D) have ``SUPP(C, D)`` forbidden,
   because ``C -> A -> B -> D`` would force it.
@@ -28,10 +29,10 @@ np.float64(1.0)
 from __future__ import annotations
 
 import itertools
+from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-import networkx as nx
 import numpy as np
 
 from unstack.errors import NoConsistentWorld
@@ -83,20 +84,20 @@ def propagate_evidence(objects: Sequence[str], probabilities: np.ndarray) -> Evi
         A forced chain implies a relation whose probability is 0.
     """
     n = len(objects)
-    forced_graph = nx.DiGraph()
-    forced_graph.add_nodes_from(range(n))
-    forced_graph.add_edges_from(map(tuple, np.argwhere(probabilities == 1.0)))
+    given_forced = probabilities == 1.0
+    np.fill_diagonal(given_forced, False)
     given_forbidden = probabilities == 0.0
     np.fill_diagonal(given_forbidden, False)
-    closure = nx.transitive_closure(forced_graph, reflexive=None)
-    forced = np.zeros((n, n), dtype=bool)
-    for a, b in closure.edges:
-        if a != b:
-            forced[a, b] = True
+    if not given_forced.any():
+        forbidden = given_forbidden  # nothing forced: nothing to propagate
+        forced = given_forced
+        pruned = probabilities.copy() if probabilities.flags.writeable else probabilities
+        return _evidence(objects, forced, forbidden, pruned)
+    forced = _closure(given_forced)
     conflicts = np.argwhere(forced & given_forbidden)
     if conflicts.size:
         a, b = (int(v) for v in conflicts[0])
-        chain = nx.shortest_path(forced_graph, a, b)
+        chain = _shortest_path(given_forced, a, b)
         links = [(objects[u], objects[v]) for u, v in itertools.pairwise(chain)]
         reason = " and ".join(f"P({_name(u, v)}) = 1" for u, v in links)
         raise NoConsistentWorld(
@@ -111,9 +112,38 @@ def propagate_evidence(objects: Sequence[str], probabilities: np.ndarray) -> Evi
     pruned = probabilities.copy()
     pruned[forced] = 1.0
     pruned[forbidden] = 0.0
+    return _evidence(objects, forced, forbidden, pruned)
+
+
+def _evidence(objects: Sequence[str], forced: np.ndarray, forbidden: np.ndarray, pruned: np.ndarray) -> Evidence:
     pruned.setflags(write=False)
     return Evidence(
         forced=tuple((objects[a], objects[b]) for a, b in np.argwhere(forced)),
         forbidden=tuple((objects[a], objects[b]) for a, b in np.argwhere(forbidden)),
         probabilities=pruned,
     )
+
+
+def _closure(relation: np.ndarray) -> np.ndarray:
+    """Transitive closure of a boolean relation (Warshall), without the diagonal."""
+    reach = relation.copy()
+    for k in range(reach.shape[0]):
+        reach |= reach[:, k : k + 1] & reach[k : k + 1, :]
+    np.fill_diagonal(reach, False)
+    return reach
+
+
+def _shortest_path(relation: np.ndarray, source: int, target: int) -> list[int]:
+    """A shortest chain ``source -> ... -> target`` of the relation (breadth-first search)."""
+    previous = {source: source}
+    queue = deque([source])
+    while queue:
+        node = queue.popleft()
+        for following in np.flatnonzero(relation[node]).tolist():
+            if following not in previous:
+                previous[following] = node
+                queue.append(following)
+    chain = [target]
+    while chain[-1] != source:
+        chain.append(previous[chain[-1]])
+    return chain[::-1]

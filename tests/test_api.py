@@ -1,0 +1,101 @@
+"""The top-level API a planner codes against: unstack.load_model, support_probabilities, decide, plan."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import unstack
+from unstack.errors import InvalidArgument, InvalidFile
+
+
+def test_a_scene_is_decided_through_the_default_model(examples: Path) -> None:
+    scene = unstack.load(examples / "pile5.scene.json")
+    assert isinstance(scene, unstack.Scene)
+    decision = unstack.decide(scene)
+    supports = unstack.support_probabilities(scene)
+    assert decision.objects == supports.objects == scene.detected
+    np.testing.assert_array_equal(decision.expected_costs, unstack.decide(supports).expected_costs)
+    assert supports.metadata["model"].startswith("default:")
+
+
+def test_a_shipped_model_is_named_and_loaded_once(examples: Path) -> None:
+    scene = unstack.load_scene(examples / "pile5.scene.json")
+    extended = unstack.load_model("extended")
+    assert unstack.load_model("extended") is extended
+    by_name = unstack.decide(scene, model="extended")
+    by_object = unstack.decide(scene, model=extended)
+    np.testing.assert_array_equal(by_name.expected_costs, by_object.expected_costs)
+    assert unstack.support_probabilities(scene, "extended").metadata["model"] == "shipped:extended-paper2.skops"
+
+
+def test_a_model_file_is_loaded_by_path(tmp_path: Path) -> None:
+    from unstack.learning.model_file import bundled_model_path
+
+    copy = tmp_path / "paper"  # named like a shipped model: a path reaches the file
+    copy.write_bytes(bundled_model_path("paper").read_bytes())
+    model = unstack.load_model(copy)
+    assert model is not unstack.load_model("paper")
+    with pytest.raises(InvalidFile, match=r"missing\.skops"):
+        unstack.load_model(tmp_path / "missing.skops")
+
+
+def test_wrong_arguments_are_invalid_arguments(examples: Path) -> None:
+    supports = unstack.load_supports(examples / "pile5.supports.json")
+    with pytest.raises(InvalidArgument, match=r"pile5\.supports\.json: a model turns a scene into support probabilities"):
+        unstack.decide(supports, model="paper")
+    with pytest.raises(ValueError, match="expected a Scene or Supports, got dict"):
+        unstack.plan({"objects": []})  # type: ignore[arg-type]
+    with pytest.raises(InvalidArgument, match="expected a Scene, got Supports"):
+        unstack.support_probabilities(supports)  # type: ignore[arg-type]
+    with pytest.raises(InvalidArgument, match="expected a model name or a model file path, got int"):
+        unstack.load_model(3)  # type: ignore[arg-type]
+    with pytest.raises(InvalidArgument, match="model must be a model name, a model file path or a SupportModel"):
+        unstack.decide(unstack.load_scene(examples / "pile5.scene.json"), model=3.0)  # type: ignore[arg-type]
+
+
+def test_plan_from_a_scene_and_from_supports(examples: Path) -> None:
+    plan = unstack.plan(unstack.load_scene(examples / "pile5.scene.json"), seed=0)
+    assert sorted(plan.order) == sorted(plan.objects)
+    supports = unstack.load_supports(examples / "pile5.supports.json")
+    assert unstack.plan(supports).order[0] == unstack.decide(supports).choice
+
+
+def test_validate_summarises_a_file(examples: Path) -> None:
+    result = unstack.validate(examples / "pile5.scene.json")
+    assert result.format == "unstack.scene/1" and "5 detected" in result.detail
+
+
+def test_importing_unstack_and_deciding_on_supports_stays_light(repo: Path) -> None:
+    code = (
+        "import sys, unstack\n"
+        "unstack.decide(unstack.load_supports('examples/pile5.supports.json'))\n"
+        "print(' '.join(sorted(sys.modules)))"
+    )
+    env = {**os.environ, "PYTHONPATH": str(repo)}
+    output = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=repo, env=env)
+    loaded = {name.split(".")[0] for name in output.stdout.split()}
+    assert not loaded & {"sklearn", "numba", "networkx", "pybullet", "matplotlib", "pysat", "scipy"}, sorted(loaded & {"sklearn", "numba", "networkx", "pybullet", "matplotlib", "pysat", "scipy"})
+    assert "unstack.learning" not in output.stdout.split()
+
+
+def test_the_public_api_is_listed_in_the_reference(repo: Path) -> None:
+    reference = (repo / "docs" / "reference.md").read_text()
+    for name in unstack.__all__:
+        if name != "__version__":
+            assert f"unstack.{name}" in reference, name
+
+
+def test_ranking_and_json_of_a_scene_decision(examples: Path) -> None:
+    decision = unstack.decide(unstack.load_scene(examples / "pile5.scene.json"))
+    ranking = decision.ranking()
+    assert ranking[0][0] == decision.choice
+    assert [cost for _, cost, _ in ranking[1:]] == sorted(cost for _, cost, _ in ranking[1:])
+    document = json.loads(json.dumps(decision.to_dict()))
+    assert document["choice"] == decision.choice and isinstance(document["warnings"], list)

@@ -1,0 +1,307 @@
+"""The one-call API a planner codes against (re-exported by :mod:`unstack`).
+
+``load_model`` names a shipped model or reads a model file; ``support_probabilities`` turns
+a scene into support probabilities with a model (the default one when none is given);
+``decide`` and ``plan`` take a scene or support probabilities and return a
+:class:`~unstack.reasoner.decision.Decision` or a :class:`~unstack.reasoner.plan.Plan`.
+
+Light by design: deciding on support probabilities imports neither scikit-learn nor the
+learning package; they load only when a scene needs probabilities. The shipped models are
+loaded once per process (thread-safe) and shared: treat them as read-only.
+
+Examples
+--------
+>>> import unstack
+>>> supports = unstack.Supports(["top", "bottom"], [[0, 0.1], [0.9, 0]])
+>>> unstack.decide(supports).choice
+'top'
+>>> unstack.plan(supports).order
+['top', 'bottom']
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+import weakref
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Union
+
+from unstack.errors import InvalidArgument, ModelRequired
+from unstack.reasoner.decision import DEFAULT_COST, Decision
+from unstack.reasoner.plan import Plan
+from unstack.scene import Scene
+from unstack.supports import Supports
+
+if TYPE_CHECKING:
+    from unstack.learning.model_file import SupportModel
+
+__all__ = ["decide", "load_model", "model_names", "plan", "support_probabilities"]
+
+ModelArgument = Union[None, str, os.PathLike[str], "SupportModel"]
+
+_LOCK = threading.Lock()
+#: Shipped models loaded so far: file path -> ((size, mtime), model).
+_SHIPPED: dict[str, tuple[tuple[int, int], SupportModel]] = {}
+#: What each loaded model is called in provenance metadata (by ``id``; dropped with the model).
+_LABELS: dict[int, str] = {}
+
+
+def model_names() -> tuple[str, ...]:
+    """The names of the models shipped with the package (what :func:`load_model` accepts besides files).
+
+    Returns
+    -------
+    tuple of str
+        Read at call time from :data:`unstack.learning.model_file.BUNDLED_MODELS`.
+
+    Examples
+    --------
+    >>> "paper" in model_names()
+    True
+    """
+    from unstack.learning.model_file import BUNDLED_MODELS
+
+    return tuple(BUNDLED_MODELS)
+
+
+def _remember(model: SupportModel, label: str) -> SupportModel:
+    key = id(model)
+    with _LOCK:
+        if key not in _LABELS:
+            weakref.finalize(model, _LABELS.pop, key, None)
+        _LABELS[key] = label
+    return model
+
+
+def _shipped(path: Path, label: str) -> SupportModel:
+    """A shipped model, loaded once per process (reloaded if the file changes)."""
+    from unstack.learning.model_file import load_model as read_model
+
+    try:
+        status = path.stat()
+    except OSError:
+        raise ModelRequired(
+            f"the shipped model {path.name} is not installed; load a model file instead (unstack train makes one)"
+        ) from None
+    stamp = (status.st_size, status.st_mtime_ns)
+    with _LOCK:
+        cached = _SHIPPED.get(str(path))
+    if cached is not None and cached[0] == stamp:
+        return cached[1]
+    model = read_model(path)  # outside the lock: another thread may load it too; either copy is fine
+    with _LOCK:
+        _SHIPPED[str(path)] = (stamp, model)
+    return _remember(model, label)
+
+
+def load_model(name_or_path: str | os.PathLike[str] | None = None) -> SupportModel:
+    """A support model: a shipped one by name, or a model file (``unstack.model/1``).
+
+    Parameters
+    ----------
+    name_or_path : str or path-like, optional
+        A name of :func:`model_names` (``"paper"``, ``"extended"``, ...) or the path of a
+        model file; ``None`` is the default model
+        (:func:`unstack.learning.model_file.default_model_path`). A file named like a
+        shipped model is reached with a path such as ``"./paper"``.
+
+    Returns
+    -------
+    SupportModel
+        Shipped models are loaded once per process and shared (read-only).
+
+    Raises
+    ------
+    InvalidArgument
+        ``name_or_path`` is neither a string nor a path.
+    ModelRequired
+        The shipped model is not installed.
+    InvalidModel
+        The file is missing, unreadable or not an unstack model (loading never runs code
+        from it).
+
+    Examples
+    --------
+    >>> model = load_model("paper")
+    >>> model.features.feature_set
+    'paper'
+    >>> load_model("paper") is model
+    True
+    """
+    from unstack.learning import model_file
+
+    if name_or_path is None:
+        path = model_file.default_model_path()
+        return _shipped(path, f"default:{path.name}")
+    if not isinstance(name_or_path, str | os.PathLike):
+        raise InvalidArgument(f"expected a model name or a model file path, got {type(name_or_path).__name__}")
+    name = os.fspath(name_or_path)
+    if isinstance(name_or_path, str) and name in model_file.BUNDLED_MODELS:
+        path = model_file.bundled_model_path(name)
+        return _shipped(path, f"shipped:{path.name}")
+    return _remember(model_file.load_model(name), name)
+
+
+def _model(model: Any) -> SupportModel:
+    """A loaded model from what a caller passed as ``model``."""
+    if model is None or isinstance(model, str | os.PathLike):
+        return load_model(model)
+    if not (hasattr(model, "support_probability") and hasattr(model, "features")):
+        raise InvalidArgument(
+            f"model must be a model name, a model file path or a SupportModel, got {type(model).__name__}"
+        )
+    loaded: SupportModel = model
+    return loaded
+
+
+def support_probabilities(scene: Scene, model: ModelArgument = None) -> Supports:
+    """``P(SUPP(X, Y))`` for every ordered pair of a scene's detected boxes, from a model.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its detected boxes become the objects, in that order.
+    model : str, path-like or SupportModel, optional
+        A shipped model's name, a model file, or a loaded model; ``None``: the default
+        model (loaded once per process).
+
+    Returns
+    -------
+    Supports
+        With the scene, the model and its warnings (``metadata["warnings"]``) recorded in
+        the metadata.
+
+    Raises
+    ------
+    InvalidArgument
+        ``scene`` is not a :class:`~unstack.scene.Scene`, or ``model`` is of the wrong type.
+
+    Examples
+    --------
+    >>> import unstack
+    >>> supports = support_probabilities(unstack.load_scene("examples/pile5.scene.json"))
+    >>> supports.n_objects, supports.metadata["model"]
+    (5, 'default:default-paper2.skops')
+    """
+    if not isinstance(scene, Scene):
+        raise InvalidArgument(f"expected a Scene, got {type(scene).__name__}")
+    from unstack.learning.probabilities import scene_support_probabilities
+
+    loaded = _model(model)
+    label = _LABELS.get(id(loaded), "")
+    return scene_support_probabilities(scene, loaded, model_name=label)
+
+
+def _supports(scene_or_supports: Any, model: Any) -> Supports:
+    if isinstance(scene_or_supports, Supports):
+        if model is not None:
+            raise InvalidArgument(
+                f"{scene_or_supports.source}: a model turns a scene into support probabilities; these are "
+                "support probabilities already, so the model would be ignored (pass no model)"
+            )
+        return scene_or_supports
+    if isinstance(scene_or_supports, Scene):
+        return support_probabilities(scene_or_supports, model)
+    raise InvalidArgument(f"expected a Scene or Supports, got {type(scene_or_supports).__name__}")
+
+
+def decide(
+    scene_or_supports: Scene | Supports,
+    *,
+    model: ModelArgument = None,
+    method: str = "auto",
+    cost: str = DEFAULT_COST,
+    seed: int | None = None,
+    samples: int | None = None,
+    time_limit: float | None = None,
+) -> Decision:
+    """Which box to unload first: from a scene (through a model) or from support probabilities.
+
+    Parameters
+    ----------
+    scene_or_supports : Scene or Supports
+        A scene gets its probabilities from ``model`` (:func:`support_probabilities`).
+    model : str, path-like or SupportModel, optional
+        For a scene only (an error with support probabilities); ``None``: the default model.
+    method : {"auto", "exact", "sat", "approx"}
+        See :func:`unstack.reasoner.decision.decide`.
+    cost : {"count", "mass"}
+        Eq. 11 (number of supported boxes) or their total mass.
+    seed : int, optional
+        Seed of the sampler: with it (and no ``time_limit``) the numbers are identical on
+        every run, whatever the machine's load.
+    samples : int, optional
+        Recorded sweeps per sampled group (default
+        :data:`~unstack.reasoner.sampling.DEFAULT_SAMPLES`).
+    time_limit : float, optional
+        Seconds for the whole decision instead of a fixed number of sweeps (not reproducible).
+
+    Returns
+    -------
+    Decision
+        ``choice``, ``expected_costs``, :meth:`~unstack.reasoner.decision.Decision.ranking`,
+        :meth:`~unstack.reasoner.decision.Decision.to_dict`, ``warnings``.
+
+    Raises
+    ------
+    InvalidArgument
+        A wrong type or an argument out of its domain (also a :class:`ValueError`).
+    NoConsistentWorld
+        Hard evidence contradicts transitivity.
+
+    Examples
+    --------
+    >>> import unstack
+    >>> decision = decide(unstack.load("examples/pile5.scene.json"))
+    >>> decision.choice == decision.ranking()[0][0]
+    True
+    >>> decide(unstack.Supports(["a", "b"], [[0, 0.2], [0.7, 0]]), seed=0).choice
+    'a'
+    """
+    from unstack.reasoner.decision import decide as decide_supports
+
+    supports = _supports(scene_or_supports, model)
+    return decide_supports(supports, method=method, cost=cost, seed=seed, samples=samples, time_limit=time_limit)
+
+
+def plan(
+    scene_or_supports: Scene | Supports,
+    *,
+    model: ModelArgument = None,
+    method: str = "auto",
+    cost: str = DEFAULT_COST,
+    seed: int | None = None,
+    samples: int | None = None,
+    time_limit: float | None = None,
+) -> Plan:
+    """An unloading order: decide, take the chosen box out, decide again on the rest.
+
+    Parameters
+    ----------
+    scene_or_supports : Scene or Supports
+        A scene gets its probabilities from ``model`` once, before the first step.
+    model, method, cost, seed, samples, time_limit
+        As in :func:`decide` (the budget applies to each step).
+
+    Returns
+    -------
+    Plan
+        ``order``, ``steps`` and :meth:`~unstack.reasoner.plan.Plan.to_dict`.
+
+    Raises
+    ------
+    InvalidArgument
+        A wrong type or an argument out of its domain.
+
+    Examples
+    --------
+    >>> import unstack
+    >>> supports = unstack.Supports(["top", "middle", "bottom"], [[0, 0.05, 0.02], [0.9, 0, 0.1], [0.8, 0.95, 0]])
+    >>> plan(supports).order
+    ['top', 'middle', 'bottom']
+    """
+    from unstack.reasoner.plan import unloading_plan
+
+    supports = _supports(scene_or_supports, model)
+    return unloading_plan(supports, method=method, cost=cost, seed=seed, samples=samples, time_limit=time_limit)

@@ -1,0 +1,114 @@
+"""Checks of the arguments of the reasoner's public functions (one place, one style).
+
+Each check returns the canonical value or raises :class:`~unstack.errors.InvalidArgument`
+(an :class:`~unstack.errors.UnstackError` and a :class:`ValueError`) naming the argument
+and what it got. Messages speak of arguments, never of command-line flags.
+
+Examples
+--------
+>>> check_budget(2.5, "time_limit")
+2.5
+>>> check_budget(float("nan"), "time_limit")
+Traceback (most recent call last):
+...
+unstack.errors.InvalidArgument: time_limit must be a positive, finite number of seconds, got nan
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from unstack.errors import InvalidArgument, InvalidFile
+
+__all__ = ["check_budget", "check_choice", "check_count", "check_matrix", "check_seed"]
+
+
+def check_budget(value: Any, name: str) -> float:
+    """A positive, finite number of seconds (``time_limit``).
+
+    Parameters
+    ----------
+    value : float
+        The argument.
+    name : str
+        Its name, for the message.
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> check_budget(1, "time_limit")
+    1.0
+    """
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        raise InvalidArgument(f"{name} must be a number of seconds, got {value!r}")
+    seconds = float(value)
+    if not (math.isfinite(seconds) and seconds > 0):
+        raise InvalidArgument(f"{name} must be a positive, finite number of seconds, got {seconds}")
+    return seconds
+
+
+def check_count(value: Any, name: str, minimum: int = 1) -> int:
+    """An integer of at least ``minimum`` (``samples``, ``chains``, ``max_boxes``).
+
+    Examples
+    --------
+    >>> check_count(np.int64(4), "samples")
+    4
+    """
+    if isinstance(value, bool) or not isinstance(value, int | np.integer):
+        raise InvalidArgument(f"{name} must be an integer, got {value!r}")
+    if value < minimum:
+        raise InvalidArgument(f"{name} must be at least {minimum}, got {value}")
+    return int(value)
+
+
+def check_seed(value: Any) -> int | None:
+    """``None`` or a non-negative integer.
+
+    Examples
+    --------
+    >>> check_seed(None) is None
+    True
+    """
+    if value is None:
+        return None
+    return check_count(value, "seed", minimum=0)
+
+
+def check_choice(value: Any, name: str, choices: tuple[str, ...]) -> str:
+    """One of ``choices``.
+
+    Examples
+    --------
+    >>> check_choice("exact", "method", ("exact", "sat"))
+    'exact'
+    """
+    if not isinstance(value, str) or value not in choices:
+        raise InvalidArgument(f"unknown {name} {value!r}; expected one of {', '.join(choices)}")
+    return value
+
+
+def check_matrix(value: Any, name: str = "probabilities") -> np.ndarray:
+    """A square matrix of support probabilities (finite, in [0, 1], zero diagonal), as float64.
+
+    Examples
+    --------
+    >>> check_matrix([[0, 0.5], [0.2, 0]]).dtype
+    dtype('float64')
+    """
+    from unstack.checks import check_probability_matrix
+
+    shape = np.shape(value) if isinstance(value, np.ndarray | list | tuple) else None
+    if shape is None or len(shape) != 2 or shape[0] != shape[1] or shape[0] < 1:
+        got = f"shape {shape}" if shape is not None else type(value).__name__
+        raise InvalidArgument(f"{name} must be a non-empty square matrix, got {got}")
+    try:
+        return check_probability_matrix(value, shape[0], source=name, path="$")
+    except InvalidFile as error:
+        raise InvalidArgument(f"{name}{error.json_path[1:]}: {error.message}") from None

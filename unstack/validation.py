@@ -1,0 +1,91 @@
+"""Checking a file: its schema, and what a schema cannot say (ids, matrices, hard evidence).
+
+Examples
+--------
+>>> import pathlib, tempfile
+>>> from unstack.supports import Supports
+>>> file = pathlib.Path(tempfile.mkdtemp()) / "pair.json"
+>>> Supports(["a", "b"], [[0, 0.3], [0.6, 0]]).save(file)
+>>> validate(file).detail
+'2 objects'
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+from unstack.jsonio import read_document, validate_document
+
+__all__ = ["Validated", "validate"]
+
+
+@dataclass(frozen=True)
+class Validated:
+    """A valid file: where it came from, its format tag and a one-line summary.
+
+    Attributes
+    ----------
+    source : str
+        The file name as given (``<stdin>`` for ``"-"``).
+    format : str
+        Its ``format`` tag, such as ``unstack.scene/1``.
+    detail : str
+        What it holds, such as ``5 objects``.
+    """
+
+    source: str
+    format: str
+    detail: str
+
+
+def validate(path: str | os.PathLike[str]) -> Validated:
+    """Check any unstack document as deeply as the library can without deciding.
+
+    Supports and scenes are built (ids, matrices, poses, the point cloud); the hard
+    evidence of support probabilities (exactly 0 or 1) must admit a transitive world.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A supports, scene, decision, plan or data-set manifest file; ``"-"`` reads stdin.
+
+    Returns
+    -------
+    Validated
+
+    Raises
+    ------
+    InvalidFile
+        The file is unreadable, not JSON, of an unknown format or against its schema.
+    NoConsistentWorld
+        Its hard evidence contradicts transitivity (the message names the file).
+
+    Examples
+    --------
+    >>> validate("examples/pile5.supports.json").format
+    'unstack.supports/1'
+    """
+    document = read_document(path)
+    tag = validate_document(document)
+    if tag == "unstack.supports/1":
+        from unstack.reasoner.decision import _propagate
+        from unstack.supports import Supports
+
+        supports = Supports.from_document(document)
+        _propagate(supports)
+        detail = f"{supports.n_objects} objects"
+    elif tag == "unstack.scene/1":
+        from unstack.scene import Scene
+
+        scene = Scene.from_document(document)
+        detail = f"{len(scene.boxes)} boxes, {len(scene.detected)} detected, {len(scene.points):,} points"
+    elif tag == "unstack.plan/1":
+        detail = f"{len(document.data['order'])} boxes in order"
+    elif tag == "unstack.dataset/1":
+        detail = f"{document.data['configs']} configurations, seed {document.data['seed']}"
+    elif tag == "unstack.payoff/1":
+        detail = f"{document.data['consistent_worlds']} consistent worlds"
+    else:
+        detail = f"choice {document.data['choice']!r}"
+    return Validated(document.source, tag, detail)
