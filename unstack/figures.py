@@ -1,4 +1,8 @@
-"""Saving matplotlib figures: the Agg backend, and PNG files written atomically.
+"""Matplotlib figures without pyplot: no backend switch, no global figure registry.
+
+A host process (a robot's planner with its own GUI, say) keeps its matplotlib backend:
+figures here are :class:`matplotlib.figure.Figure` objects drawn by their own Agg canvas,
+and PNG files are written atomically.
 
 Examples
 --------
@@ -17,27 +21,115 @@ import os
 from pathlib import Path
 from typing import Any
 
-__all__ = ["pyplot", "save_png"]
+__all__ = ["Plotting", "figure", "pyplot", "save_png", "subplots"]
 
 
-def pyplot() -> Any:
-    """``matplotlib.pyplot`` on the non-interactive Agg backend (no screen needed)."""
-    import matplotlib
+def figure(**options: Any) -> Any:
+    """A :class:`matplotlib.figure.Figure` with its own Agg canvas (``options`` as for ``Figure``).
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    Parameters
+    ----------
+    **options
+        ``figsize``, ``dpi``, ... of :class:`matplotlib.figure.Figure`.
 
-    return plt
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> figure(figsize=(2, 1)).get_size_inches().tolist()
+    [2.0, 1.0]
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    drawn = Figure(**options)
+    FigureCanvasAgg(drawn)
+    return drawn
 
 
-def save_png(figure: Any, output: str | os.PathLike[str], *, dpi: int = 110) -> None:
-    """Write ``figure`` to a temporary file beside ``output``, rename it, and close the figure."""
-    plt = pyplot()
+def subplots(*grid: Any, figsize: Any = None, **options: Any) -> tuple[Any, Any]:
+    """A figure and its axes, as ``pyplot.subplots`` gives them, without pyplot.
+
+    Parameters
+    ----------
+    *grid
+        Rows and columns.
+    figsize : tuple, optional
+        Inches.
+    **options
+        Passed to :meth:`matplotlib.figure.Figure.subplots` (``sharex``, ``height_ratios``...).
+
+    Returns
+    -------
+    figure : matplotlib.figure.Figure
+    axes : Axes or array of Axes
+
+    Examples
+    --------
+    >>> drawn, axes = subplots(1, 2)
+    >>> len(axes)
+    2
+    """
+    drawn = figure(figsize=figsize)
+    return drawn, drawn.subplots(*grid, **options)
+
+
+class Plotting:
+    """The few ``pyplot`` entry points unstack's plots use, on pyplot-free figures."""
+
+    figure = staticmethod(figure)
+    subplots = staticmethod(subplots)
+
+    @property
+    def cm(self) -> Any:
+        """:mod:`matplotlib.cm` (colour maps, ``ScalarMappable``)."""
+        import matplotlib.cm
+
+        return matplotlib.cm
+
+    @staticmethod
+    def close(_figure: Any) -> None:
+        """Nothing to close: no figure is registered anywhere."""
+
+
+def pyplot() -> Plotting:
+    """Plotting helpers in the shape of ``matplotlib.pyplot`` that leave the backend alone.
+
+    Returns
+    -------
+    Plotting
+        ``figure``, ``subplots``, ``cm`` and ``close``.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> before = matplotlib.get_backend()
+    >>> _ = pyplot().subplots()
+    >>> matplotlib.get_backend() == before
+    True
+    """
+    return Plotting()
+
+
+def save_png(drawn: Any, output: str | os.PathLike[str], *, dpi: int = 110) -> None:
+    """Write ``drawn`` (a figure) to a temporary file beside ``output``, then rename it.
+
+    Parameters
+    ----------
+    drawn : matplotlib.figure.Figure
+    output : str or path-like
+    dpi : int
+
+    Returns
+    -------
+    None
+    """
     target = Path(output)
     temporary = target.with_name(f".{target.name}.tmp.png")
     try:
-        figure.savefig(temporary, dpi=dpi)
+        drawn.savefig(temporary, dpi=dpi)
         os.replace(temporary, target)
     finally:
-        plt.close(figure)
         temporary.unlink(missing_ok=True)

@@ -29,8 +29,10 @@ from unstack.errors import InvalidFile, UnknownFormat
 
 __all__ = [
     "FORMATS",
+    "MAX_DEPTH",
     "Document",
     "atomic_write_text",
+    "check_output_path",
     "format_json_path",
     "load_schema",
     "read_document",
@@ -44,9 +46,12 @@ FORMATS: dict[str, str] = {
     "unstack.decision/1": "decision-1.schema.json",
     "unstack.dataset/1": "dataset-1.schema.json",
     "unstack.plan/1": "plan-1.schema.json",
+    "unstack.payoff/1": "payoff-1.schema.json",
 }
 
 STDIN_NAME = "<stdin>"
+#: Deepest nesting of arrays and objects a document may have (unstack's formats need 5).
+MAX_DEPTH = 64
 
 
 class Document:
@@ -88,14 +93,30 @@ def _short(value: Any, limit: int = 40) -> str:
 
 
 def _find_non_finite(value: Any, path: list[str | int]) -> Iterator[list[str | int]]:
-    if isinstance(value, float) and not math.isfinite(value):
-        yield path
-    elif isinstance(value, dict):
-        for key, item in value.items():
-            yield from _find_non_finite(item, [*path, key])
-    elif isinstance(value, list):
-        for index, item in enumerate(value):
-            yield from _find_non_finite(item, [*path, index])
+    """JSON paths of non-finite numbers, depth first (iterative: no recursion limit)."""
+    stack: list[tuple[Any, list[str | int]]] = [(value, path)]
+    while stack:
+        item, where = stack.pop()
+        if isinstance(item, float) and not math.isfinite(item):
+            yield where
+        elif isinstance(item, dict):
+            stack.extend((child, [*where, key]) for key, child in reversed(list(item.items())))
+        elif isinstance(item, list):
+            stack.extend((child, [*where, index]) for index, child in reversed(list(enumerate(item))))
+
+
+def _too_deep(value: Any, limit: int) -> list[str | int] | None:
+    """The JSON path of the first value nested deeper than ``limit``, or None."""
+    stack: list[tuple[Any, list[str | int]]] = [(value, [])]
+    while stack:
+        item, where = stack.pop()
+        if len(where) > limit:
+            return where
+        if isinstance(item, dict):
+            stack.extend((child, [*where, key]) for key, child in item.items())
+        elif isinstance(item, list):
+            stack.extend((child, [*where, index]) for index, child in enumerate(item))
+    return None
 
 
 def _get(data: Any, path: list[str | int]) -> Any:
@@ -125,8 +146,13 @@ def read_document(path: str | os.PathLike[str]) -> Document:
     """
     source = str(path)
     if source == "-":
-        text = sys.stdin.read()
         source, base_dir = STDIN_NAME, Path.cwd()
+        if sys.stdin is None or sys.stdin.closed:
+            raise InvalidFile(source, "$", "standard input is closed; give a file name or pipe a document in")
+        try:
+            text = sys.stdin.read()
+        except (OSError, ValueError, UnicodeDecodeError) as error:
+            raise InvalidFile(source, "$", f"cannot read standard input: {error}") from None
     else:
         file = Path(path)
         if file.is_dir():
@@ -144,8 +170,16 @@ def read_document(path: str | os.PathLike[str]) -> Document:
         raise InvalidFile(
             source, "$", f"invalid JSON at line {error.lineno} column {error.colno}: {error.msg}"
         ) from None
+    except RecursionError:
+        raise InvalidFile(source, "$", f"expected JSON nested at most {MAX_DEPTH} levels deep") from None
+    except ValueError as error:  # an integer of more digits than Python converts
+        raise InvalidFile(source, "$", f"invalid JSON: {error}") from None
     if not isinstance(data, dict):
         raise InvalidFile(source, "$", f"expected a JSON object, got {type(data).__name__}")
+    deep = _too_deep(data, MAX_DEPTH)
+    if deep is not None:
+        where = format_json_path(deep[:8]) + "..."
+        raise InvalidFile(source, where, f"expected JSON nested at most {MAX_DEPTH} levels deep")
     for bad in _find_non_finite(data, []):
         raise InvalidFile(source, format_json_path(bad), f"expected a finite number, got {_get(data, bad)}")
     return Document(data, source, base_dir)
@@ -259,9 +293,59 @@ def validate_document(
 
 
 def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
+    """The process's umask, read without changing it (``/proc/self/status``; elsewhere the
+    mode of a freshly created file)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    with tempfile.TemporaryDirectory() as folder:
+        probe = Path(folder) / "probe"
+        descriptor = os.open(probe, os.O_CREAT | os.O_WRONLY, 0o777)
+        os.close(descriptor)
+        return 0o777 & ~probe.stat().st_mode
+
+
+def check_output_path(path: str | os.PathLike[str]) -> Path:
+    """Check, before any work, that a file can be written at ``path``.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Where an output will go.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    InvalidArgument
+        The folder does not exist or is not a folder, or ``path`` is a folder.
+
+    Examples
+    --------
+    >>> check_output_path("/no/such/out.json")
+    Traceback (most recent call last):
+    ...
+    unstack.errors.InvalidArgument: /no/such/out.json: cannot write there: the folder /no/such does not exist
+    """
+    from unstack.errors import InvalidArgument
+
+    target = Path(path)
+    folder = target.parent
+    if target.is_dir():
+        raise InvalidArgument(f"{path}: cannot write there: it is a folder")
+    if not folder.exists():
+        raise InvalidArgument(f"{path}: cannot write there: the folder {folder} does not exist")
+    if not folder.is_dir():
+        raise InvalidArgument(f"{path}: cannot write there: {folder} is not a folder")
+    if not os.access(folder, os.W_OK):
+        raise InvalidArgument(f"{path}: cannot write there: the folder {folder} is not writable")
+    return target
 
 
 def atomic_write_text(path: str | os.PathLike[str], text: str) -> None:
@@ -277,7 +361,7 @@ def atomic_write_text(path: str | os.PathLike[str], text: str) -> None:
     >>> target.read_text()
     '{}'
     """
-    target = Path(path)
+    target = check_output_path(path)
     handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
     try:
         with os.fdopen(handle, "w", encoding="utf-8") as stream:

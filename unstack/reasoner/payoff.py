@@ -17,6 +17,7 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -24,7 +25,9 @@ from unstack.reasoner.costs import cost_weights
 from unstack.reasoner.worlds import SAT_MAX_BOXES, WorldSet, enumerate_worlds
 from unstack.supports import Supports
 
-__all__ = ["PayoffMatrix", "payoff_matrix"]
+__all__ = ["PAYOFF_FORMAT", "PayoffMatrix", "payoff_matrix"]
+
+PAYOFF_FORMAT = "unstack.payoff/1"
 
 
 @dataclass(frozen=True, eq=False)
@@ -53,6 +56,40 @@ class PayoffMatrix:
     def expected_costs(self) -> np.ndarray:
         """``EC(A_j)`` of every box (Eq. 13)."""
         return np.asarray(self.worlds.probabilities @ self.costs)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``unstack.payoff/1`` JSON object: every consistent world with its probability and costs.
+
+        Returns
+        -------
+        dict
+            Valid against ``payoff-1.schema.json``.
+
+        Examples
+        --------
+        >>> from unstack.supports import Supports
+        >>> document = payoff_matrix(Supports(["a", "b"], [[0, 0.9], [0.0, 0]])).to_dict()
+        >>> document["consistent_worlds"], document["worlds"][1]["supports"]
+        (2, [['a', 'b']])
+        """
+        objects = self.objects
+        return {
+            "format": PAYOFF_FORMAT,
+            "objects": list(objects),
+            "cost": self.cost,
+            "consistent_worlds": len(self.worlds),
+            "expected_costs": self.expected_costs().tolist(),
+            "worlds": [
+                {
+                    "probability": float(self.worlds.probabilities[i]),
+                    "supports": [
+                        [objects[x], objects[y]] for x, y in zip(*self.worlds.worlds[i].nonzero(), strict=True)
+                    ],
+                    "costs": self.costs[i].tolist(),
+                }
+                for i in range(len(self.worlds))
+            ],
+        }
 
 
 def payoff_matrix(supports: Supports, *, cost: str = "count", max_boxes: int = SAT_MAX_BOXES) -> PayoffMatrix:

@@ -20,6 +20,7 @@ from __future__ import annotations
 import contextlib
 import os
 import sys
+import threading
 from collections.abc import Iterator
 from types import ModuleType, TracebackType
 from typing import Any
@@ -36,10 +37,19 @@ WALL = 0.1
 APRON = 1.5
 
 
+_IMPORT_LOCK = threading.Lock()
+
+
 @contextlib.contextmanager
 def _quiet_c_output() -> Iterator[None]:
-    """Silence C-level stdout and stderr: pybullet prints its build time on import and
-    ``argv[0]=`` when a client connects, which would corrupt JSON on stdout."""
+    """Silence C-level stdout and stderr while pybullet is first imported.
+
+    pybullet's module initialisation prints its build time with C ``printf``, which would
+    corrupt JSON on stdout. This is the one place unstack touches process-wide state, and
+    it is confined: it runs once per process (under a lock), only when pybullet is not
+    imported yet, for the duration of the import. A host that minds can import pybullet
+    itself first. Connecting needs no silencing (see :func:`_direct_client`).
+    """
     import ctypes
 
     libc = ctypes.CDLL(None)
@@ -60,10 +70,18 @@ def _quiet_c_output() -> Iterator[None]:
 
 
 def import_pybullet() -> tuple[ModuleType, Any]:
-    """Import pybullet (quietly) and its ``BulletClient``; a clear error if it is missing."""
+    """Import pybullet and its ``BulletClient``; a clear error if it is missing.
+
+    The first import in a process is silenced (see :func:`_quiet_c_output`); later calls
+    change nothing.
+    """
     try:
-        with _quiet_c_output():
-            import pybullet
+        with _IMPORT_LOCK:
+            if "pybullet" in sys.modules:
+                import pybullet
+            else:
+                with _quiet_c_output():
+                    import pybullet
             from pybullet_utils.bullet_client import BulletClient
     except ImportError as error:  # pragma: no cover - depends on the installation
         from unstack.errors import UnstackError
@@ -72,6 +90,20 @@ def import_pybullet() -> tuple[ModuleType, Any]:
             "the simulator needs pybullet: pip install 'unstack[sim]' (or pip install pybullet)"
         ) from error
     return pybullet, BulletClient
+
+
+def _direct_client(pybullet: ModuleType, bullet_client: Any) -> Any:
+    """A ``BulletClient`` on a new DIRECT server, connected without an options string.
+
+    ``BulletClient(connection_mode=DIRECT)`` passes ``options=""``, and pybullet echoes any
+    options string (``argv[0]=``) on C stdout; ``pybullet.connect(DIRECT)`` alone prints
+    nothing, so no output needs silencing.
+    """
+    client = bullet_client.__new__(bullet_client)
+    client._shapes = {}
+    client._pid = os.getpid()
+    client._client = pybullet.connect(pybullet.DIRECT)
+    return client
 
 
 def rotation_angles_deg(before_xyzw: np.ndarray, after_xyzw: np.ndarray) -> np.ndarray:
@@ -103,8 +135,7 @@ class PhysicsWorld:
         pybullet, bullet_client = import_pybullet()
         self.settings = settings
         self.pybullet = pybullet
-        with _quiet_c_output():
-            self.client = bullet_client(connection_mode=pybullet.DIRECT)
+        self.client = _direct_client(pybullet, bullet_client)
         self.client.setGravity(0.0, 0.0, -9.81)
         self.client.setTimeStep(settings.pile.time_step)
         self.client.setPhysicsEngineParameter(deterministicOverlappingPairs=1)

@@ -1,0 +1,93 @@
+"""unstack leaves a host process's state alone: umask, file descriptors, matplotlib backend."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from unstack.jsonio import _umask, atomic_write_text
+
+
+def test_the_umask_is_read_without_being_set(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    current = os.umask(0o027)
+    os.umask(current)
+
+    def refuse(_mask: int) -> int:
+        raise AssertionError("os.umask was called")
+
+    monkeypatch.setattr(os, "umask", refuse)
+    assert _umask() == current
+    target = tmp_path / "out.json"
+    atomic_write_text(target, "{}")
+    assert target.stat().st_mode & 0o777 == 0o666 & ~current
+
+
+def test_the_umask_fallback_reads_a_new_files_mode(monkeypatch: pytest.MonkeyPatch) -> None:
+    import builtins
+
+    current = os.umask(0o022)
+    os.umask(current)
+    real_open = builtins.open
+
+    def no_proc(file: object, *args: object, **kwargs: object) -> object:
+        if str(file) == "/proc/self/status":
+            raise OSError("no /proc here")
+        return real_open(file, *args, **kwargs)  # type: ignore[call-overload]
+
+    monkeypatch.setattr(builtins, "open", no_proc)
+    assert _umask() == current
+
+
+def test_plots_keep_the_hosts_backend_and_skip_pyplot(tmp_path: Path) -> None:
+    code = f"""
+import sys, matplotlib
+matplotlib.use("svg")
+from unstack.figures import pyplot, save_png
+plt = pyplot()
+figure, axes = plt.subplots(1, 2, figsize=(3, 2))
+axes[0].plot([0, 1], [1, 0])
+save_png(figure, {str(tmp_path / "plot.png")!r})
+print(matplotlib.get_backend(), "matplotlib.pyplot" in sys.modules)
+"""
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert result.stdout.split() == ["svg", "False"]
+    assert (tmp_path / "plot.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_a_simulated_world_does_not_touch_file_descriptors(monkeypatch: pytest.MonkeyPatch) -> None:
+    pytest.importorskip("pybullet")
+    from unstack.sim.settings import SimulationSettings
+    from unstack.sim.world import PhysicsWorld, import_pybullet
+
+    import_pybullet()  # the one confined, silenced import (a no-op if already imported)
+
+    calls: list[tuple[object, ...]] = []
+    real_dup2 = os.dup2
+
+    def record(*arguments: object) -> None:
+        calls.append(arguments)
+
+    monkeypatch.setattr(os, "dup2", record)
+    try:
+        with PhysicsWorld(SimulationSettings(boxes=(1, 1))) as world:
+            world.add_box([0.4, 0.3, 0.3], [1.0, 0.0, 0.5], [0, 0, 0, 1], mass=5.0)
+    finally:
+        monkeypatch.setattr(os, "dup2", real_dup2)
+    assert calls == []
+
+
+def test_a_world_prints_nothing_on_stdout(repo: Path) -> None:
+    pytest.importorskip("pybullet")
+    code = (
+        "from unstack.sim.world import PhysicsWorld\n"
+        "from unstack.sim.settings import SimulationSettings\n"
+        "for _ in range(2):\n"
+        "    PhysicsWorld(SimulationSettings(boxes=(1, 1))).close()\n"
+        "print('{}')\n"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=repo)
+    assert result.stdout == "{}\n"
