@@ -324,3 +324,61 @@ def unload(
         )
     Console().print(table)
     click.echo(f"results in {folder / 'unloading.json'} and {folder / 'unloading.png'}")
+
+
+@experiment.command()
+@click.option("--out", required=True, type=click.Path(), help="Folder for generalisation.json and the pictures.")
+@click.option("--model", "model_path", default=None, help=MODEL_HELP)
+@click.option("--seeds", type=click.IntRange(min=1), default=3, show_default=True, help="Scenes drawn per kind.")
+@click.option("--first-seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Seed of the first scene of each kind (later ones follow).")  # fmt: skip
+@click.option("--physics", is_flag=True, help="Also check each scene's labels in the physics engine.")
+def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int, physics: bool) -> None:
+    """The generalisation suite: hand-made canonical scenes, two clouds each, the decision checked.
+
+    Each kind (a tower, a bridge, a wall, a leaning box, load nobody detected, ...) is drawn
+    --seeds times and scanned by the project's range sensor and by surface sampling; a
+    decision is right when it picks a box that holds up nothing and its expected costs keep
+    their bounds. Writes generalisation.json and generalisation.png (one scene per kind).
+    """
+    from unstack.cli.learning import load_support_model
+    from unstack.experiments.canonical_scenes import CANONICAL_KINDS, build_case
+    from unstack.experiments.generalisation import physical_check, run_suite, suite_figure, summary_rows
+    from unstack.learning.probabilities import scene_support_probabilities
+    from unstack.reasoner.decision import decide
+
+    folder = _out(out)
+    model, name = load_support_model(model_path)
+    seed_list = list(range(first_seed, first_seed + seeds))
+    with progress_bar("scenes") as report:
+        results = run_suite(
+            lambda scene: decide(scene_support_probabilities(scene, model, model_name=name), seed=0),
+            seeds=seed_list,
+            progress=report,
+        )
+    physics_problems = {}
+    if physics:
+        for kind in CANONICAL_KINDS:
+            for seed in seed_list:
+                problems = physical_check(build_case(kind, seed=seed))
+                if problems:
+                    physics_problems[f"{kind} seed {seed}"] = problems
+    rows = summary_rows(results)
+    _write_json(folder / "generalisation.json", {"model": name, "seeds": seed_list, "summary": rows,
+                 "physics": physics_problems if physics else None,
+                 "decisions": [result.to_dict() for result in results]})  # fmt: skip
+    first = {(r.kind, r.cloud): r for r in results if r.seed == first_seed}
+    suite_figure([(build_case(kind, seed=first_seed), first[(kind, "sensor")]) for kind in CANONICAL_KINDS],
+                 str(folder / "generalisation.png"))  # fmt: skip
+    table = Table(title=f"Generalisation suite ({name}; {len(seed_list)} scenes per kind and cloud)")
+    for column in ("kind", "cloud", "scenes", "right first pick", "within every bound"):
+        table.add_column(column, justify="left" if column in ("kind", "cloud") else "right")
+    for row in rows:
+        table.add_row(row["kind"], row["cloud"], str(row["scenes"]), str(row["right_pick"]), str(row["right"]))
+    right = sum(result.right for result in results)
+    picks = sum(result.choice in result.pickable for result in results)
+    console = Console()
+    console.print(table)
+    console.print(f"right first pick {picks}/{len(results)}; within every bound {right}/{len(results)}")
+    for key, problems in physics_problems.items():
+        console.print(f"physics disagrees with the labels of {key}: {'; '.join(problems)}")

@@ -67,7 +67,7 @@ ISETS_FROM_HELP = "How ISets are drawn: random detected boxes, or a detected box
 MODEL_HELP = "Model file, or a shipped model: paper (the default: the paper's SVM) or extended (better decisions)."
 FEATURES_HELP = (
     "paper: the 19 numbers of Eq. 6; extended: those and 17 contact features (gaps, overlaps, cloud); "
-    "general: 18 features that do not depend on how the cloud was sampled (oriented geometry, cloud coverage)."
+    "general: 20 features that do not depend on how the cloud was sampled (oriented geometry, cloud coverage)."
 )
 #: Configuration numbers of the n-th data set of a training run start at n times this.
 CONFIGURATION_OFFSET = 100_000

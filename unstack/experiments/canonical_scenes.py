@@ -44,6 +44,11 @@ class CanonicalCase:
     holds : dict of str to int
         Detected boxes that hold up others, and how many boxes (detected or not) rest on
         them directly or through others.
+    load : dict of str to float
+        The same boxes and the load they carry when a box resting on m boxes weighs 1/m
+        on each (with what rests on it): ``load(X) = sum over Y on X of (1 + load(Y)) / m_Y``.
+        A tower's bottom box carries every box above it; each of two boxes under a bridge
+        carries half of it.
     in_container : bool
         Whether the scene stands in a container section (walls, ceiling) or in the open.
     hidden_load : tuple of str
@@ -55,6 +60,7 @@ class CanonicalCase:
     detected: tuple[str, ...]
     pickable: tuple[str, ...]
     holds: dict[str, int] = field(default_factory=dict)
+    load: dict[str, float] = field(default_factory=dict)
     in_container: bool = True
     hidden_load: tuple[str, ...] = ()
 
@@ -106,6 +112,12 @@ class _Builder:
             above |= self.held(other)
         return above
 
+    def carried(self, name: str) -> float:
+        """The load on ``name`` when each box weighs equally on the boxes it rests on."""
+        return sum(
+            (1.0 + self.carried(other)) / len(under) for other, under in self.rests_on.items() if name in under
+        )
+
     def case(self, kind: str, *, detected: list[str] | None = None, in_container: bool = True) -> CanonicalCase:
         names = list(self.boxes)
         chosen = names if detected is None else detected
@@ -117,6 +129,7 @@ class _Builder:
             detected=tuple(chosen),
             pickable=tuple(sorted(name for name in chosen if name not in holds)),
             holds=holds,
+            load={name: self.carried(name) for name in holds},
             in_container=in_container,
             hidden_load=hidden,
         )

@@ -5,8 +5,9 @@ project's range sensor (pybullet's renderer from the door, :mod:`unstack.sim.sen
 :func:`unstack.clouds.surface_cloud` (faces sampled at another density, from a moved
 viewpoint, with depth noise and missing faces). A decision is *right* when its choice is a
 pickable box (it holds up nothing) and its expected costs respect the scene's bounds: a box
-that holds up k boxes costs at least ``HOLD_SHARE * k``, a pickable box less than
-:data:`FREE_MAX`.
+that carries a load of k boxes (a box resting on m boxes weighs 1/m on each, with what rests
+on it; see :class:`~unstack.experiments.canonical_scenes.CanonicalCase`) costs at least
+``HOLD_SHARE * k``, a pickable box less than :data:`FREE_MAX`.
 
 Examples
 --------
@@ -27,11 +28,22 @@ import numpy as np
 from unstack.experiments.canonical_scenes import CANONICAL_KINDS, CanonicalCase, build_case
 from unstack.scene import Scene
 
-__all__ = ["CLOUDS", "FREE_MAX", "HOLD_SHARE", "SuiteResult", "canonical_scene", "check_decision", "run_suite"]
+__all__ = [
+    "CLOUDS",
+    "FREE_MAX",
+    "HOLD_SHARE",
+    "SuiteResult",
+    "canonical_scene",
+    "check_decision",
+    "physical_check",
+    "run_suite",
+    "suite_figure",
+    "summary_rows",
+]
 
 #: The two ways a canonical scene is scanned.
 CLOUDS = ("sensor", "surface")
-#: A box that holds up k boxes must cost at least this share of k.
+#: A box that carries a load of k boxes must cost at least this share of k.
 HOLD_SHARE = 0.5
 #: A pickable box must cost less than this.
 FREE_MAX = 0.5
@@ -128,9 +140,9 @@ def check_decision(case: CanonicalCase, choice: str, expected_costs: dict[str, f
     problems = []
     if choice not in case.pickable:
         problems.append(f"picked {choice!r}, which holds up {case.holds.get(choice, 0)} boxes")
-    for box, held in case.holds.items():
-        if expected_costs[box] < HOLD_SHARE * held:
-            problems.append(f"EC({box}) = {expected_costs[box]:.3f} < {HOLD_SHARE * held:.2f} (holds up {held})")
+    for box, load in case.load.items():
+        if expected_costs[box] < HOLD_SHARE * load:
+            problems.append(f"EC({box}) = {expected_costs[box]:.3f} < {HOLD_SHARE * load:.2f} (carries {load:.2f})")
     for box in case.pickable:
         if expected_costs[box] >= FREE_MAX:
             problems.append(f"EC({box}) = {expected_costs[box]:.3f} >= {FREE_MAX} although it holds up nothing")
@@ -181,3 +193,111 @@ def run_suite(
         if progress is not None:
             progress(done, len(tasks))
     return results
+
+
+def physical_check(case: CanonicalCase) -> list[str]:
+    """Where the case's labels disagree with the physics engine (empty when they agree).
+
+    The boxes are put in pybullet as placed (no settling), each box is taken away in turn
+    and the others watched (:func:`unstack.sim.ground_truth.removal_responses`): a box the
+    case calls pickable must move nothing, and a box it says holds up others must move at
+    least one of them. Boxes that move with nothing taken away make the case unstable.
+    """
+    from unstack.sim.ground_truth import removal_responses, support_labels
+    from unstack.sim.settings import GroundTruthSettings, SimulationSettings
+    from unstack.sim.world import PhysicsWorld
+
+    truth = GroundTruthSettings()
+    with PhysicsWorld(SimulationSettings(boxes=(1, 1)), door=False) as world:
+        for box in case.boxes:
+            world.add_box(box.size, box.position, box.orientation_xyzw, mass=5.0)
+        response = removal_responses(world, truth)
+    problems = []
+    if response.baseline_displacement > truth.displacement_threshold:
+        problems.append(f"unstable: a box moves {response.baseline_displacement:.3f} m with nothing taken away")
+    labels = support_labels(
+        response.displacement,
+        response.rotation_deg,
+        displacement_threshold=truth.displacement_threshold,
+        rotation_threshold_deg=truth.rotation_threshold_deg,
+    )
+    index = {box.id: k for k, box in enumerate(case.boxes)}
+    for box_id in case.pickable:
+        moved = [case.boxes[j].id for j in np.flatnonzero(labels[index[box_id]])]
+        if moved:
+            problems.append(f"taking {box_id!r} away moves {moved}")
+    for box_id in case.holds:
+        if not labels[index[box_id]].any():
+            problems.append(f"taking {box_id!r} away moves nothing, although it holds up {case.holds[box_id]}")
+    return problems
+
+
+def summary_rows(results: Sequence[SuiteResult]) -> list[dict[str, Any]]:
+    """Per kind and cloud: decisions, right first picks, decisions within every bound."""
+    rows: dict[tuple[str, str], dict[str, Any]] = {}
+    for result in results:
+        row = rows.setdefault(
+            (result.kind, result.cloud),
+            {"kind": result.kind, "cloud": result.cloud, "scenes": 0, "right_pick": 0, "right": 0},
+        )
+        row["scenes"] += 1
+        row["right_pick"] += result.choice in result.pickable
+        row["right"] += result.right
+    return list(rows.values())
+
+
+def _draw_box(axes: Any, box: Any, colour: str, alpha: float, hatch: bool) -> None:
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    from unstack.geometry import box_corners
+
+    corners = box_corners(box)
+    faces = [[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]]
+    collection = Poly3DCollection(
+        [corners[face] for face in faces], facecolor=colour, edgecolor="black", alpha=alpha, linewidths=0.6,
+        linestyles="--" if hatch else "-",
+    )  # fmt: skip
+    axes.add_collection3d(collection)
+
+
+def suite_figure(cases: Sequence[tuple[CanonicalCase, SuiteResult]], output: str) -> None:
+    """One small 3-D view per case: the chosen box red, the other pickable boxes green, boxes
+    that hold up others grey, undetected boxes dashed and pale. Written atomically (PNG or SVG)."""
+    import math
+    import os
+    import tempfile
+
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    columns = 4
+    rows = math.ceil(len(cases) / columns)
+    figure = Figure(figsize=(3.2 * columns, 3.0 * rows), layout="constrained")
+    FigureCanvasAgg(figure)
+    for number, (case, result) in enumerate(cases):
+        axes = figure.add_subplot(rows, columns, number + 1, projection="3d")
+        for box in case.boxes:
+            detected = box.id in case.detected
+            colour = "tab:red" if box.id == result.choice else "tab:green" if box.id in case.pickable else "0.6"
+            _draw_box(axes, box, colour if detected else "0.9", 0.85 if detected else 0.25, not detected)
+        corners = np.vstack([np.array([b.position - b.size, b.position + b.size]) for b in case.boxes])
+        low, high = corners.min(axis=0), corners.max(axis=0)
+        span = float(max(high - low)) / 2
+        centre = (low + high) / 2
+        axes.set_xlim(centre[0] - span, centre[0] + span)
+        axes.set_ylim(centre[1] - span, centre[1] + span)
+        axes.set_zlim(0, 2 * span)
+        axes.view_init(elev=18, azim=-150)
+        axes.set_axis_off()
+        verdict = "right" if result.right else "WRONG" if result.choice not in result.pickable else "bound missed"
+        cost = result.expected_costs[result.choice]
+        axes.set_title(f"{case.kind.replace('_', ' ')}\npick {result.choice} (EC {cost:.2f}): {verdict}", fontsize=9)
+    folder = os.path.dirname(os.path.abspath(output))
+    handle, temporary = tempfile.mkstemp(dir=folder, prefix=".suite-", suffix=os.path.splitext(output)[1])
+    os.close(handle)
+    try:
+        figure.savefig(temporary, dpi=110)
+        os.replace(temporary, output)
+    finally:
+        if os.path.exists(temporary):
+            os.unlink(temporary)

@@ -11,8 +11,12 @@ trained on one simulator's clouds then says little on a cloud made otherwise. Th
   ``overlap_share_y`` (the footprints' common area over X's and over Y's), ``footprint_gap``
   (distance between the footprints), ``height_x``, ``height_y``, ``bottom_x``, ``bottom_y``,
   ``z_overlap_share`` (common height over the lower of the two heights: side by side),
-  ``centre_dz``, ``tilt_x``, ``tilt_y`` (degrees from upright), and ``centre_over_x`` (how far
-  Y's centroid lies inside X's footprint, negative outside: is Y's weight over X);
+  ``centre_dz``, ``tilt_x``, ``tilt_y`` (degrees from upright), ``centre_over_x`` (how far
+  Y's centroid lies inside X's footprint, negative outside: is Y's weight over X),
+  ``separation`` (the smallest distance from the corners, edge midpoints and face centres
+  of either box to the other box: 0 when they touch, whatever the direction) and
+  ``lean_towards_x`` (how far Y's upper half leans over towards X: the horizontal offset of
+  Y's highest corner from its centroid along the direction to X's centroid);
 * what the cloud shows, as *coverage* -- the share of :data:`COVERAGE_BIN`-wide bins across
   a box's width (world y, across the container, as the sensor at the door sees it) that hold
   at least one point -- which is the same for a dense and a sparse scan:
@@ -70,6 +74,8 @@ GENERAL_FEATURE_NAMES: tuple[str, ...] = (
     "tilt_x",
     "tilt_y",
     "centre_over_x",
+    "separation",
+    "lean_towards_x",
     "between_coverage",
     "load_coverage_x",
     "load_coverage_y",
@@ -102,11 +108,43 @@ def _coverage(y_values: np.ndarray, low: float, high: float) -> float:
     return float(len(np.unique(index)) / bins)
 
 
+#: Surface samples of a unit cube: 8 corners, 12 edge midpoints, 6 face centres.
+_SURFACE = (
+    np.array(
+        [[a, b, c] for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1) if (a, b, c) != (0, 0, 0)],
+        dtype=np.float64,
+    )
+    / 2.0
+)
+
+
+def _separation(first: _BoxFrame, second: _BoxFrame) -> float:
+    """Smallest distance from a surface sample of either box to the other box."""
+    distances = []
+    for source, target in ((first, second), (second, first)):
+        samples = (_SURFACE * source.box.size) @ source.rotation.T + source.box.position
+        local = (samples - target.box.position) @ target.rotation
+        outside = np.maximum(np.abs(local) - target.box.size / 2.0, 0.0)
+        distances.append(float(np.min(np.linalg.norm(outside, axis=1))))
+    return min(distances)
+
+
+def _lean_towards(leaning: _BoxFrame, other: _BoxFrame) -> float:
+    """Horizontal offset of ``leaning``'s highest corner from its centroid, towards ``other``."""
+    direction = other.box.position[:2] - leaning.box.position[:2]
+    length = float(np.linalg.norm(direction))
+    if length < 1e-9:
+        return 0.0
+    highest = leaning.corners[int(np.argmax(leaning.corners[:, 2]))]
+    return float(np.dot(highest[:2] - leaning.box.position[:2], direction / length))
+
+
 class _BoxFrame:
     """A box with what the features need of it: corners, footprint, frame, the points over it."""
 
     def __init__(self, box: Box, points: np.ndarray) -> None:
         corners = box_corners(box)
+        self.corners = corners
         self.box = box
         self.top = float(corners[:, 2].max())
         self.bottom = float(corners[:, 2].min())
@@ -172,7 +210,7 @@ class _BoxFrame:
 
 
 def general_features(boxes: Sequence[Box], points: np.ndarray, pairs: Sequence[tuple[int, int]]) -> np.ndarray:
-    """The general features of each ordered pair ``(X, Y)`` of box indices, shape (len(pairs), 18)."""
+    """The general features of each ordered pair ``(X, Y)`` of box indices, shape (len(pairs), 20)."""
     index = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
     cloud = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     frames = {int(k): _BoxFrame(boxes[int(k)], cloud) for k in np.unique(index)}
@@ -208,6 +246,8 @@ def general_features(boxes: Sequence[Box], points: np.ndarray, pairs: Sequence[t
             x.tilt,
             y.tilt,
             x.centre_inside(y.box.position) if gap <= FAR else -gap,
+            _separation(x, y) if gap <= FAR else gap,
+            _lean_towards(y, x),
             between,
             per_box[int(a)][0],
             per_box[int(b)][0],

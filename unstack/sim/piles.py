@@ -10,8 +10,9 @@ the pile has the requested number of boxes.
 Walls (``arrangement="wall"``) are loaded as trailers are: columns of boxes standing side
 by side across the container, rows of columns from the back wall towards the door, each box
 placed on the one under it with a small random offset and yaw, a few centimetres of gap
-between columns, columns of random height; a share of the boxes (``fallen_share``) is
-dropped in front of the wall instead, tumbling as boxes that fell off it. The wall then
+between columns, columns of random height; a share of the boxes (``fallen_share``) is not
+stacked: about half of them stand on the floor leaning 10-30 degrees onto the front of the
+wall, the others are dropped in front of it, tumbling as boxes that fell off. The wall then
 settles with the door open.
 
 Examples
@@ -275,6 +276,31 @@ def _wall_layout(
     return placed
 
 
+def _lean_on_wall(world: PhysicsWorld, pile: Pile, rng: np.random.Generator) -> None:
+    """Stand a box on the floor in front of the wall, tipped 10-30 degrees onto a front box."""
+    from scipy.spatial.transform import Rotation
+
+    footprints = _footprints(world)
+    if len(footprints) == 0:
+        return
+    low_boxes = footprints[footprints[:, 2] < 0.05]
+    target = low_boxes[np.argmin(low_boxes[:, 0])] if len(low_boxes) else footprints[np.argmin(footprints[:, 0])]
+    size = np.sort(
+        world.settings.box_sizes()[rng.integers(len(world.settings.box_sizes()))]
+    )  # thin along x, tall along z
+    angle = float(rng.uniform(10.0, 30.0))
+    rotation = Rotation.from_euler("y", angle, degrees=True)
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=np.float64)
+    corners = rotation.apply(signs * size / 2.0)
+    y = float(rng.uniform(target[1], target[4]))
+    position = [float(target[0] - corners[:, 0].max() - 0.003), y, float(-corners[:, 2].min() + 0.002)]
+    if position[0] - size.max() < 0.0:
+        return  # no room in front of the wall
+    mass = float(rng.uniform(*world.settings.pile.mass_range))
+    body = world.add_box(size, position, rotation.as_quat(), mass=mass)
+    pile.boxes.append(PileBox(body, size.copy(), mass))
+
+
 def build_wall(settings: SimulationSettings, *, count: int, seed: int | np.random.SeedSequence) -> Pile:
     """Stack ``count`` boxes as a wall from the back of the section, drop some in front, settle.
 
@@ -312,6 +338,9 @@ def build_wall(settings: SimulationSettings, *, count: int, seed: int | np.rando
             mass = float(rng.uniform(*settings.pile.mass_range))
             body = world.add_box(size, centre, _yaw_xyzw(yaw), mass=mass)
             pile.boxes.append(PileBox(body, size.copy(), mass))
+        world.settle()
+        for _ in range(int(rng.binomial(fallen, 0.5))):
+            _lean_on_wall(world, pile, rng)
         world.settle()
         world.close_door()
         for round_index in range(settings.pile.max_refills + 1):
