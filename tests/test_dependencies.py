@@ -50,3 +50,13 @@ def test_reasoner_source_does_not_import_learning_or_sim(repo: Path) -> None:
         text = path.read_text()
         for forbidden in ("sklearn", "scipy", "pybullet", "unstack.learning", "unstack.sim", "unstack.cli"):
             assert f"import {forbidden}" not in text and f"from {forbidden}" not in text, (path.name, forbidden)
+
+
+def test_a_small_decision_loads_only_what_it_needs(repo: Path) -> None:
+    """``unstack decide FILE --json`` on five boxes: no compiled engine, SAT solver, schema library or tables."""
+    probe = PROBE.format(file=str(repo / "examples" / "pile5.supports.json"), method="auto")
+    result = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300, check=True)
+    loaded = {name.split(".")[0] for name in json.loads(result.stderr)}
+    lean = {"numba", "pysat", "networkx", "jsonschema", "rich", "scipy", *HEAVY}
+    assert not loaded & lean, sorted(loaded & lean)
+    assert "unstack.learning" not in json.loads(result.stderr)

@@ -260,7 +260,7 @@ def validate_document(
     InvalidFile
         The document violates its schema (the first problem, by JSON path).
     """
-    from jsonschema import Draft202012Validator
+    from unstack.schema_check import iter_errors
 
     accepted = list(expected) if expected is not None else list(FORMATS)
     tag = document.data.get("format")
@@ -280,8 +280,7 @@ def validate_document(
             "$.format",
             f"{why} {_short(tag)}; expected {' or '.join(accepted)}",
         )
-    validator = Draft202012Validator(load_schema(tag))
-    errors = sorted(validator.iter_errors(document.data), key=lambda e: list(e.absolute_path))
+    errors = sorted(iter_errors(load_schema(tag), document.data), key=lambda e: list(e.absolute_path))
     if errors:
         first = errors[0]
         if first.validator in {"oneOf", "anyOf"} and first.context:

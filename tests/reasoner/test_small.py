@@ -20,7 +20,7 @@ def test_the_table_holds_every_preorder_once(n: int) -> None:
     table = preorders(n)
     assert len(table) == PREORDER_COUNTS[n]
     assert len({world.tobytes() for world in table}) == len(table)
-    assert all(is_transitive(world) for world in table[:: max(1, len(table) // 200)])
+    assert all(is_transitive(world) for world in table)
     assert not table[:, np.arange(n), np.arange(n)].any()
 
 

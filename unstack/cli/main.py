@@ -1,37 +1,76 @@
-"""``unstack`` commands: ``decide``, ``worlds``, ``validate``, ``simulate``, ``render``,
-``train``, ``evaluate``, ``probabilities``.
+"""``unstack`` commands: ``decide``, ``plan``, ``worlds``, ``validate``, ``warm-up``, and (loaded
+on first use) ``simulate``, ``render``, ``train``, ``evaluate``, ``probabilities``, ``experiment``.
 
-Each command is a thin layer over the library: read and validate the input, call one
-library function, render the result. ``UnstackError`` (and unwritable outputs) become a
-single ``unstack: error: ...`` line on stderr with exit code 2.
+Each command is a thin layer over the library: read the input, call one public function
+(``unstack.decide``, ``unstack.plan``, ``unstack.validate``, ...), render the result.
+``UnstackError`` (and unwritable outputs) become a single ``unstack: error: ...`` line on
+stderr with exit code 2. Only what a command needs is imported: deciding on a supports
+file loads neither scikit-learn, numba for small groups, networkx nor rich's tables.
 """
 
 from __future__ import annotations
 
+import importlib
 import json
+import math
 import sys
 from collections.abc import Callable
 from typing import Any
 
 import click
-from rich.console import Console
 
-from unstack.cli.learning import MODEL_HELP
 from unstack.errors import UnstackError
-from unstack.reasoner.costs import COSTS, DEFAULT_COST
 
 __all__ = ["cli", "main"]
 
 INPUT_HELP = "An unstack.supports/1 or unstack.scene/1 JSON file; '-' reads standard input."
+MODEL_HELP = "Model file, or a shipped model: paper (the default: the paper's SVM) or extended (better decisions)."
+
+#: Commands whose modules load only when they run (their imports are heavy).
+LAZY_COMMANDS = {
+    "simulate": "unstack.cli.simulation:simulate",
+    "render": "unstack.cli.simulation:render",
+    "train": "unstack.cli.learning:train",
+    "evaluate": "unstack.cli.learning:evaluate",
+    "probabilities": "unstack.cli.learning:probabilities",
+    "experiment": "unstack.cli.experiments:experiment",
+}
+
+
+def printable(text: str) -> str:
+    """``text`` with control characters escaped (``\\x1b`` for ESC), safe for a terminal.
+
+    Examples
+    --------
+    >>> printable("box\\x1b[31m")
+    'box\\\\x1b[31m'
+    """
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text)
 
 
 def _fail(message: str) -> None:
-    click.echo(f"unstack: error: {message}", err=True)
+    click.echo(f"unstack: error: {printable(message)}", err=True)
     sys.exit(2)
 
 
+def _warn(message: str) -> None:
+    click.echo(f"unstack: warning: {printable(message)}", err=True)
+
+
 class _Group(click.Group):
-    """A click group that turns library errors into one line and exit code 2."""
+    """A click group that loads heavy commands lazily and turns library errors into one line."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return sorted([*super().list_commands(ctx), *LAZY_COMMANDS])
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        if cmd_name in LAZY_COMMANDS and cmd_name not in self.commands:
+            module, name = LAZY_COMMANDS[cmd_name].split(":")
+            command = getattr(importlib.import_module(module), name)
+            self.add_command(command, cmd_name)
+        return super().get_command(ctx, cmd_name)
 
     def invoke(self, ctx: click.Context) -> Any:
         try:
@@ -41,6 +80,14 @@ class _Group(click.Group):
         except OSError as error:
             _fail(f"{getattr(error, 'filename', None) or ''}: {error.strerror or error}".lstrip(": "))
         return None
+
+
+def _check_output(path: str | None) -> None:
+    """Fail before any work when ``--output`` cannot be written (naming the user's path)."""
+    if path is not None:
+        from unstack.jsonio import check_output_path
+
+        check_output_path(path)
 
 
 def _write_output(path: str | None, document: dict[str, Any]) -> None:
@@ -55,24 +102,33 @@ def _emit(as_json: bool, document: dict[str, Any], render: Callable[[], Any]) ->
     if as_json:
         click.echo(json.dumps(document, indent=2))
     else:
+        from rich.console import Console
+
         Console(highlight=False).print(render())
 
 
-def _load_supports(path: str, model_path: str | None = None) -> Any:
-    """Supports from a supports file, or from a scene file through the learned model."""
-    from unstack import load
-    from unstack.scene import Scene
+def _load_input(path: str, model: str | None) -> Any:
+    """A scene or supports file; ``--model`` only means something for a scene."""
+    import unstack
 
-    loaded = load(path)
-    if isinstance(loaded, Scene):
-        from unstack.cli.learning import scene_supports
-
-        return scene_supports(loaded, model_path)
+    loaded = unstack.load(path)
+    if model is not None and isinstance(loaded, unstack.Supports):
+        raise UnstackError(
+            f"{loaded.source}: --model applies to a scene file; this file holds support probabilities already"
+        )
     return loaded
+
+
+def _finite_seconds(_ctx: click.Context, _param: click.Parameter, value: float | None) -> float | None:
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise click.BadParameter(f"expected a positive, finite number of seconds, got {value}")
+    return value
 
 
 def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
     """The options shared by ``decide`` and ``plan``: method, cost, sampling budget, seed."""
+    from unstack.reasoner.costs import COSTS, DEFAULT_COST
+
     options = [
         click.option(
             "--method",
@@ -80,33 +136,40 @@ def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
             default="auto",
             show_default=True,
             help="exact: weighted preorder counting (<= 8 boxes per group); sat: list worlds with CaDiCaL "
-            "(<= 6); approx: sampling with standard errors (<= 63); auto: per group, the fastest that fits.",
+            "(<= 6); approx: sampling with standard errors (<= 63); auto: per group, exact up to 8, else approx.",
         ),
         click.option(
             "--cost",
             type=click.Choice(list(COSTS)),
             default=DEFAULT_COST,
             show_default=True,
-            help="load: Eq. 11's count with each box counted with the undetected load the cloud shows on it; "
-            "count: number of supported boxes (Eq. 11 exactly); mass: their total mass (needs masses).",
-        ),
-        click.option(
-            "--time-limit",
-            type=click.FloatRange(min=0.0, min_open=True),
-            default=None,
-            help="Seconds of sampling for the sampled groups (default 1; under 10 also samples groups of 8).",
+            help="load: supported boxes, each with the undetected load on it; count: number of supported "
+            "boxes (Eq. 11); mass: their total mass (needs masses).",
         ),
         click.option(
             "--samples",
             type=click.IntRange(min=1),
             default=None,
-            help="Recorded sweeps per sampled group instead of a time limit (reproducible with --seed).",
+            help="Recorded sweeps per sampled group (default 4096; reproducible with --seed).",
+        ),
+        click.option(
+            "--time-limit",
+            type=float,
+            default=None,
+            callback=_finite_seconds,
+            help="Seconds for the whole decision instead of a number of sweeps (not reproducible; under 10 "
+            "also samples groups of 8).",
         ),
         click.option("--seed", type=click.IntRange(min=0), default=None, help="Seed of the sampler."),
     ]
     for option in reversed(options):
         command = option(command)
     return command
+
+
+def _print_warnings(warnings: tuple[str, ...]) -> None:
+    for warning in warnings:
+        _warn(warning)
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
@@ -121,9 +184,10 @@ def cli() -> None:
 @click.option(
     "-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON decision to this file (atomically)."
 )
+@click.option("--timing", is_flag=True, help="Add wall-clock seconds to the JSON (it is canonical without them).")
 @_reasoning_options
-@click.option("--model", "model_path", default=None, help=MODEL_HELP)
-def decide(file: str, as_json: bool, output: str | None, model_path: str | None, **reasoning: Any) -> None:
+@click.option("--model", "model", default=None, help=MODEL_HELP)
+def decide(file: str, as_json: bool, output: str | None, timing: bool, model: str | None, **reasoning: Any) -> None:
     """Print which box to unload first, the expected cost of every box and P(support | consistent).
 
     FILE is an unstack.supports/1 file, or an unstack.scene/1 file whose detected boxes get
@@ -131,14 +195,20 @@ def decide(file: str, as_json: bool, output: str | None, model_path: str | None,
     Groups of linked boxes too large to count are sampled: each EC then has a standard
     error, and the headline says how probable it is that the choice is truly the minimum.
     """
-    from unstack.cli.render import decision_view
-    from unstack.reasoner.decision import decide as decide_box
+    import unstack
 
-    supports = _load_supports(file, model_path)
-    decision = decide_box(supports, **reasoning)
-    document = decision.to_dict()
+    _check_output(output)
+    decision = unstack.decide(_load_input(file, model), model=model, **reasoning)
+    document = decision.to_dict(timing=timing)
     _write_output(output, document)
-    _emit(as_json, document, lambda: decision_view(decision))
+    _print_warnings(decision.warnings)
+
+    def view() -> Any:
+        from unstack.cli.render import decision_view
+
+        return decision_view(decision)
+
+    _emit(as_json, document, view)
 
 
 @cli.command()
@@ -147,34 +217,28 @@ def decide(file: str, as_json: bool, output: str | None, model_path: str | None,
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON payoff matrix to this file.")
 @click.option("--limit", type=click.IntRange(min=1), default=20, show_default=True, help="Worlds shown in the table.")
 @click.option("--cost", type=click.Choice(["count", "mass"]), default="count", show_default=True)
-def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str) -> None:
+@click.option("--model", "model", default=None, help=MODEL_HELP)
+def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str, model: str | None) -> None:
     """Print the payoff matrix (Table II): consistent worlds, their probabilities and action costs.
 
     Lists worlds with a SAT solver, so it is for small scenes (up to 6 boxes).
     """
-    from unstack.cli.render import payoff_view
+    import unstack
     from unstack.reasoner.payoff import payoff_matrix
 
-    supports = _load_supports(file)
+    _check_output(output)
+    loaded = _load_input(file, model)
+    supports = loaded if isinstance(loaded, unstack.Supports) else unstack.support_probabilities(loaded, model)
     table = payoff_matrix(supports, cost=cost)
-    objects = table.objects
-    document = {
-        "format": "unstack.payoff/1",
-        "objects": list(objects),
-        "cost": cost,
-        "consistent_worlds": len(table.worlds),
-        "expected_costs": table.expected_costs().tolist(),
-        "worlds": [
-            {
-                "probability": float(table.worlds.probabilities[i]),
-                "supports": [[objects[x], objects[y]] for x, y in zip(*table.worlds.worlds[i].nonzero(), strict=True)],
-                "costs": table.costs[i].tolist(),
-            }
-            for i in range(len(table.worlds))
-        ],
-    }
+    document = table.to_dict()
     _write_output(output, document)
-    _emit(as_json, document, lambda: payoff_view(table, limit))
+
+    def view() -> Any:
+        from unstack.cli.render import payoff_view
+
+        return payoff_view(table, limit)
+
+    _emit(as_json, document, view)
 
 
 @cli.command()
@@ -182,31 +246,24 @@ def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str) 
 @click.option("--json", "as_json", is_flag=True, help="Print the plan as unstack.plan/1 JSON.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON plan to this file.")
 @_reasoning_options
-@click.option("--model", "model_path", default=None, help=MODEL_HELP)
-def plan(file: str, as_json: bool, output: str | None, model_path: str | None, **reasoning: Any) -> None:
+@click.option("--model", "model", default=None, help=MODEL_HELP)
+def plan(file: str, as_json: bool, output: str | None, model: str | None, **reasoning: Any) -> None:
     """Order all detected boxes by repeated decisions: pick, remove from the set, decide again.
 
-    With sampling, --time-limit applies to each step.
+    With sampling, the budget (--samples or --time-limit) applies to each step.
     """
-    from rich.table import Table
+    import unstack
 
-    from unstack.reasoner.plan import unloading_plan
-
-    supports = _load_supports(file, model_path)
-    result = unloading_plan(supports, **reasoning)
+    _check_output(output)
+    result = unstack.plan(_load_input(file, model), model=model, **reasoning)
     document = result.to_dict()
     _write_output(output, document)
+    _print_warnings(result.warnings)
 
-    def view() -> Table:
-        table = Table(title="Unloading plan (each step decided on the boxes still in place)", title_justify="left")
-        sampled = any(step.decision.sampling is not None for step in result.steps)
-        columns = ("step", "unload", "EC", *(("± s.e.", "P(minimum)") if sampled else ()), "boxes in place")
-        for column in columns:
-            table.add_column(column, justify="right" if column != "unload" else "left")
-        for number, step in enumerate(result.steps, start=1):
-            errors = (f"{step.expected_cost_error:.4f}", f"{step.decision.choice_probability:.3f}") if sampled else ()
-            table.add_row(str(number), step.choice, f"{step.expected_cost:.4f}", *errors, str(len(step.remaining)))
-        return table
+    def view() -> Any:
+        from unstack.cli.render import plan_view
+
+        return plan_view(result)
 
     _emit(as_json, document, view)
 
@@ -214,44 +271,53 @@ def plan(file: str, as_json: bool, output: str | None, model_path: str | None, *
 @cli.command()
 @click.argument("files", nargs=-1, required=True, type=str)
 def validate(files: tuple[str, ...]) -> None:
-    """Check files against their schema (supports, scene, decision, plan, data set manifest)."""
-    from unstack.jsonio import read_document, validate_document
-    from unstack.scene import Scene
-    from unstack.supports import Supports
+    """Check every file against its schema and what a schema cannot say (ids, matrices, hard evidence).
 
+    One line per file (valid on stdout, invalid on stderr), then a summary; exit code 2 when
+    any file is invalid.
+    """
+    import unstack
+
+    invalid = 0
     for file in files:
-        document = read_document(file)
-        tag = validate_document(document)
-        if tag == "unstack.supports/1":
-            supports = Supports.from_document(document)
-            detail = f"{supports.n_objects} objects"
-        elif tag == "unstack.scene/1":
-            scene = Scene.from_document(document)
-            detail = f"{len(scene.boxes)} boxes, {len(scene.detected)} detected, {len(scene.points):,} points"
-        elif tag == "unstack.plan/1":
-            detail = f"{len(document.data['order'])} boxes in order"
-        elif tag == "unstack.dataset/1":
-            detail = f"{document.data['configs']} configurations, seed {document.data['seed']}"
-        else:
-            detail = f"choice {document.data['choice']!r}"
-        click.echo(f"{document.source}: valid {tag} ({detail})")
+        try:
+            result = unstack.validate(file)
+        except UnstackError as error:
+            invalid += 1
+            click.echo(f"unstack: error: {printable(str(error))}", err=True)
+            continue
+        click.echo(f"{printable(result.source)}: valid {result.format} ({printable(result.detail)})")
+    valid = len(files) - invalid
+    click.echo(f"{len(files)} file{'s' if len(files) != 1 else ''}: {valid} valid, {invalid} invalid")
+    if invalid:
+        sys.exit(2)
 
 
-def _register_commands() -> None:
-    from unstack.cli.experiments import experiment
-    from unstack.cli.learning import evaluate, probabilities, train
-    from unstack.cli.simulation import render, simulate
+@cli.command("warm-up")
+def warm_up() -> None:
+    """Compile numba's kernels now (once after installing; later runs load them from the cache).
 
-    for command in (simulate, render, train, evaluate, probabilities, experiment):
-        cli.add_command(command)
+    The first decision on six or more linked boxes, the first sampled group and the first
+    scene otherwise pay this compilation themselves.
+    """
+    from unstack.warmup import KERNELS
+    from unstack.warmup import warm_up as compile_kernels
 
+    total = len(KERNELS)
+    done = [0]
+    click.echo(f"warm-up: compiling {total} groups of kernels (about 10 s after a fresh install) ...", err=True)
 
-_register_commands()
+    def report(name: str, seconds: float) -> None:
+        done[0] += 1
+        click.echo(f"warm-up: [{done[0]}/{total}] {name} ready in {seconds:.1f} s", err=True)
+
+    seconds = compile_kernels(report)
+    click.echo(f"warm-up: done in {sum(seconds.values()):.1f} s; numba's cache holds the kernels")
 
 
 def _warning_line(message: Warning | str, category: type[Warning], *_: object, **__: object) -> None:
     """Library warnings (an empty point cloud, say) as one line on stderr, without source lines."""
-    click.echo(f"unstack: warning: {message}", err=True)
+    _warn(str(message))
 
 
 def main() -> None:

@@ -1,4 +1,8 @@
-"""Rich renderings of decisions and payoff matrices for the terminal."""
+"""Rich renderings of decisions, plans and payoff matrices for the terminal.
+
+Box ids are shown as plain text with control characters escaped: an id never becomes
+rich markup or a terminal escape sequence.
+"""
 
 from __future__ import annotations
 
@@ -6,10 +10,17 @@ from rich.console import Group
 from rich.table import Table
 from rich.text import Text
 
+from unstack.cli.main import printable
 from unstack.reasoner.decision import Decision
 from unstack.reasoner.payoff import PayoffMatrix
+from unstack.reasoner.plan import Plan
 
-__all__ = ["decision_view", "payoff_view"]
+__all__ = ["decision_view", "payoff_view", "plan_view"]
+
+
+def _id(box: str) -> Text:
+    """A box id as a table cell: never markup, never a control sequence."""
+    return Text(printable(box))
 
 
 def _number(value: float) -> str:
@@ -22,7 +33,7 @@ MATRIX_MAX_BOXES = 12
 
 def decision_view(decision: Decision) -> Group:
     """The choice, the expected cost of every box and the conditional support matrix."""
-    unit = "boxes" if decision.cost == "count" else "kg"
+    unit = "kg" if decision.cost == "mass" else "boxes"
     order = sorted(range(len(decision.objects)), key=lambda i: (decision.expected_costs[i], decision.objects[i]))
     costs = Table(title=f"EC: expected {unit} supported (Eq. 13)", title_justify="left")
     costs.add_column("rank", justify="right")
@@ -36,16 +47,16 @@ def decision_view(decision: Decision) -> Group:
         box = decision.objects[i]
         mark = "<- unload first" if box == decision.choice else ("tie" if box in decision.ties else "")
         error = [] if not sampled else [f"{decision.expected_cost_errors[i]:.4f}"]  # type: ignore[index]
-        costs.add_row(str(rank), box, _number(float(decision.expected_costs[i])), *error, mark)
+        costs.add_row(str(rank), _id(box), _number(float(decision.expected_costs[i])), *error, mark)
     matrix: Table | Text
     if len(decision.objects) <= MATRIX_MAX_BOXES:
         matrix = Table(title="P(row supports column | consistent world)", title_justify="left")
         matrix.add_column("supports ->")
         for box in decision.objects:
-            matrix.add_column(box, justify="right")
+            matrix.add_column(_id(box), justify="right")
         for i, box in enumerate(decision.objects):
             cells = ["-" if i == j else f"{decision.marginals[i, j]:.3f}" for j in range(len(decision.objects))]
-            matrix.add_row(box, *cells)
+            matrix.add_row(_id(box), *cells)
     else:
         matrix = Text(f"({len(decision.objects)} boxes: P(row supports column | consistent) is in --json)")
     worlds = "" if decision.consistent_worlds is None else f", {decision.consistent_worlds:,} consistent worlds"
@@ -66,12 +77,12 @@ def decision_view(decision: Decision) -> Group:
         )
         if "warning" in decision.sampling:
             footer.append(f"\nwarning: {decision.sampling['warning']}", style="bold yellow")
-    headline = Text.assemble(("Unload first: ", "bold"), (decision.choice, "bold green"))
+    headline = Text.assemble(("Unload first: ", "bold"), (printable(decision.choice), "bold green"))
     if decision.choice_probability < 1.0 or decision.sampling is not None:
         headline.append(f"  (P(truly the minimum EC) = {decision.choice_probability:.3f})")
     if len(decision.ties) > 1:
         headline.append(
-            f"  (tied with {', '.join(t for t in decision.ties if t != decision.choice)}; smallest id wins)"
+            f"  (tied with {', '.join(printable(t) for t in decision.ties if t != decision.choice)}; smallest id wins)"
         )
     return Group(headline, costs, matrix, footer)
 
@@ -88,13 +99,13 @@ def payoff_view(table: PayoffMatrix, limit: int) -> Group:
     view.add_column("P(w)", justify="right")
     view.add_column("support relations")
     for box in objects:
-        view.add_column(f"A:{box}", justify="right")
+        view.add_column(_id(f"A:{box}"), justify="right")
     for i in order:
         relations = [f"{objects[x]}>{objects[y]}" for x, y in zip(*worlds.worlds[i].nonzero(), strict=True)]
         view.add_row(
             str(i + 1),
             f"{worlds.probabilities[i]:.4g}",
-            " ".join(relations) or "(none)",
+            _id(" ".join(relations) or "(none)"),
             *(f"{c:g}" for c in table.costs[i]),
         )
     expected = table.expected_costs()
@@ -107,3 +118,16 @@ def payoff_view(table: PayoffMatrix, limit: int) -> Group:
     )
     note = Text(f"{shown}; 'x>y' means x supports y", style="dim")
     return Group(view, note)
+
+
+def plan_view(result: Plan) -> Table:
+    """The unloading order, one row per pick, with errors when steps were sampled."""
+    table = Table(title="Unloading plan (each step decided on the boxes still in place)", title_justify="left")
+    sampled = any(step.decision.sampling is not None for step in result.steps)
+    columns = ("step", "unload", "EC", *(("± s.e.", "P(minimum)") if sampled else ()), "boxes in place")
+    for column in columns:
+        table.add_column(column, justify="right" if column != "unload" else "left")
+    for number, step in enumerate(result.steps, start=1):
+        errors = (f"{step.expected_cost_error:.4f}", f"{step.decision.choice_probability:.3f}") if sampled else ()
+        table.add_row(str(number), _id(step.choice), f"{step.expected_cost:.4f}", *errors, str(len(step.remaining)))
+    return table

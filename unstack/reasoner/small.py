@@ -40,24 +40,35 @@ _OFF_DIAGONAL = {n: ~np.eye(n, dtype=bool) for n in range(SMALL_MAX_BOXES + 1)}
 
 
 def _extend(worlds: np.ndarray) -> np.ndarray:
-    """Every preorder on one more box whose restriction to the first boxes is in ``worlds``."""
+    """Every preorder on one more box whose restriction to the first boxes is in ``worlds``.
+
+    The new box joins with a set D of supporters and a set U of boxes it supports. The
+    result is transitive iff D is closed under supporters, U is closed under supported
+    boxes, and every box of D supports every other box of U (checked on bit masks).
+    """
     count, m, _ = worlds.shape
     n = m + 1
-    choices = np.arange(1 << m)
-    bits = ((choices[:, None] >> np.arange(m)[None, :]) & 1).astype(bool)  # (2^m, m)
-    down = np.repeat(bits, 1 << m, axis=0)  # boxes supporting the new one
-    up = np.tile(bits, (1 << m, 1))  # boxes the new one supports
-    candidates = np.zeros((count, len(down), n, n), dtype=bool)
-    candidates[:, :, :m, :m] = worlds[:, None]
-    candidates[:, :, :m, m] = down[None]
-    candidates[:, :, m, :m] = up[None]
-    flat: np.ndarray = candidates.reshape(-1, n, n)
-    # transitive iff R o R is within R (the diagonal of R o R is mutual support: allowed)
-    composed = np.einsum("wij,wjk->wik", flat.astype(np.uint8), flat.astype(np.uint8)) > 0
-    composed[:, np.arange(n), np.arange(n)] = False
-    keep = ~(composed & ~flat).any(axis=(1, 2))
-    kept: np.ndarray = flat[keep]
-    return kept
+    bits = np.left_shift(1, np.arange(m))
+    successors = (worlds * bits[None, None, :]).sum(axis=2)  # (count, m): boxes x supports
+    predecessors = (worlds * bits[None, :, None]).sum(axis=1)  # (count, m): boxes supporting x
+    masks = np.arange(1 << m)
+    member = ((masks[:, None] >> np.arange(m)[None, :]) & 1).astype(bool)  # (2^m, m)
+    # down[w, D]: D holds every supporter of its members; up[w, U]: every box its members support
+    down = ~np.any(member[None] & ((predecessors[:, None, :] & ~masks[None, :, None]) != 0), axis=2)
+    up = ~np.any(member[None] & ((successors[:, None, :] & ~masks[None, :, None]) != 0), axis=2)
+    # cross[w, D, U]: each x in D supports each y != x in U
+    reach = successors | bits[None, :]  # (count, m)
+    blocked = np.zeros((count, 1 << m, 1 << m), dtype=bool)
+    for x in range(m):
+        outside = ~reach[:, x][:, None] & masks[None, :]  # (count, 2^m): boxes of U x does not reach
+        blocked |= member[None, :, x, None] & (outside[:, None, :] != 0)
+    keep = down[:, :, None] & up[:, None, :] & ~blocked
+    world, d, u = np.nonzero(keep)
+    extended = np.zeros((len(world), n, n), dtype=bool)
+    extended[:, :m, :m] = worlds[world]
+    extended[:, :m, m] = member[d]
+    extended[:, m, :m] = member[u]
+    return extended
 
 
 def preorders(n: int) -> np.ndarray:

@@ -1,0 +1,84 @@
+"""Compile (or load from numba's cache) every compiled kernel before the first real call.
+
+After a fresh install the first decision on a group of six or more boxes, the first
+sampled group and the first scene's features each pay for numba's compilation (seconds
+each; the README states what was measured). ``unstack warm-up`` -- or :func:`warm_up` at a
+robot's start-up -- pays it once, and numba caches the result on disk for later processes.
+
+Examples
+--------
+>>> [name for name, _ in KERNELS][:2]
+['exact engine', 'sampler']
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+__all__ = ["KERNELS", "warm_up"]
+
+
+def _exact() -> None:
+    from unstack.reasoner.marginals import exact_marginals
+
+    probabilities = np.full((6, 6), 0.5)
+    np.fill_diagonal(probabilities, 0.0)
+    exact_marginals(probabilities)
+
+
+def _sampler() -> None:
+    from unstack.reasoner.sampling import sample_worlds, sampled_marginals
+
+    probabilities = np.full((9, 9), 0.3)
+    np.fill_diagonal(probabilities, 0.0)
+    sampled_marginals(probabilities, samples=16, seed=0, burn_in=1)
+    sample_worlds(probabilities, 1, seed=0, burn_in=1)
+
+
+def _features() -> None:
+    from unstack.learning._contact_kernel import column_index, counts_in_boxes
+    from unstack.learning._dbaf_kernel import gaussian_sums
+
+    points = np.random.default_rng(0).uniform(0.0, 1.0, (64, 3))
+    gaussian_sums(points, points[:4].copy(), 2.0)
+    columns = column_index(points, 0.25)
+    counts_in_boxes(*columns, 0.25, np.zeros((2, 3)), np.ones((2, 3)))
+
+
+#: What :func:`warm_up` compiles, in order: ``(name, function)``.
+KERNELS: tuple[tuple[str, Callable[[], None]], ...] = (
+    ("exact engine", _exact),
+    ("sampler", _sampler),
+    ("feature kernels", _features),
+)
+
+
+def warm_up(progress: Callable[[str, float], None] | None = None) -> dict[str, float]:
+    """Compile or load every kernel; report each one's seconds.
+
+    Parameters
+    ----------
+    progress : callable, optional
+        Called as ``progress(name, seconds)`` after each kernel.
+
+    Returns
+    -------
+    dict
+        Seconds per kernel name (near 0 once numba's cache holds them).
+
+    Examples
+    --------
+    >>> sorted(warm_up())
+    ['exact engine', 'feature kernels', 'sampler']
+    """
+    seconds = {}
+    for name, compile_kernel in KERNELS:
+        start = time.perf_counter()
+        compile_kernel()
+        seconds[name] = time.perf_counter() - start
+        if progress is not None:
+            progress(name, seconds[name])
+    return seconds
