@@ -36,7 +36,7 @@ from unstack.supports import Supports
 if TYPE_CHECKING:
     from unstack.learning.model_file import SupportModel
 
-__all__ = ["decide", "load_model", "model_names", "plan", "support_probabilities"]
+__all__ = ["decide", "load_model", "model_label", "model_names", "plan", "support_probabilities"]
 
 ModelArgument = Union[None, str, os.PathLike[str], "SupportModel"]
 
@@ -143,6 +143,27 @@ def load_model(name_or_path: str | os.PathLike[str] | None = None) -> SupportMod
     return _remember(model_file.load_model(name), name)
 
 
+def model_label(model: SupportModel) -> str:
+    """How a model loaded by :func:`load_model` is named in provenance metadata.
+
+    Parameters
+    ----------
+    model : SupportModel
+
+    Returns
+    -------
+    str
+        ``"default:FILE"``, ``"shipped:FILE"``, the path it was loaded from, or ``""``
+        for a model built in memory.
+
+    Examples
+    --------
+    >>> model_label(load_model("extended"))
+    'shipped:extended-paper2.skops'
+    """
+    return _LABELS.get(id(model), "")
+
+
 def _model(model: Any) -> SupportModel:
     """A loaded model from what a caller passed as ``model``."""
     if model is None or isinstance(model, str | os.PathLike):
@@ -189,8 +210,7 @@ def support_probabilities(scene: Scene, model: ModelArgument = None) -> Supports
     from unstack.learning.probabilities import scene_support_probabilities
 
     loaded = _model(model)
-    label = _LABELS.get(id(loaded), "")
-    return scene_support_probabilities(scene, loaded, model_name=label)
+    return scene_support_probabilities(scene, loaded, model_name=model_label(loaded))
 
 
 def _supports(scene_or_supports: Any, model: Any) -> Supports:

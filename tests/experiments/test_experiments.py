@@ -162,17 +162,17 @@ def test_unloading_resumes_from_its_checkpoints(
     from unstack.experiments.unloading import unloading_experiment
 
     model = load_model(default_model_path())
-    first = unloading_experiment(small_dataset, model, configs=1, time_limit=0.1, checkpoints=tmp_path)
+    first = unloading_experiment(small_dataset, model, configs=1, samples=64, checkpoints=tmp_path)
     assert len(list(tmp_path.glob("*.json"))) == 1
 
     def no_simulation(*_: object, **__: object) -> None:
         raise AssertionError("a finished pile was simulated again")
 
     monkeypatch.setattr(simulator, "execute_unloading", no_simulation)
-    again = unloading_experiment(small_dataset, model, configs=1, time_limit=0.1, checkpoints=tmp_path)
+    again = unloading_experiment(small_dataset, model, configs=1, samples=64, checkpoints=tmp_path)
     assert again == first
     with pytest.raises(AssertionError, match="simulated again"):  # another seed is another run
-        unloading_experiment(small_dataset, model, configs=1, time_limit=0.1, seed=5, checkpoints=tmp_path)
+        unloading_experiment(small_dataset, model, configs=1, samples=64, seed=5, checkpoints=tmp_path)
 
 
 def test_unloading_runs_on_a_dask_cluster(small_dataset: Path) -> None:
@@ -185,7 +185,18 @@ def test_unloading_runs_on_a_dask_cluster(small_dataset: Path) -> None:
         LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster,
         Client(cluster) as client,
     ):
-        result = unloading_experiment(small_dataset, model, configs=2, time_limit=0.1, client=client)
+        result = unloading_experiment(small_dataset, model, configs=2, samples=64, client=client)
     assert [pile["scene"] for pile in result["piles"]] == ["config-0000.json", "config-0001.json"]
     for pile in result["piles"]:
         assert all(sorted(run["order"]) == sorted(pile["runs"]["highest"]["order"]) for run in pile["runs"].values())
+
+
+def test_unloading_orders_are_reproducible_for_a_seed(small_dataset: Path) -> None:
+    from unstack.experiments.unloading import unloading_orders
+    from unstack.scene import load_scene
+
+    scene = load_scene(sorted(small_dataset.glob("config-*.json"))[0])
+    model = load_model(default_model_path())
+    first = unloading_orders(scene, model, seed=3, samples=64)
+    assert first == unloading_orders(scene, model, seed=3, samples=64)
+    assert sorted(first["reasoner"]) == sorted(scene.detected)

@@ -10,6 +10,7 @@ from rich.console import Console
 from rich.table import Table
 
 from unstack.cli.learning import FEATURES_HELP, ISETS_FROM_HELP, MODEL_HELP
+from unstack.cli.main import finite_seconds
 from unstack.cli.progress import progress_bar
 from unstack.errors import UnstackError
 
@@ -177,7 +178,7 @@ def decisions(
     data_dir: str, out: str, model_path: str | None, r: int, isets: int, draw: str, seed: int, full: bool
 ) -> None:
     """Fig. 4 and beyond: MSE(cost), first pick right and physical disturbance of every decision maker."""
-    from unstack.cli.learning import load_support_model
+    from unstack.cli.main import load_model_option
     from unstack.experiments.decisions import DECISION_MAKERS, evaluate_decisions, plot_fig4
     from unstack.sim.dataset import require_configurations
 
@@ -186,7 +187,7 @@ def decisions(
     if r < 2 or isets < 1:
         raise UnstackError(f"expected --r >= 2 and --isets >= 1, got {r} and {isets}")
     require_configurations(data_dir)  # before any progress bar or output folder
-    model, name = load_support_model(model_path)
+    model, name = load_model_option(model_path)
     folder = _out(out)
     with progress_bar("ISets") as report:
         result = evaluate_decisions(data_dir, model, r=r, isets=isets, seed=seed, progress=report, draw=draw)
@@ -220,7 +221,7 @@ def decisions(
 @click.option("--piles", type=int, default=None, help="Use only the first N piles.")
 def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) -> None:
     """The paper's real setting in simulation: every ISet of r = 3, 4, 5 of each 7-box pile."""
-    from unstack.cli.learning import load_support_model
+    from unstack.cli.main import load_model_option
     from unstack.experiments.real7 import real7 as run
     from unstack.experiments.real7 import summary_rows
     from unstack.sim.dataset import require_configurations
@@ -228,7 +229,7 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
     if piles is not None and piles < 1:
         raise UnstackError(f"--piles must be at least 1, got {piles}")
     require_configurations(data_dir)
-    model, name = load_support_model(model_path)
+    model, name = load_model_option(model_path)
     with progress_bar("ISets") as report:
         result = run(data_dir, model, piles=piles, progress=report)
     result["model"] = name
@@ -250,8 +251,10 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
 @click.option("--out", required=True, type=click.Path(), help="Folder for unloading.json and unloading.png.")
 @click.option("--model", "model_path", default=None, help=MODEL_HELP)
 @click.option("--configs", type=click.IntRange(min=1), default=4, show_default=True, help="Piles (the first N).")
-@click.option("--time-limit", type=click.FloatRange(min=0.0, min_open=True), default=0.3, show_default=True,
-              help="Seconds per decision of the plan (large groups are sampled).")  # fmt: skip
+@click.option("--samples", type=click.IntRange(min=1), default=1024, show_default=True,
+              help="Recorded sweeps per sampled group in each decision (reproducible with the seed).")  # fmt: skip
+@click.option("--time-limit", type=float, default=None, callback=finite_seconds,
+              help="Seconds per decision instead of --samples (not reproducible).")  # fmt: skip
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of the sampler and the random order.")  # fmt: skip
 @click.option("--full", is_flag=True, help="Every configuration of the data set (overrides --configs).")
@@ -265,7 +268,8 @@ def unload(
     out: str,
     model_path: str | None,
     configs: int,
-    time_limit: float,
+    samples: int,
+    time_limit: float | None,
     seed: int,
     full: bool,
     closed_loop: bool,
@@ -277,14 +281,14 @@ def unload(
     Resumable: each pile's result is kept in OUT/unloading-piles as soon as it is done, and a
     run started again with the same piles, model, time limit and seed reuses them.
     """
-    from unstack.cli.learning import load_support_model
+    from unstack.cli.main import load_model_option
     from unstack.experiments.unloading import plot_unloading, unloading_experiment
     from unstack.sim.dataset import require_configurations
 
     found = len(require_configurations(data_dir))
     if full:
         configs = found
-    model, name = load_support_model(model_path)
+    model, name = load_model_option(model_path)
     from unstack.sim.dataset import connect_scheduler
 
     client = connect_scheduler(scheduler) if scheduler else None  # fails in seconds, before any output
@@ -292,7 +296,8 @@ def unload(
     try:
         with progress_bar("piles") as report:
             result = unloading_experiment(
-                data_dir, model, configs=configs, time_limit=time_limit, seed=seed, progress=report,
+                data_dir, model, configs=configs, samples=None if time_limit else samples, time_limit=time_limit,
+                seed=seed, progress=report,
                 checkpoints=folder / "unloading-piles", closed_loop=closed_loop, n_jobs=jobs, client=client,
             )  # fmt: skip
     finally:
@@ -341,14 +346,14 @@ def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int
     decision is right when it picks a box that holds up nothing and its expected costs keep
     their bounds. Writes generalisation.json and generalisation.png (one scene per kind).
     """
-    from unstack.cli.learning import load_support_model
+    from unstack.cli.main import load_model_option
     from unstack.experiments.canonical_scenes import CANONICAL_KINDS, build_case
     from unstack.experiments.generalisation import physical_check, run_suite, suite_figure, summary_rows
     from unstack.learning.probabilities import scene_support_probabilities
     from unstack.reasoner.decision import decide
 
     folder = _out(out)
-    model, name = load_support_model(model_path)
+    model, name = load_model_option(model_path)
     seed_list = list(range(first_seed, first_seed + seeds))
     with progress_bar("scenes") as report:
         results = run_suite(

@@ -119,10 +119,18 @@ def _load_input(path: str, model: str | None) -> Any:
     return loaded
 
 
-def _finite_seconds(_ctx: click.Context, _param: click.Parameter, value: float | None) -> float | None:
+def finite_seconds(_ctx: click.Context, _param: click.Parameter, value: float | None) -> float | None:
     if value is not None and not (math.isfinite(value) and value > 0):
         raise click.BadParameter(f"expected a positive, finite number of seconds, got {value}")
     return value
+
+
+def load_model_option(model: str | None) -> tuple[Any, str]:
+    """The model of ``--model`` (a shipped model's name or a file; the default when None) and its name."""
+    from unstack.api import load_model, model_label
+
+    loaded = load_model(model)
+    return loaded, model_label(loaded)
 
 
 def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
@@ -156,7 +164,7 @@ def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
             "--time-limit",
             type=float,
             default=None,
-            callback=_finite_seconds,
+            callback=finite_seconds,
             help="Seconds for the whole decision instead of a number of sweeps (not reproducible; under 10 "
             "also samples groups of 8).",
         ),
