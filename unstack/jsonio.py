@@ -266,6 +266,10 @@ def validate_document(
     tag = document.data.get("format")
     if tag is None:
         raise UnknownFormat(document.source, "$", f"missing required key 'format' (expected {', '.join(accepted)})")
+    if not isinstance(tag, str):
+        raise UnknownFormat(
+            document.source, "$.format", f"expected a format tag string ({' or '.join(accepted)}), got {_short(tag)}"
+        )
     if tag not in accepted:
         family = str(tag).rsplit("/", 1)[0]
         same_family = [known for known in accepted if known.rsplit("/", 1)[0] == family]
