@@ -115,9 +115,10 @@ def surface_cloud(
     rays = cloud - eye
     ranges = np.linalg.norm(rays, axis=1)
     directions = rays / ranges[:, None]
-    # A point z-buffer: angular bins a little finer than the samples at the nearest range;
-    # in each bin only the points within one spacing of the nearest survive.
-    step = spacing / max(float(ranges.min()), spacing) * 0.7
+    # A point z-buffer: angular bins coarser than the samples at the nearest range, so that a
+    # near surface leaves no empty bin to see through; in each bin only the points within
+    # two spacings of the nearest survive.
+    step = 1.5 * spacing / max(float(ranges.min()), spacing)
     azimuth = np.arctan2(directions[:, 1], directions[:, 0])
     elevation = np.arcsin(np.clip(directions[:, 2], -1.0, 1.0))
     bins = np.stack([np.floor(azimuth / step), np.floor(elevation / step)], axis=1).astype(np.int64)
@@ -125,7 +126,7 @@ def surface_cloud(
     bin_index = bin_index.ravel()
     nearest = np.full(bin_index.max() + 1, np.inf)
     np.minimum.at(nearest, bin_index, ranges)
-    visible = ranges <= nearest[bin_index] + spacing
+    visible = ranges <= nearest[bin_index] + 2 * spacing
     cloud, ranges, directions = cloud[visible], ranges[visible], directions[visible]
     if depth_noise > 0:
         cloud = eye + directions * (ranges + rng.normal(0.0, depth_noise, size=len(ranges)))[:, None]

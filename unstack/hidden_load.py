@@ -13,8 +13,9 @@ dropped first):
   :data:`STACK_GAP`) of it -- a box resting on X whose front face is not seen still shows
   its top there;
 * ``coverage``: the share of :data:`COVERAGE_BIN`-wide bins across X's width (world y, as
-  the sensor at the door sees it) holding an unexplained point within :data:`LOAD_BAND` of
-  the lowest one -- how much of X's top carries something;
+  the sensor at the door sees it) holding an unexplained point within one layer (a typical
+  box height plus :data:`STACK_GAP`) of the lowest one -- how much of X's top carries
+  something, from its front face, its top face or both;
 * ``rise``: how high the unexplained material reaches, going up without a vertical gap
   wider than :data:`STACK_GAP`;
 * the estimate ``coverage * max(1, rise / typical box height)``, the typical height being
@@ -43,12 +44,10 @@ import numpy as np
 from unstack.geometry import bounding_boxes, box_corners, convex_hull_2d, footprint, points_in_box
 from unstack.scene import Scene
 
-__all__ = ["EXPLAINED_MARGIN", "LOAD_BAND", "STACK_GAP", "hidden_load"]
+__all__ = ["EXPLAINED_MARGIN", "STACK_GAP", "hidden_load"]
 
 #: Points within this distance of a detected box belong to it (metres).
 EXPLAINED_MARGIN = 0.02
-#: Points up to this far above the lowest unexplained point count as resting on the box (metres).
-LOAD_BAND = 0.15
 #: A vertical gap wider than this ends the material stacked on a box (metres).
 STACK_GAP = 0.08
 #: Points closer than this to a box's top belong to the top face (metres).
@@ -96,7 +95,7 @@ def _load_on(column: np.ndarray, top: float, low_y: float, high_y: float, typica
     jumps = np.flatnonzero(np.diff(above) > STACK_GAP)
     rise = float(above[jumps[0]] if len(jumps) else above[-1])
     first = float(above[0])
-    band = column[(heights >= first) & (heights <= first + LOAD_BAND)]
+    band = column[(heights >= first) & (heights <= first + typical_height + STACK_GAP)]
     bins = max(1, int(np.ceil((high_y - low_y) / COVERAGE_BIN)))
     occupied = np.unique(np.clip(((band[:, 1] - low_y) / (high_y - low_y) * bins).astype(int), 0, bins - 1))
     return len(occupied) / bins * max(1.0, rise / typical_height)

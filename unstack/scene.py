@@ -42,7 +42,7 @@ def _check_edges(size: np.ndarray, source: str, path: str) -> np.ndarray:
             raise InvalidScene(
                 source,
                 f"{path}[{k}]",
-                f"expected a box edge between {MIN_BOX_EDGE} and {MAX_BOX_EDGE} m (unstack works in metres), "
+                f"expected a box edge between {MIN_BOX_EDGE:g} and {MAX_BOX_EDGE:g} m (unstack works in metres), "
                 f"got {edge:g}",
             )
     return size

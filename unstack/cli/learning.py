@@ -18,10 +18,10 @@ __all__ = ["evaluate", "load_support_model", "metrics_view", "probabilities", "s
 
 
 def load_support_model(path: str | None) -> tuple[Any, str]:
-    """The model of ``--model``: a file, or the name of a shipped model (default: ``paper``)."""
-    from unstack.learning.model_file import BUNDLED_MODELS, bundled_model_path, load_model
+    """The model of ``--model``: a file, or the name of a shipped model (default: ``general``)."""
+    from unstack.learning.model_file import BUNDLED_MODELS, DEFAULT_MODEL_NAME, bundled_model_path, load_model
 
-    name = "paper" if path is None else path
+    name = DEFAULT_MODEL_NAME if path is None else path
     if name not in BUNDLED_MODELS:
         return load_model(name), name
     shipped = bundled_model_path(name)
@@ -64,10 +64,13 @@ def metrics_view(report: dict[str, Any], title: str) -> Group:
 
 
 ISETS_FROM_HELP = "How ISets are drawn: random detected boxes, or a detected box and its nearest neighbours."
-MODEL_HELP = "Model file, or a shipped model: paper (the default: the paper's SVM) or extended (better decisions)."
+MODEL_HELP = (
+    "Model file, or a shipped model: general (the default: pose features, five pile families), paper (the "
+    "paper's SVM, for the reproduction) or extended (the paper's piles with contact features)."
+)
 FEATURES_HELP = (
     "paper: the 19 numbers of Eq. 6; extended: those and 17 contact features (gaps, overlaps, cloud); "
-    "general: 20 features that do not depend on how the cloud was sampled (oriented geometry, cloud coverage)."
+    "general: 15 features of the two boxes' poses (oriented footprints, gaps, tilt, separation), no cloud."
 )
 #: Configuration numbers of the n-th data set of a training run start at n times this.
 CONFIGURATION_OFFSET = 100_000

@@ -93,7 +93,7 @@ class FeatureSettings:
         Largest neglected term of the ``kdtree`` method, relative to the largest term.
     feature_set : {"paper", "extended", "general"}
         ``"paper"``: the 19 numbers of Eq. 6; ``"extended"``: those and the 17 contact
-        features (:mod:`unstack.learning.contact_features`); ``"general"``: 20 features
+        features (:mod:`unstack.learning.contact_features`); ``"general"``: 15 features
         that do not depend on how the cloud was sampled
         (:mod:`unstack.learning.general_features`), without Eq. 6.
     """
@@ -245,7 +245,7 @@ def pair_features(
     """``F_XY`` (Eq. 6) for each ordered pair ``(X, Y)`` of box indices, shape (len(pairs), 19).
 
     With ``settings.feature_set == "extended"`` the 17 contact features follow: shape
-    (len(pairs), 36); with ``"general"`` only the 20 general features; columns named by
+    (len(pairs), 36); with ``"general"`` only the 15 general features; columns named by
     :func:`feature_names`.
     """
     settings = settings or FeatureSettings()
@@ -253,7 +253,7 @@ def pair_features(
     if settings.feature_set == "general":
         from unstack.learning.general_features import general_features
 
-        return general_features(boxes, points, [(int(a), int(b)) for a, b in index])
+        return general_features(boxes, [(int(a), int(b)) for a, b in index])
     used = np.unique(index)
     local = {int(box): row for row, box in enumerate(used)}
     subset = [boxes[int(box)] for box in used]

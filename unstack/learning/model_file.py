@@ -40,6 +40,7 @@ from unstack.learning.features import FeatureSettings
 __all__ = [
     "BUNDLED_MODELS",
     "DEFAULT_MODEL",
+    "DEFAULT_MODEL_NAME",
     "MODEL_FORMAT",
     "RANGE_MARGIN",
     "InvalidModel",
@@ -53,11 +54,16 @@ __all__ = [
 
 MODEL_FORMAT = "unstack.model/1"
 #: File name of the model shipped with the package (``unstack/learning/models``).
-DEFAULT_MODEL = "default-paper2.skops"
-#: Models shipped with the package, by the name ``--model`` accepts: ``paper`` (the default:
-#: the paper's SVM and 19 features) and ``extended`` (gradient boosting on the extended
-#: features, split by pile; better decisions, see the results page).
-BUNDLED_MODELS = {"paper": DEFAULT_MODEL, "extended": "extended-paper2.skops"}
+#: Models shipped with the package, by the name ``--model`` accepts: ``general`` (the
+#: default: gradient boosting on the pose-only general features, trained on five pile
+#: families with detector pose errors; see the generalisation page of the docs), ``paper``
+#: (the paper's SVM and 19 features, for the reproduction) and ``extended`` (gradient
+#: boosting on the extended features of the paper's piles; see the results page).
+BUNDLED_MODELS = {"general": "general-mix.skops", "paper": "default-paper2.skops", "extended": "extended-paper2.skops"}
+#: The name of the model used when none is given.
+DEFAULT_MODEL_NAME = "general"
+#: File name of the default model shipped with the package (``unstack/learning/models``).
+DEFAULT_MODEL = BUNDLED_MODELS[DEFAULT_MODEL_NAME]
 
 
 #: scikit-learn types a model may hold beyond those skops trusts by default: the internals
@@ -241,8 +247,8 @@ def load_model(path: str | os.PathLike[str]) -> SupportModel:
 
 
 def default_model_path() -> Path:
-    """Where the model shipped with the package lies."""
-    return bundled_model_path("paper")
+    """Where the default model shipped with the package lies."""
+    return bundled_model_path(DEFAULT_MODEL_NAME)
 
 
 def bundled_model_path(name: str) -> Path:

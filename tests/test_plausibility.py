@@ -1,0 +1,69 @@
+"""Implausible scenes are refused with the JSON path; doubtful ones are warned about."""
+
+from __future__ import annotations
+
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from unstack.errors import InvalidScene
+from unstack.plausibility import scene_warnings
+from unstack.scene import Box, Scene
+
+
+@pytest.mark.parametrize(
+    ("size", "position", "message"),
+    [
+        ([600.0, 400.0, 400.0], [1000.0, 0.0, 200.0], r"\$\.size\[0\]: expected a box edge between 0\.02 and 5 m"),
+        ([0.01, 0.4, 0.4], [1.0, 0.0, 0.2], r"\$\.size\[0\]: expected a box edge between 0\.02 and 5 m"),
+        ([0.6, 0.4, 0.4], [1e300, 0.0, 0.2], r"\$\.position\[0\]: expected a coordinate within 100 m"),
+    ],
+)
+def test_a_box_no_carton_can_be_is_refused(size: list[float], position: list[float], message: str) -> None:
+    with pytest.raises(InvalidScene, match=message):
+        Box("a", size, position)
+
+
+def test_two_boxes_in_one_place_are_refused() -> None:
+    boxes = [Box("a", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2]), Box("b", [0.4, 0.4, 0.4], [1.05, 0.0, 0.2])]
+    with pytest.raises(InvalidScene, match=r"\$\.boxes\[1\]: box 'b' shares 88 % of the smaller one's volume"):
+        Scene(boxes, np.zeros((0, 3)), ["a"])
+
+
+def test_a_small_overlap_a_floating_box_and_an_empty_cloud_are_warned_about() -> None:
+    boxes = [
+        Box("a", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2]),
+        Box("b", [0.4, 0.4, 0.4], [1.0, 0.36, 0.2]),
+        Box("high", [0.3, 0.3, 0.3], [1.0, 1.0, 1.2]),
+    ]
+    warnings = scene_warnings(Scene(boxes, np.zeros((0, 3)), ["a", "b", "high"], source="s.json"))
+    assert any(re.search(r"boxes 'a' and 'b' overlap by 1\d % of the smaller one's volume", line) for line in warnings)
+    assert any("box 'high' floats" in line for line in warnings)
+    assert any("the point cloud is empty" in line for line in warnings)
+
+
+def test_a_box_resting_on_another_does_not_float() -> None:
+    boxes = [Box("a", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2]), Box("b", [0.3, 0.3, 0.3], [1.0, 0.0, 0.551])]
+    assert scene_warnings(Scene(boxes, [[0.8, 0.0, 0.3]], ["a", "b"])) == []
+
+
+def test_a_scene_in_millimetres_is_one_line_and_exit_code_2(tmp_path: Path) -> None:
+    scene = {
+        "format": "unstack.scene/1",
+        "boxes": [{"id": "a", "size": [600, 400, 400], "position": [1000, 0, 200], "orientation_xyzw": [0, 0, 0, 1]}],
+        "points": [],
+        "detected": ["a"],
+    }
+    file = tmp_path / "mm.json"
+    file.write_text(json.dumps(scene))
+    result = subprocess.run([sys.executable, "-m", "unstack", "decide", str(file)], capture_output=True, text=True)
+    assert result.returncode == 2
+    assert result.stderr.strip().splitlines() == [
+        f"unstack: error: {file}: $.boxes[0].size[0]: expected a box edge between 0.02 and 5 m "
+        "(unstack works in metres), got 600"
+    ]
