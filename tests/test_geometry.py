@@ -35,7 +35,7 @@ def test_footprint_overlap_matches_a_monte_carlo_estimate(yaw_a: float, yaw_b: f
     rng = np.random.default_rng(0)
     samples = rng.uniform(-1.0, 1.0, size=(40_000, 3)) * [1, 1, 0] + [0, 0, 0.15]
     inside_first = points_in_box(samples, first)
-    lifted = samples + [0, 0, 0.3]
+    lifted = samples + np.array([0.0, 0.0, 0.3])
     inside_both = inside_first & points_in_box(lifted, second)
     estimate = inside_both.mean() * 4.0
     exact = footprint_overlap_area(footprint(first), footprint(second))
@@ -45,8 +45,8 @@ def test_footprint_overlap_matches_a_monte_carlo_estimate(yaw_a: float, yaw_b: f
 
 def test_polygon_distance_of_separated_squares_is_the_gap() -> None:
     square = convex_hull_2d(np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float))
-    assert polygon_distance(square, square + [1.5, 0.0]) == pytest.approx(0.5)
-    assert polygon_distance(square, square + [0.5, 0.5]) == 0.0
+    assert polygon_distance(square, square + np.array([1.5, 0.0])) == pytest.approx(0.5)
+    assert polygon_distance(square, square + np.array([0.5, 0.5])) == 0.0
 
 
 def test_a_box_turned_about_z_is_upright_and_a_tipped_one_is_not() -> None:
