@@ -48,7 +48,9 @@ def test_a_model_file_is_loaded_by_path(tmp_path: Path) -> None:
 
 def test_wrong_arguments_are_invalid_arguments(examples: Path) -> None:
     supports = unstack.load_supports(examples / "pile5.supports.json")
-    with pytest.raises(InvalidArgument, match=r"pile5\.supports\.json: a model turns a scene into support probabilities"):
+    with pytest.raises(
+        InvalidArgument, match=r"pile5\.supports\.json: a model turns a scene into support probabilities"
+    ):
         unstack.decide(supports, model="paper")
     with pytest.raises(ValueError, match="expected a Scene or Supports, got dict"):
         unstack.plan({"objects": []})  # type: ignore[arg-type]
@@ -81,7 +83,9 @@ def test_importing_unstack_and_deciding_on_supports_stays_light(repo: Path) -> N
     env = {**os.environ, "PYTHONPATH": str(repo)}
     output = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=repo, env=env)
     loaded = {name.split(".")[0] for name in output.stdout.split()}
-    assert not loaded & {"sklearn", "numba", "networkx", "pybullet", "matplotlib", "pysat", "scipy"}, sorted(loaded & {"sklearn", "numba", "networkx", "pybullet", "matplotlib", "pysat", "scipy"})
+    assert not loaded & {"sklearn", "numba", "networkx", "pybullet", "matplotlib", "pysat", "scipy"}, sorted(
+        loaded & {"sklearn", "numba", "networkx", "pybullet", "matplotlib", "pysat", "scipy"}
+    )
     assert "unstack.learning" not in output.stdout.split()
 
 

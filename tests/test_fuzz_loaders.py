@@ -180,9 +180,15 @@ def test_the_small_validator_agrees_with_jsonschema(text: str) -> None:
         document = json.loads(text)
     except ValueError:
         return
-    if not isinstance(document, dict) or not isinstance(document.get("format"), str) or document["format"] not in FORMATS:
+    if (
+        not isinstance(document, dict)
+        or not isinstance(document.get("format"), str)
+        or document["format"] not in FORMATS
+    ):
         return
     schema = load_schema(document["format"])
     ours = {(tuple(map(str, e.absolute_path)), e.validator) for e in iter_errors(schema, document)}
-    theirs = {(tuple(map(str, e.absolute_path)), e.validator) for e in Draft202012Validator(schema).iter_errors(document)}
+    theirs = {
+        (tuple(map(str, e.absolute_path)), e.validator) for e in Draft202012Validator(schema).iter_errors(document)
+    }
     assert ours == theirs

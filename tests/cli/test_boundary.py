@@ -70,7 +70,9 @@ def test_model_on_a_supports_file_is_an_error() -> None:
 def test_ids_with_control_characters_are_escaped(tmp_path: Path) -> None:
     file = tmp_path / "escape.json"
     objects = ["top\x1b[31m", "bottom\x07[bold]"]
-    file.write_text(json.dumps({"format": "unstack.supports/1", "objects": objects, "probabilities": [[0, 0.1], [0.9, 0]]}))
+    file.write_text(
+        json.dumps({"format": "unstack.supports/1", "objects": objects, "probabilities": [[0, 0.1], [0.9, 0]]})
+    )
     for command in ("decide", "plan", "worlds", "validate"):
         result = unstack(command, str(file))
         assert result.returncode == 0, result.stderr
@@ -79,7 +81,9 @@ def test_ids_with_control_characters_are_escaped(tmp_path: Path) -> None:
             assert "top\\x1b[31m" in result.stdout, (command, result.stdout)
     assert json.loads(unstack("decide", str(file), "--json").stdout)["choice"] == objects[0]
     duplicate = tmp_path / "duplicate.json"
-    duplicate.write_text(json.dumps({"format": "unstack.supports/1", "objects": ["\x1b", "\x1b"], "probabilities": [[0, 0], [0, 0]]}))
+    duplicate.write_text(
+        json.dumps({"format": "unstack.supports/1", "objects": ["\x1b", "\x1b"], "probabilities": [[0, 0], [0, 0]]})
+    )
     result = unstack("decide", str(duplicate))
     one_line_error(result, "appears twice")
     assert "\x1b" not in result.stderr
@@ -90,7 +94,11 @@ def test_an_output_in_a_missing_folder_fails_before_any_work(tmp_path: Path) -> 
     p = rng.uniform(0.05, 0.95, (30, 30))
     np.fill_diagonal(p, 0.0)
     big = tmp_path / "big.json"
-    big.write_text(json.dumps({"format": "unstack.supports/1", "objects": [f"b{i}" for i in range(30)], "probabilities": p.tolist()}))
+    big.write_text(
+        json.dumps(
+            {"format": "unstack.supports/1", "objects": [f"b{i}" for i in range(30)], "probabilities": p.tolist()}
+        )
+    )
     target = tmp_path / "missing" / "out.json"
     for command in ("decide", "plan"):  # a billion sweeps: only failing first returns in time
         result = unstack(command, str(big), "--samples", "1000000000", "--output", str(target))
@@ -101,7 +109,13 @@ def test_an_output_in_a_missing_folder_fails_before_any_work(tmp_path: Path) -> 
 def test_validate_checks_every_file_and_summarises(tmp_path: Path) -> None:
     contradiction = tmp_path / "contradiction.json"
     contradiction.write_text(
-        json.dumps({"format": "unstack.supports/1", "objects": ["a", "b", "c"], "probabilities": [[0, 1, 0], [0, 0, 1], [0, 0, 0]]})
+        json.dumps(
+            {
+                "format": "unstack.supports/1",
+                "objects": ["a", "b", "c"],
+                "probabilities": [[0, 1, 0], [0, 0, 1], [0, 0, 0]],
+            }
+        )
     )
     missing = tmp_path / "missing.json"
     result = unstack("validate", str(missing), PILE5, str(contradiction), "examples/scene3.json")
@@ -119,7 +133,13 @@ def test_validate_checks_every_file_and_summarises(tmp_path: Path) -> None:
 def test_a_contradiction_in_decide_names_the_file(tmp_path: Path) -> None:
     contradiction = tmp_path / "contradiction.json"
     contradiction.write_text(
-        json.dumps({"format": "unstack.supports/1", "objects": ["a", "b", "c"], "probabilities": [[0, 1, 0], [0, 0, 1], [0, 0, 0]]})
+        json.dumps(
+            {
+                "format": "unstack.supports/1",
+                "objects": ["a", "b", "c"],
+                "probabilities": [[0, 1, 0], [0, 0, 1], [0, 0, 0]],
+            }
+        )
     )
     one_line_error(unstack("decide", str(contradiction)), f"{contradiction}: no consistent world")
 
@@ -157,5 +177,9 @@ def test_warm_up_reports_each_kernel() -> None:
     assert result.returncode == 0, result.stderr
     lines = result.stderr.splitlines()
     assert lines[0].startswith("warm-up: compiling 3 groups of kernels")
-    assert [line.split("] ")[1].split(" ready")[0] for line in lines[1:]] == ["exact engine", "sampler", "feature kernels"]
+    assert [line.split("] ")[1].split(" ready")[0] for line in lines[1:]] == [
+        "exact engine",
+        "sampler",
+        "feature kernels",
+    ]
     assert result.stdout.startswith("warm-up: done in ")
