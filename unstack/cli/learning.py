@@ -10,7 +10,7 @@ from rich.console import Console, Group
 from rich.table import Table
 from rich.text import Text
 
-from unstack.errors import ModelRequired, UnstackError
+from unstack.errors import UnstackError
 from unstack.learning.features import FEATURE_SETS
 from unstack.learning.training_data import ISET_DRAWS
 
@@ -18,26 +18,18 @@ __all__ = ["evaluate", "load_support_model", "metrics_view", "probabilities", "s
 
 
 def load_support_model(path: str | None) -> tuple[Any, str]:
-    """The model of ``--model``: a file, or the name of a shipped model (default: ``general``)."""
-    from unstack.learning.model_file import BUNDLED_MODELS, DEFAULT_MODEL_NAME, bundled_model_path, load_model
+    """The model of ``--model`` and its name (:func:`unstack.api.load_model`: a file, a shipped
+    model's name, or the default model when None)."""
+    from unstack.cli.main import load_model_option
 
-    name = DEFAULT_MODEL_NAME if path is None else path
-    if name not in BUNDLED_MODELS:
-        return load_model(name), name
-    shipped = bundled_model_path(name)
-    if not shipped.is_file():
-        raise ModelRequired(
-            f"the shipped model {shipped.name} is not installed; pass --model FILE (make one with unstack train)"
-        )
-    return load_model(shipped), f"{'default' if path is None else 'shipped'}:{shipped.name}"
+    return load_model_option(path)
 
 
 def scene_supports(scene: Any, model_path: str | None) -> Any:
-    """Support probabilities of a scene's detected boxes from the learned model."""
-    from unstack.learning.probabilities import scene_support_probabilities
+    """Support probabilities of a scene's detected boxes (:func:`unstack.support_probabilities`)."""
+    from unstack.api import support_probabilities
 
-    model, name = load_support_model(model_path)
-    return scene_support_probabilities(scene, model, model_name=name)
+    return support_probabilities(scene, model_path)
 
 
 def metrics_view(report: dict[str, Any], title: str) -> Group:
