@@ -49,6 +49,7 @@ def metrics_view(report: dict[str, Any], title: str) -> Group:
         ("balanced_error_rate", "balanced error rate (Eq. 16)"),
         ("average_entropy", "average entropy (Eq. 15)"),
         ("brier_score", "Brier score"),
+        ("expected_calibration_error", "expected calibration error"),
     ):
         value = report[key]
         summary.add_row(label, f"{value:.4f}" if isinstance(value, float) else str(value))
@@ -206,8 +207,10 @@ def train(
 @click.argument("data_dir", type=click.Path(file_okay=False))
 @click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
 @click.option("--isets", type=int, default=3, show_default=True, help="ISets drawn per configuration.")
-@click.option("--isets-from", "draw", type=click.Choice(["random", "neighbours"]), default="random",
+@click.option("--isets-from", "draw", type=click.Choice(list(ISET_DRAWS)), default="random",
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
+@click.option("--pose-noise", type=click.FloatRange(0.0, 0.1), default=0.0, show_default=True,
+              help="Score on boxes as a detector reports them: errors of this many metres.")  # fmt: skip
 @click.option("--seed", type=int, default=1, show_default=True, help="Seed of the ISets.")
 @click.option("--jobs", type=int, default=1, show_default=True, help="Parallel processes.")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
@@ -218,19 +221,20 @@ def evaluate(
     r: int,
     isets: int,
     draw: str,
+    pose_noise: float,
     seed: int,
     jobs: int,
     as_json: bool,
     reliability: str | None,
 ) -> None:
-    """Score a model on a data set: confusion matrix, success rate, BER, entropy, calibration."""
+    """Score a model (a file or a shipped model's name) on a data set: confusion matrix,
+    success rate, BER, entropy, calibration."""
     from unstack.learning.metrics import classification_report, save_reliability_diagram
-    from unstack.learning.model_file import load_model
 
     if r < 2 or isets < 1 or jobs < 1:
         raise UnstackError("expected --r >= 2, --isets >= 1 and --jobs >= 1")
-    model = load_model(model_file)
-    examples = _examples(data_dir, r, isets, seed, jobs, model.features, draw)
+    model, _ = load_support_model(model_file)
+    examples = _examples(data_dir, r, isets, seed, jobs, model.features, draw, pose_noise=pose_noise)
     report = classification_report(examples.labels, model.support_probability(examples.features))
     if reliability:
         save_reliability_diagram(report, reliability, title=f"{model_file} on {data_dir}")

@@ -297,6 +297,7 @@ def suite_figure(cases: Sequence[tuple[CanonicalCase, SuiteResult]], output: str
     os.close(handle)
     try:
         figure.savefig(temporary, dpi=110)
+        os.chmod(temporary, 0o644)
         os.replace(temporary, output)
     finally:
         if os.path.exists(temporary):

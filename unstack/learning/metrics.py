@@ -24,6 +24,7 @@ __all__ = [
     "balanced_error_rate",
     "classification_report",
     "confusion_counts",
+    "expected_calibration_error",
     "reliability_curve",
     "save_reliability_diagram",
 ]
@@ -85,12 +86,33 @@ def reliability_curve(truth: np.ndarray, probability: np.ndarray, bins: int = 10
     return {"bin_edges": edges.tolist(), "mean_predicted": mean_predicted, "observed": observed, "counts": counts}
 
 
+def expected_calibration_error(truth: Any, probability: Any, bins: int = 10) -> float:
+    """Expected calibration error: the bin-size weighted mean of |observed - predicted| over
+    ``bins`` equal-width probability bins (0 for a perfectly calibrated classifier).
+
+    Examples
+    --------
+    >>> expected_calibration_error([0, 1, 0, 1], [0.05, 0.95, 0.05, 0.95])
+    0.05
+    """
+    actual = np.asarray(truth, dtype=np.float64)
+    p = np.asarray(probability, dtype=np.float64)
+    if actual.size == 0:
+        return float("nan")
+    curve = reliability_curve(actual, p, bins)
+    total = 0.0
+    for count, predicted, observed in zip(curve["counts"], curve["mean_predicted"], curve["observed"], strict=True):
+        if count:
+            total += count * abs(observed - predicted)
+    return round(total / actual.size, 12)
+
+
 def classification_report(truth: Any, probability: Any) -> dict[str, Any]:
     """Every metric of a set of relations, JSON-ready.
 
     Keys: ``relations``, ``supp``, ``not_supp``, ``confusion_matrix`` (Fig. 5 layout),
     ``supp_recall``, ``not_supp_recall``, ``success_rate``, ``balanced_error_rate``,
-    ``average_entropy``, ``brier_score``, ``reliability``.
+    ``average_entropy``, ``brier_score``, ``expected_calibration_error``, ``reliability``.
     """
     from sklearn.metrics import brier_score_loss
 
@@ -109,6 +131,7 @@ def classification_report(truth: Any, probability: Any) -> dict[str, Any]:
         "balanced_error_rate": balanced_error_rate(actual, p),
         "average_entropy": average_entropy(p),
         "brier_score": float(brier_score_loss(actual, p, pos_label=True)) if actual.size else float("nan"),
+        "expected_calibration_error": expected_calibration_error(actual, p),
         "reliability": reliability_curve(actual, p),
     }
 
