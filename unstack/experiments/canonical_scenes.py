@@ -114,9 +114,7 @@ class _Builder:
 
     def carried(self, name: str) -> float:
         """The load on ``name`` when each box weighs equally on the boxes it rests on."""
-        return sum(
-            (1.0 + self.carried(other)) / len(under) for other, under in self.rests_on.items() if name in under
-        )
+        return sum((1.0 + self.carried(other)) / len(under) for other, under in self.rests_on.items() if name in under)
 
     def case(self, kind: str, *, detected: list[str] | None = None, in_container: bool = True) -> CanonicalCase:
         names = list(self.boxes)
