@@ -118,7 +118,7 @@ def enumerate_worlds(supports: Supports, *, solver: str = SAT_SOLVER, max_boxes:
         raise TooLarge(
             f"{n} boxes: listing consistent worlds is limited to {max_boxes} boxes "
             f"(n = {max_boxes + 1} has {PREORDER_COUNTS[max_boxes + 1]:,} worlds); "
-            "use the exact marginals engine (--method exact), which does not list worlds"
+            "use the exact marginals engine (method 'exact'), which does not list worlds"
         )
     evidence = propagate_evidence(objects, supports.probabilities)
     variables = SupportVariables(objects)
