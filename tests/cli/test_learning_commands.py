@@ -121,5 +121,7 @@ def test_an_empty_point_cloud_is_a_one_line_warning(tmp_path: Path) -> None:
     scene.write_text(json.dumps(document))
     result = unstack("probabilities", str(scene))
     assert result.returncode == 0, result.stderr
-    assert result.stderr == f"unstack: warning: {scene}: the point cloud is empty; the DBAF features are 0\n"
+    assert result.stderr == (
+        f"unstack: warning: {scene}: the point cloud is empty; undetected load and cloud features cannot be seen\n"
+    )
     assert json.loads(result.stdout)["format"] == "unstack.supports/1"

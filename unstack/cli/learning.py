@@ -254,6 +254,8 @@ def probabilities(scene_file: str, model_path: str | None, output: str | None) -
     from unstack.scene import load_scene
 
     supports = scene_supports(load_scene(scene_file), model_path)
+    for line in supports.metadata.get("warnings", []):
+        click.echo(f"unstack: warning: {line}", err=True)
     text = json.dumps(supports.to_dict(), indent=2) + "\n"
     if output:
         atomic_write_text(output, text)

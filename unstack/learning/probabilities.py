@@ -16,7 +16,6 @@ Examples
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Sequence
 
 import numpy as np
@@ -77,8 +76,6 @@ def scene_support_probabilities(
         the scene's plausibility warnings (:func:`unstack.plausibility.scene_warnings`)
         and features outside the model's training range (out of distribution).
     """
-    if len(scene.points) == 0:
-        warnings.warn(f"{scene.source}: the point cloud is empty; the DBAF features are 0", stacklevel=2)
     index = {box_id: k for k, box_id in enumerate(scene.box_ids)}
     objects = list(scene.detected if boxes is None else boxes)
     detected = [index[box_id] for box_id in objects]
