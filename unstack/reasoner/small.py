@@ -15,8 +15,8 @@ Examples
 >>> preorders(3).shape
 (29, 3, 3)
 >>> half = np.full((3, 3), 0.5); np.fill_diagonal(half, 0)
->>> result = small_marginals(half)
->>> result.consistent_worlds, round(float(result.marginals[0, 1]), 6)
+>>> marginals, worlds, _ = small_marginals(half)
+>>> worlds, round(float(marginals[0, 1]), 6)
 (29, 0.413793)
 """
 
