@@ -185,7 +185,8 @@ def check_quaternion_xyzw(
     array([0., 0., 0., 1.])
     """
     quaternion = check_vector(value, 4, source=source, path=path, error=error)
-    norm = float(np.linalg.norm(quaternion))
+    with np.errstate(over="ignore", invalid="ignore"):  # a huge component is reported below, not warned
+        norm = float(np.linalg.norm(quaternion))
     if abs(norm - 1.0) > tolerance:
         raise error(
             source, path, f"expected a unit quaternion [x, y, z, w] (norm within {tolerance} of 1), got norm {norm:.6g}"

@@ -163,7 +163,12 @@ def load_points(
         raise InvalidScene(source, json_path, f"point cloud file {str(file)!r} does not exist")
     try:
         if file.suffix.lower() == ".npy":
-            array = np.load(file, allow_pickle=False)
+            try:
+                array = np.load(file, allow_pickle=False)
+            except ValueError:  # numpy's words suggest allowing pickle: never, for a user's file
+                raise InvalidScene(
+                    source, json_path, f"expected a .npy array of N x 3 numbers, {file.name!r} is not one"
+                ) from None
         elif file.suffix.lower() == ".ply":
             from plyfile import PlyData
 

@@ -8,7 +8,6 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 from tests.cli.test_commands import PILE5, unstack
 
@@ -51,7 +50,6 @@ def test_a_box_far_away(tmp_path: Path, examples: Path) -> None:
     one_line_error(unstack("decide", str(far)), f"{far}: $.boxes[0].position[0]")
 
 
-@pytest.mark.xfail(strict=True, reason="needs unstack/scene.py load_points to word numpy's pickle error (reported)")
 def test_a_text_file_named_npy(tmp_path: Path, examples: Path) -> None:
     document = json.loads((examples / "scene3.json").read_text())
     (tmp_path / "scene3.points.npy").write_text("x y z\n0 0 0\n")

@@ -86,13 +86,22 @@ def test_a_file_with_untrusted_types_is_refused_without_running_it(tmp_path: Pat
     assert not calls.exists()
 
 
-def test_the_shipped_default_model_loads() -> None:
+def test_the_shipped_default_model_is_the_general_one_with_its_feature_ranges() -> None:
     from unstack.learning.model_file import default_model_path
 
     model = load_model(default_model_path())
-    assert model.metadata["learner"] == "svm" and model.features == FeatureSettings()
+    assert model.metadata["learner"] == "gradient_boosting" and model.features.feature_set == "general"
+    assert model.metadata["training"]["split_by"] == "configuration" and model.metadata["training"]["pose_noise"] > 0
+    assert len(model.metadata["feature_ranges"]) == 15
     validation = model.metadata["validation"]
     assert validation["relations"] > 500 and 0 <= validation["balanced_error_rate"] <= 0.5
+
+
+def test_the_shipped_paper_model_is_the_papers_svm() -> None:
+    from unstack.learning.model_file import bundled_model_path
+
+    model = load_model(bundled_model_path("paper"))
+    assert model.metadata["learner"] == "svm" and model.features == FeatureSettings()
 
 
 def test_the_shipped_extended_model_loads_and_was_split_by_pile() -> None:

@@ -45,7 +45,7 @@ def cost_weights(supports: Supports, cost: str) -> np.ndarray:
         if supports.masses is None:
             raise UnstackError(
                 f"{supports.source}: $.masses: the mass-weighted cost needs box masses; "
-                'add "masses" (kg, aligned with objects) or use --cost count'
+                'add "masses" (kg, aligned with objects) or use the count cost'
             )
         return np.asarray(supports.masses, dtype=np.float64)
     raise UnstackError(f"unknown cost {cost!r}; expected one of {', '.join(COSTS)}")
