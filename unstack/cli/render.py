@@ -33,9 +33,13 @@ MATRIX_MAX_BOXES = 12
 
 def decision_view(decision: Decision) -> Group:
     """The choice, the expected cost of every box and the conditional support matrix."""
-    unit = "kg" if decision.cost == "mass" else "boxes"
+    titles = {
+        "mass": "EC: expected kg supported (Eq. 13)",
+        "count": "EC: detected boxes supported (Eq. 11)",
+        "load": "EC: boxes supported, hidden load too",
+    }
     order = sorted(range(len(decision.objects)), key=lambda i: (decision.expected_costs[i], decision.objects[i]))
-    costs = Table(title=f"EC: expected {unit} supported (Eq. 13)", title_justify="left")
+    costs = Table(title=titles.get(decision.cost, "EC (Eq. 13)"), title_justify="left")
     costs.add_column("rank", justify="right")
     costs.add_column("box")
     costs.add_column("EC", justify="right")
