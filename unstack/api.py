@@ -246,8 +246,9 @@ def decide(
         For a scene only (an error with support probabilities); ``None``: the default model.
     method : {"auto", "exact", "sat", "approx"}
         See :func:`unstack.reasoner.decision.decide`.
-    cost : {"count", "mass"}
-        Eq. 11 (number of supported boxes) or their total mass.
+    cost : {"load", "count", "mass"}
+        ``load`` (the default): Eq. 11 with every box counted together with the undetected
+        load the cloud shows on it; ``count``: Eq. 11 exactly; ``mass``: their total mass.
     seed : int, optional
         Seed of the sampler: with it (and no ``time_limit``) the numbers are identical on
         every run, whatever the machine's load.

@@ -25,6 +25,7 @@ if TYPE_CHECKING:
     from unstack.scene import Box
 
 __all__ = [
+    "BOX_FACES",
     "bounding_boxes",
     "box_corners",
     "convex_hull_2d",
@@ -37,6 +38,9 @@ __all__ = [
     "tilt_deg",
 ]
 
+#: The six faces of a cuboid as cycles of indices into :func:`box_corners` (each face fixes
+#: one bit of the corner index).
+BOX_FACES = ((0, 1, 3, 2), (4, 5, 7, 6), (0, 1, 5, 4), (2, 3, 7, 6), (0, 2, 6, 4), (1, 3, 7, 5))
 #: Corner signs of a cuboid, in a fixed order (x fastest).
 _CORNER_SIGNS = np.array([[sx, sy, sz] for sz in (-1, 1) for sy in (-1, 1) for sx in (-1, 1)], dtype=np.float64)
 

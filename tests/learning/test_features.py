@@ -9,6 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from unstack.geometry import box_corners
 from unstack.learning.features import (
     FEATURE_NAMES,
     FeatureSettings,
@@ -18,7 +19,6 @@ from unstack.learning.features import (
     pair_features,
 )
 from unstack.scene import Box
-from unstack.sim.render import box_corners
 
 
 def naive_dbaf(points: np.ndarray, queries: np.ndarray, sigma: float) -> np.ndarray:

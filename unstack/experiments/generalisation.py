@@ -249,12 +249,11 @@ def summary_rows(results: Sequence[SuiteResult]) -> list[dict[str, Any]]:
 def _draw_box(axes: Any, box: Any, colour: str, alpha: float, hatch: bool) -> None:
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-    from unstack.geometry import box_corners
+    from unstack.geometry import BOX_FACES, box_corners
 
     corners = box_corners(box)
-    faces = [[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]]
     collection = Poly3DCollection(
-        [corners[face] for face in faces], facecolor=colour, edgecolor="black", alpha=alpha, linewidths=0.6,
+        [corners[list(face)] for face in BOX_FACES], facecolor=colour, edgecolor="black", alpha=alpha, linewidths=0.6,
         linestyles="--" if hatch else "-",
     )  # fmt: skip
     axes.add_collection3d(collection)

@@ -26,28 +26,11 @@ from typing import Any
 import numpy as np
 
 from unstack.errors import UnstackError
-from unstack.scene import Box, Scene
+from unstack.geometry import BOX_FACES, box_corners
+from unstack.scene import Scene
 from unstack.sim.settings import SensorSettings, SimulationSettings
 
-__all__ = ["box_corners", "render_scene"]
-
-#: The 6 faces of a cuboid as indices into :func:`box_corners`.
-FACES = ((0, 1, 3, 2), (4, 5, 7, 6), (0, 1, 5, 4), (2, 3, 7, 6), (0, 2, 6, 4), (1, 3, 7, 5))
-
-
-def box_corners(box: Box) -> np.ndarray:
-    """The 8 corners (8, 3) of a box in the world frame; corner k has bits (x, y, z) of k.
-
-    Examples
-    --------
-    >>> box_corners(Box("a", [2, 2, 2], [0, 0, 0]))[7].tolist()
-    [1.0, 1.0, 1.0]
-    """
-    from scipy.spatial.transform import Rotation
-
-    signs = np.array([[(k >> 2) & 1, (k >> 1) & 1, k & 1] for k in range(8)], dtype=np.float64) * 2.0 - 1.0
-    local = signs * box.size / 2.0
-    return np.asarray(Rotation.from_quat(box.orientation_xyzw).apply(local) + box.position)
+__all__ = ["render_scene"]
 
 
 def _support_counts(scene: Scene) -> np.ndarray | None:
@@ -160,7 +143,7 @@ def render_scene(
     oblique = figure.add_subplot(1, 2, 1, projection="3d")
     for index, box in enumerate(scene.boxes):
         corners = box_corners(box)
-        faces = [[corners[k] for k in face] for face in FACES]
+        faces = [[corners[k] for k in face] for face in BOX_FACES]
         is_detected = box.id in detected
         oblique.add_collection3d(
             Poly3DCollection(
