@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from unstack.jsonio import _umask, atomic_write_text
+from unstack.atomic import atomic_write_text, process_umask
 
 
 def test_the_umask_is_read_without_being_set(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -20,7 +20,7 @@ def test_the_umask_is_read_without_being_set(tmp_path: Path, monkeypatch: pytest
         raise AssertionError("os.umask was called")
 
     monkeypatch.setattr(os, "umask", refuse)
-    assert _umask() == current
+    assert process_umask() == current
     target = tmp_path / "out.json"
     atomic_write_text(target, "{}")
     assert target.stat().st_mode & 0o777 == 0o666 & ~current
@@ -39,18 +39,18 @@ def test_the_umask_fallback_reads_a_new_files_mode(monkeypatch: pytest.MonkeyPat
         return real_open(file, *args, **kwargs)  # type: ignore[call-overload]
 
     monkeypatch.setattr(builtins, "open", no_proc)
-    assert _umask() == current
+    assert process_umask() == current
 
 
 def test_plots_keep_the_hosts_backend_and_skip_pyplot(tmp_path: Path) -> None:
     code = f"""
 import sys, matplotlib
 matplotlib.use("svg")
-from unstack.figures import pyplot, save_png
+from unstack.figures import pyplot, save_figure
 plt = pyplot()
 figure, axes = plt.subplots(1, 2, figsize=(3, 2))
 axes[0].plot([0, 1], [1, 0])
-save_png(figure, {str(tmp_path / "plot.png")!r})
+save_figure(figure, {str(tmp_path / "plot.png")!r})
 print(matplotlib.get_backend(), "matplotlib.pyplot" in sys.modules)
 """
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)

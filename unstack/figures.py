@@ -10,7 +10,7 @@ Examples
 >>> plt = pyplot()
 >>> figure, axes = plt.subplots()
 >>> target = pathlib.Path(tempfile.mkdtemp()) / "empty.png"
->>> save_png(figure, target)
+>>> save_figure(figure, target)
 >>> target.read_bytes()[:4]
 b'\\x89PNG'
 """
@@ -18,10 +18,9 @@ b'\\x89PNG'
 from __future__ import annotations
 
 import os
-from pathlib import Path
 from typing import Any
 
-__all__ = ["Plotting", "figure", "pyplot", "save_png", "subplots"]
+__all__ = ["Plotting", "figure", "pyplot", "save_figure", "subplots"]
 
 
 def figure(**options: Any) -> Any:
@@ -113,8 +112,8 @@ def pyplot() -> Plotting:
     return Plotting()
 
 
-def save_png(drawn: Any, output: str | os.PathLike[str], *, dpi: int = 110) -> None:
-    """Write ``drawn`` (a figure) to a temporary file beside ``output``, then rename it.
+def save_figure(drawn: Any, output: str | os.PathLike[str], *, dpi: int = 110) -> None:
+    """Write ``drawn`` (a figure) atomically; the format follows the suffix (PNG, SVG, PDF).
 
     Parameters
     ----------
@@ -126,10 +125,6 @@ def save_png(drawn: Any, output: str | os.PathLike[str], *, dpi: int = 110) -> N
     -------
     None
     """
-    target = Path(output)
-    temporary = target.with_name(f".{target.name}.tmp.png")
-    try:
-        drawn.savefig(temporary, dpi=dpi)
-        os.replace(temporary, target)
-    finally:
-        temporary.unlink(missing_ok=True)
+    from unstack.atomic import atomic_save_figure
+
+    atomic_save_figure(drawn, output, dpi=dpi)

@@ -18,7 +18,6 @@ import json
 import math
 import os
 import sys
-import tempfile
 from collections.abc import Iterable, Iterator
 from functools import cache
 from importlib import resources
@@ -31,8 +30,6 @@ __all__ = [
     "FORMATS",
     "MAX_DEPTH",
     "Document",
-    "atomic_write_text",
-    "check_output_path",
     "format_json_path",
     "load_schema",
     "read_document",
@@ -293,86 +290,3 @@ def validate_document(
                 first = deepest
         raise error_class(document.source, format_json_path(first.absolute_path), _describe(first))
     return str(tag)
-
-
-def _umask() -> int:
-    """The process's umask, read without changing it (``/proc/self/status``; elsewhere the
-    mode of a freshly created file)."""
-    try:
-        with open("/proc/self/status", encoding="ascii") as status:
-            for line in status:
-                if line.startswith("Umask:"):
-                    return int(line.split()[1], 8)
-    except (OSError, ValueError):
-        pass
-    with tempfile.TemporaryDirectory() as folder:
-        probe = Path(folder) / "probe"
-        descriptor = os.open(probe, os.O_CREAT | os.O_WRONLY, 0o777)
-        os.close(descriptor)
-        return 0o777 & ~probe.stat().st_mode
-
-
-def check_output_path(path: str | os.PathLike[str]) -> Path:
-    """Check, before any work, that a file can be written at ``path``.
-
-    Parameters
-    ----------
-    path : str or path-like
-        Where an output will go.
-
-    Returns
-    -------
-    pathlib.Path
-
-    Raises
-    ------
-    InvalidArgument
-        The folder does not exist or is not a folder, or ``path`` is a folder.
-
-    Examples
-    --------
-    >>> check_output_path("/no/such/out.json")
-    Traceback (most recent call last):
-    ...
-    unstack.errors.InvalidArgument: /no/such/out.json: cannot write there: the folder /no/such does not exist
-    """
-    from unstack.errors import InvalidArgument
-
-    target = Path(path)
-    folder = target.parent
-    if target.is_dir():
-        raise InvalidArgument(f"{path}: cannot write there: it is a folder")
-    if not folder.exists():
-        raise InvalidArgument(f"{path}: cannot write there: the folder {folder} does not exist")
-    if not folder.is_dir():
-        raise InvalidArgument(f"{path}: cannot write there: {folder} is not a folder")
-    if not os.access(folder, os.W_OK):
-        raise InvalidArgument(f"{path}: cannot write there: the folder {folder} is not writable")
-    return target
-
-
-def atomic_write_text(path: str | os.PathLike[str], text: str) -> None:
-    """Write ``text`` to ``path`` atomically: a temporary file in the same folder, then a rename.
-
-    A reader never sees a half-written file, and a failure leaves no file behind.
-
-    Examples
-    --------
-    >>> import tempfile, pathlib
-    >>> target = pathlib.Path(tempfile.mkdtemp()) / "out.json"
-    >>> atomic_write_text(target, "{}")
-    >>> target.read_text()
-    '{}'
-    """
-    target = check_output_path(path)
-    handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    try:
-        with os.fdopen(handle, "w", encoding="utf-8") as stream:
-            stream.write(text)
-            stream.flush()
-            os.fsync(stream.fileno())
-        os.chmod(temporary, 0o666 & ~_umask())
-        os.replace(temporary, target)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise

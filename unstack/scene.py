@@ -24,9 +24,10 @@ from typing import Any
 
 import numpy as np
 
+from unstack.atomic import atomic_save_array, atomic_write_text
 from unstack.checks import check_ids, check_points, check_quaternion_xyzw, check_vector
 from unstack.errors import InvalidScene
-from unstack.jsonio import Document, atomic_write_text, read_document, validate_document
+from unstack.jsonio import Document, read_document, validate_document
 
 __all__ = ["SCENE_FORMAT", "Box", "Scene", "load_points", "load_scene"]
 
@@ -312,9 +313,7 @@ class Scene:
         target = Path(path)
         if points_file is not None:
             cloud_path = target.parent / points_file
-            temporary = cloud_path.with_name(f".{cloud_path.name}.tmp.npy")
-            np.save(temporary, self.points)
-            os.replace(temporary, cloud_path)
+            atomic_save_array(cloud_path, self.points)
         atomic_write_text(target, json.dumps(self.to_dict(points_file), indent=2) + "\n")
 
     @classmethod

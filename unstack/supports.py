@@ -21,9 +21,10 @@ from typing import Any
 
 import numpy as np
 
+from unstack.atomic import atomic_write_text
 from unstack.checks import check_ids, check_probability_matrix, check_vector
 from unstack.errors import InvalidSupports
-from unstack.jsonio import Document, atomic_write_text, read_document, validate_document
+from unstack.jsonio import Document, read_document, validate_document
 
 __all__ = ["SUPPORTS_FORMAT", "Supports", "load_supports"]
 

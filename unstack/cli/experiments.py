@@ -48,7 +48,7 @@ def _paired(difference: dict[str, float | None] | None) -> str:
 
 
 def _write_json(path: Path, data: object) -> None:
-    from unstack.jsonio import atomic_write_text
+    from unstack.atomic import atomic_write_text
 
     atomic_write_text(path, json.dumps(data, indent=2) + "\n")
 

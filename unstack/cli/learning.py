@@ -250,7 +250,7 @@ def evaluate(
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None, help="Write the JSON here (atomically).")
 def probabilities(scene_file: str, model_path: str | None, output: str | None) -> None:
     """Support probabilities of a scene's detected boxes, as unstack.supports/1 JSON."""
-    from unstack.jsonio import atomic_write_text
+    from unstack.atomic import atomic_write_text
     from unstack.scene import load_scene
 
     supports = scene_supports(load_scene(scene_file), model_path)

@@ -85,7 +85,7 @@ class _Group(click.Group):
 def _check_output(path: str | None) -> None:
     """Fail before any work when ``--output`` cannot be written (naming the user's path)."""
     if path is not None:
-        from unstack.jsonio import check_output_path
+        from unstack.atomic import check_output_path
 
         check_output_path(path)
 
@@ -93,7 +93,7 @@ def _check_output(path: str | None) -> None:
 def _write_output(path: str | None, document: dict[str, Any]) -> None:
     if path is None:
         return
-    from unstack.jsonio import atomic_write_text
+    from unstack.atomic import atomic_write_text
 
     atomic_write_text(path, json.dumps(document, indent=2) + "\n")
 

@@ -286,6 +286,6 @@ def plot_fig4(result: dict[str, Any], output: str | os.PathLike[str]) -> None:
         axes[1, column].set_ylabel("% of ISets")
     figure.suptitle(f"{result['isets']} test ISets of {result['r']} boxes from {Path(result['data']).name}")
     figure.tight_layout()
-    from unstack.figures import save_png
+    from unstack.figures import save_figure
 
-    save_png(figure, output)
+    save_figure(figure, output)

@@ -80,7 +80,7 @@ def validation_roc(truth: np.ndarray, probability: np.ndarray, *, points: int = 
 
 def plot_fig5a(result: dict[str, Any], output: str | os.PathLike[str]) -> None:
     """The validation ROC curve (SUPP recall against not-SUPP recall) with the paper's Fig. 5a point."""
-    from unstack.figures import pyplot, save_png
+    from unstack.figures import pyplot, save_figure
 
     plt = pyplot()
     roc = result["validation_roc"]
@@ -104,7 +104,7 @@ def plot_fig5a(result: dict[str, Any], output: str | os.PathLike[str]) -> None:
     title = f"{validation['relations']} validation relations ({validation['supp']} SUPP), "
     axes.set_title(title + f"features {result['features']['feature_set']}, split by {result['split_by']}", fontsize=9)
     figure.tight_layout()
-    save_png(figure, output)
+    save_figure(figure, output)
 
 
 def fig5a(

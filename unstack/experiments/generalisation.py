@@ -263,11 +263,11 @@ def suite_figure(cases: Sequence[tuple[CanonicalCase, SuiteResult]], output: str
     """One small 3-D view per case: the chosen box red, the other pickable boxes green, boxes
     that hold up others grey, undetected boxes dashed and pale. Written atomically (PNG or SVG)."""
     import math
-    import os
-    import tempfile
 
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
+
+    from unstack.figures import save_figure
 
     columns = 4
     rows = math.ceil(len(cases) / columns)
@@ -291,13 +291,4 @@ def suite_figure(cases: Sequence[tuple[CanonicalCase, SuiteResult]], output: str
         verdict = "right" if result.right else "WRONG" if result.choice not in result.pickable else "bound missed"
         cost = result.expected_costs[result.choice]
         axes.set_title(f"{case.kind.replace('_', ' ')}\npick {result.choice} (EC {cost:.2f}): {verdict}", fontsize=9)
-    folder = os.path.dirname(os.path.abspath(output))
-    handle, temporary = tempfile.mkstemp(dir=folder, prefix=".suite-", suffix=os.path.splitext(output)[1])
-    os.close(handle)
-    try:
-        figure.savefig(temporary, dpi=110)
-        os.chmod(temporary, 0o644)
-        os.replace(temporary, output)
-    finally:
-        if os.path.exists(temporary):
-            os.unlink(temporary)
+    save_figure(figure, output)

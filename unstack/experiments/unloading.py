@@ -207,7 +207,7 @@ def unloading_experiment(
 
     from joblib import Parallel, delayed
 
-    from unstack.jsonio import atomic_write_text
+    from unstack.atomic import atomic_write_text
     from unstack.sim.dataset import require_configurations
 
     if samples is None and time_limit is None:
@@ -274,7 +274,7 @@ def unloading_experiment(
 
 def plot_unloading(result: dict[str, Any], output: str | os.PathLike[str]) -> None:
     """Boxes moved so far against the share of the detected boxes unloaded, per decision maker."""
-    from unstack.figures import pyplot, save_png
+    from unstack.figures import pyplot, save_figure
 
     plt = pyplot()
     figure, axis = plt.subplots(figsize=(7, 4.5))
@@ -291,4 +291,4 @@ def plot_unloading(result: dict[str, Any], output: str | os.PathLike[str]) -> No
     axis.set_title(f"Unloading {result['configs']} piles of {Path(result['data']).name} in the simulator")
     axis.legend()
     figure.tight_layout()
-    save_png(figure, output)
+    save_figure(figure, output)

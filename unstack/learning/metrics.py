@@ -156,6 +156,6 @@ def save_reliability_diagram(report: dict[str, Any], output: str | os.PathLike[s
     bottom.set_xlabel("predicted P(SUPP)")
     bottom.set_ylabel("relations")
     figure.tight_layout()
-    from unstack.figures import save_png
+    from unstack.figures import save_figure
 
-    save_png(figure, output)
+    save_figure(figure, output)

@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from unstack.atomic import atomic_write_bytes
 from unstack.errors import InvalidFile
 from unstack.learning.classifier import SupportClassifier
 from unstack.learning.features import FeatureSettings
@@ -188,13 +189,7 @@ def save_model(model: SupportModel, path: str | os.PathLike[str]) -> None:
 
     metadata = {"features": model.features.to_dict(), **model.metadata}
     payload = {"format": MODEL_FORMAT, "metadata": json.dumps(metadata, allow_nan=True), "estimator": model.estimator}
-    target = Path(path)
-    temporary = target.with_name(f".{target.name}.tmp")
-    try:
-        temporary.write_bytes(skops.io.dumps(payload))
-        os.replace(temporary, target)
-    finally:
-        temporary.unlink(missing_ok=True)
+    atomic_write_bytes(path, skops.io.dumps(payload))
 
 
 def load_model(path: str | os.PathLike[str]) -> SupportModel:

@@ -41,8 +41,8 @@ from typing import Any
 
 import numpy as np
 
+from unstack.atomic import atomic_save_array, atomic_write_text
 from unstack.errors import UnstackError
-from unstack.jsonio import atomic_write_text
 from unstack.sim.configuration import SimulatedConfiguration, config_name, simulate_configuration
 from unstack.sim.settings import SimulationSettings, json_ready
 
@@ -157,16 +157,9 @@ def _write_manifest(folder: Path, settings: SimulationSettings, seed: int, confi
     atomic_write_text(folder / MANIFEST, json.dumps(manifest, indent=2) + "\n")
 
 
-def _save_array(path: Path, array: np.ndarray) -> None:
-    temporary = path.with_name(f".{path.name}.tmp")
-    with open(temporary, "wb") as handle:
-        np.save(handle, array, allow_pickle=False)
-    os.replace(temporary, path)
-
-
 def _save_configuration(folder: Path, result: SimulatedConfiguration) -> None:
     stem = config_name(result.index)
-    _save_array(folder / f"{stem}.point_boxes.npy", result.point_boxes.astype(np.int32))
+    atomic_save_array(folder / f"{stem}.point_boxes.npy", result.point_boxes.astype(np.int32))
     result.scene.save(folder / f"{stem}.json", points_file=f"{stem}.points.npy")
     with open(folder / TIMINGS, "a", encoding="utf-8") as handle:
         handle.write(json.dumps({"index": result.index, **{k: round(v, 4) for k, v in result.timings.items()}}) + "\n")

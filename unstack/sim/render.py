@@ -212,6 +212,6 @@ def render_scene(
         bar.set_label("boxes supported (ground truth)")
     if title:
         figure.suptitle(title)
-    from unstack.figures import save_png
+    from unstack.figures import save_figure
 
-    save_png(figure, output)
+    save_figure(figure, output)

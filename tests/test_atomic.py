@@ -1,0 +1,70 @@
+"""The one atomic writer: whole files or nothing, unique temporary names, the umask honoured."""
+
+from __future__ import annotations
+
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from unstack.atomic import atomic_path, atomic_save_array, atomic_write, atomic_write_text, process_umask
+from unstack.errors import InvalidArgument
+
+
+def test_a_failed_write_leaves_neither_target_nor_temporary(tmp_path: Path) -> None:
+    target = tmp_path / "out.json"
+
+    def half_then_fail(stream: object) -> None:
+        stream.write(b'{"half":')  # type: ignore[attr-defined]
+        raise OSError("disk full")
+
+    with pytest.raises(OSError, match="disk full"):
+        atomic_write(target, half_then_fail)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_failed_write_keeps_the_old_file_whole(tmp_path: Path) -> None:
+    target = tmp_path / "out.txt"
+    target.write_text("old")
+    with pytest.raises(RuntimeError, match="boom"), atomic_path(target) as temporary:
+        temporary.write_text("new but unfinished")
+        raise RuntimeError("boom")
+    assert target.read_text() == "old"
+    assert [p.name for p in tmp_path.iterdir()] == ["out.txt"]
+
+
+def test_concurrent_writers_never_share_a_temporary_name(tmp_path: Path) -> None:
+    target = tmp_path / "shared.txt"
+    texts = [f"writer {number}\n" * 2000 for number in range(8)]
+    threads = [threading.Thread(target=atomic_write_text, args=(target, text)) for text in texts]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert target.read_text() in texts
+    assert [p.name for p in tmp_path.iterdir()] == ["shared.txt"]
+
+
+def test_the_written_mode_follows_the_umask(tmp_path: Path) -> None:
+    target = tmp_path / "points.npy"
+    atomic_save_array(target, np.arange(3.0))
+    assert target.stat().st_mode & 0o777 == 0o666 & ~process_umask()
+    np.testing.assert_array_equal(np.load(target), np.arange(3.0))
+
+
+@pytest.mark.parametrize("suffix", [".png", ".svg"])
+def test_a_figure_is_written_in_the_format_of_its_suffix(tmp_path: Path, suffix: str) -> None:
+    from matplotlib.figure import Figure
+
+    from unstack.atomic import atomic_save_figure
+
+    target = tmp_path / f"plot{suffix}"
+    atomic_save_figure(Figure(figsize=(1, 1)), target)
+    head = target.read_bytes()[:64]
+    assert head.startswith(b"\x89PNG") if suffix == ".png" else b"<?xml" in head
+
+
+def test_a_missing_folder_is_refused_before_writing(tmp_path: Path) -> None:
+    with pytest.raises(InvalidArgument, match=r"the folder .* does not exist"):
+        atomic_write_text(tmp_path / "no" / "out.json", "{}")

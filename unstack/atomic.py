@@ -1,0 +1,246 @@
+"""One atomic writer for every file the project writes.
+
+A file is written to a uniquely named temporary file in the target's folder, flushed to disk
+(``fsync``), given the mode a plain ``open`` would give it under the process's umask, and
+renamed over the target. A reader never sees a half-written file, two writers never share a
+temporary name, and a failure (an exception, a full disk) leaves neither a partial target nor
+a temporary file behind. The umask is read, never changed.
+
+Examples
+--------
+>>> import tempfile, pathlib
+>>> folder = pathlib.Path(tempfile.mkdtemp())
+>>> atomic_write_text(folder / "note.txt", "hello\\n")
+>>> (folder / "note.txt").read_text()
+'hello\\n'
+>>> atomic_write_bytes(folder / "blob.bin", b"\\x00\\x01")
+>>> (folder / "blob.bin").read_bytes()
+b'\\x00\\x01'
+>>> sorted(p.name for p in folder.iterdir())
+['blob.bin', 'note.txt']
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any, BinaryIO
+
+__all__ = [
+    "atomic_path",
+    "atomic_save_array",
+    "atomic_save_figure",
+    "atomic_write",
+    "atomic_write_bytes",
+    "atomic_write_text",
+    "check_output_path",
+    "process_umask",
+]
+
+
+def process_umask() -> int:
+    """The process's umask, read without changing it.
+
+    Read from ``/proc/self/status``; elsewhere from the mode of a freshly created file.
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> 0 <= process_umask() <= 0o777
+    True
+    """
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    with tempfile.TemporaryDirectory() as folder:
+        probe = Path(folder) / "probe"
+        descriptor = os.open(probe, os.O_CREAT | os.O_WRONLY, 0o777)
+        os.close(descriptor)
+        return 0o777 & ~probe.stat().st_mode
+
+
+def check_output_path(path: str | os.PathLike[str]) -> Path:
+    """Check, before any work, that a file can be written at ``path``.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Where an output will go.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    InvalidArgument
+        The folder does not exist or is not a folder, or ``path`` is a folder.
+
+    Examples
+    --------
+    >>> check_output_path("/no/such/out.json")
+    Traceback (most recent call last):
+    ...
+    unstack.errors.InvalidArgument: /no/such/out.json: cannot write there: the folder /no/such does not exist
+    """
+    from unstack.errors import InvalidArgument
+
+    target = Path(path)
+    folder = target.parent
+    if target.is_dir():
+        raise InvalidArgument(f"{path}: cannot write there: it is a folder")
+    if not folder.exists():
+        raise InvalidArgument(f"{path}: cannot write there: the folder {folder} does not exist")
+    if not folder.is_dir():
+        raise InvalidArgument(f"{path}: cannot write there: {folder} is not a folder")
+    if not os.access(folder, os.W_OK):
+        raise InvalidArgument(f"{path}: cannot write there: the folder {folder} is not writable")
+    return target
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
+    """Yield a unique temporary path beside ``path``; on success it replaces ``path``.
+
+    For writers that insist on a file name (``savefig``, ``np.save``): write to the yielded
+    path; when the block ends without an exception the file is synced and renamed over
+    ``path``; otherwise it is removed. The temporary name keeps the target's suffix, so a
+    writer that picks its format from the suffix picks the right one.
+
+    Parameters
+    ----------
+    path : str or path-like
+
+    Yields
+    ------
+    pathlib.Path
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "out.txt"
+    >>> with atomic_path(target) as temporary:
+    ...     _ = temporary.write_text("done")
+    >>> target.read_text()
+    'done'
+    """
+    target = check_output_path(path)
+    handle, name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=f".tmp{target.suffix}", dir=target.parent)
+    os.close(handle)
+    temporary = Path(name)
+    try:
+        yield temporary
+        with open(temporary, "rb+") as stream:
+            os.fsync(stream.fileno())
+        os.chmod(temporary, 0o666 & ~process_umask())
+        os.replace(temporary, target)
+    finally:
+        temporary.unlink(missing_ok=True)
+
+
+def atomic_write(path: str | os.PathLike[str], write: Callable[[BinaryIO], Any]) -> None:
+    """Call ``write`` on a binary stream; its bytes replace ``path`` atomically.
+
+    Parameters
+    ----------
+    path : str or path-like
+    write : callable
+        Receives the open binary stream.
+
+    Returns
+    -------
+    None
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "out.bin"
+    >>> atomic_write(target, lambda stream: stream.write(b"abc"))
+    >>> target.read_bytes()
+    b'abc'
+    """
+    with atomic_path(path) as temporary, open(temporary, "wb") as stream:
+        write(stream)
+
+
+def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
+    """Write ``data`` to ``path`` atomically (see the module).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "out.bin"
+    >>> atomic_write_bytes(target, b"xyz")
+    >>> target.read_bytes()
+    b'xyz'
+    """
+    atomic_write(path, lambda stream: stream.write(data))
+
+
+def atomic_write_text(path: str | os.PathLike[str], text: str) -> None:
+    """Write ``text`` (UTF-8) to ``path`` atomically: a reader never sees a half-written file.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "out.json"
+    >>> atomic_write_text(target, "{}")
+    >>> target.read_text()
+    '{}'
+    """
+    atomic_write_bytes(path, text.encode("utf-8"))
+
+
+def atomic_save_array(path: str | os.PathLike[str], array: Any) -> None:
+    """Write a NumPy array as ``.npy`` atomically, never with pickled objects.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib, numpy as np
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "points.npy"
+    >>> atomic_save_array(target, np.zeros((2, 3)))
+    >>> np.load(target).shape
+    (2, 3)
+    """
+    import numpy as np
+
+    atomic_write(path, lambda stream: np.save(stream, np.asarray(array), allow_pickle=False))
+
+
+def atomic_save_figure(figure: Any, path: str | os.PathLike[str], *, dpi: int = 110, **savefig: Any) -> None:
+    """Save a matplotlib figure atomically; the format follows the suffix (``.png``, ``.svg``, ``.pdf``).
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+    path : str or path-like
+    dpi : int
+    **savefig
+        Passed on to ``Figure.savefig`` (``bbox_inches``, ...).
+
+    Returns
+    -------
+    None
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from matplotlib.figure import Figure
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "plot.svg"
+    >>> atomic_save_figure(Figure(), target)
+    >>> target.read_text().lstrip().startswith("<?xml")
+    True
+    """
+    suffix = Path(path).suffix.lstrip(".").lower() or "png"
+    with atomic_path(path) as temporary:
+        figure.savefig(temporary, dpi=dpi, format=suffix, **savefig)
