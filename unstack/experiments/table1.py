@@ -18,12 +18,15 @@ from typing import Any
 
 import numpy as np
 
+from unstack.reasoner.consistency import PREORDER_COUNTS
+
 __all__ = ["OEIS_A000798", "PAPER_TABLE_I", "table1"]
 
 #: The paper's Table I: consistent worlds q' for n = 3..6.
 PAPER_TABLE_I = {3: 29, 4: 355, 5: 6942, 6: 209527}
-#: OEIS A000798, the number of preorders (quasi-orders) on n labelled elements.
-OEIS_A000798 = {0: 1, 1: 1, 2: 4, 3: 29, 4: 355, 5: 6942, 6: 209527, 7: 9535241, 8: 642779354}
+#: OEIS A000798, the number of preorders (quasi-orders) on n labelled elements: a view of
+#: :data:`unstack.reasoner.consistency.PREORDER_COUNTS`, the one table of these counts.
+OEIS_A000798 = dict(enumerate(PREORDER_COUNTS))
 
 
 def table1(sizes: Sequence[int] = (3, 4, 5, 6, 7), *, sat_max: int = 5) -> list[dict[str, Any]]:
