@@ -1,5 +1,5 @@
 """``unstack`` commands: ``decide``, ``plan``, ``worlds``, ``validate``, ``warm-up``, and (loaded
-on first use) ``simulate``, ``render``, ``train``, ``evaluate``, ``probabilities``, ``experiment``.
+on first use) ``simulate``, ``render``, ``view``, ``train``, ``evaluate``, ``probabilities``, ``experiment``.
 
 Each command is a thin layer over the library: read the input, call one public function
 (``unstack.decide``, ``unstack.plan``, ``unstack.validate``, ...), render the result.
@@ -29,7 +29,8 @@ MODEL_HELP = "Model file, or a shipped model: paper (the default: the paper's SV
 #: Commands whose modules load only when they run (their imports are heavy).
 LAZY_COMMANDS = {
     "simulate": "unstack.cli.simulation:simulate",
-    "render": "unstack.cli.simulation:render",
+    "render": "unstack.cli.pictures:render",
+    "view": "unstack.cli.pictures:view",
     "train": "unstack.cli.learning:train",
     "evaluate": "unstack.cli.learning:evaluate",
     "probabilities": "unstack.cli.learning:probabilities",

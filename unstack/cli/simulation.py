@@ -1,4 +1,4 @@
-"""``unstack simulate`` and ``unstack render``: simulated data sets and pictures of piles."""
+"""``unstack simulate``: simulated data sets of piles (``unstack render`` is in :mod:`unstack.cli.pictures`)."""
 
 from __future__ import annotations
 
@@ -6,11 +6,10 @@ import re
 
 import click
 
-from unstack.cli.learning import MODEL_HELP
 from unstack.errors import UnstackError
 from unstack.sim.settings import FAMILIES, SIZE_SETS
 
-__all__ = ["parse_box_range", "render", "simulate"]
+__all__ = ["parse_box_range", "simulate"]
 
 BOX_RANGE = re.compile(r"^\s*(-?\d+)\s*(?:-\s*(-?\d+))?\s*$")
 
@@ -119,31 +118,3 @@ def simulate(
         f"{100 * statistics.get('transitivity_violated_share', 0.0):.1f} % of "
         f"{statistics.get('transitivity_premises', 0)} premise triples"
     )
-
-
-@click.command()
-@click.argument("scene_file", type=str)
-@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="PNG file to write.")
-@click.option("--title", default=None, help="Title of the picture (default: the file name).")
-@click.option("--probabilities", "show_probabilities", is_flag=True,
-              help="Draw the learned P(X supports Y) of the detected boxes as arrows.")  # fmt: skip
-@click.option("--model", "model_path", default=None, help=MODEL_HELP)
-def render(scene_file: str, output: str, title: str | None, show_probabilities: bool, model_path: str | None) -> None:
-    """Draw a scene: oblique view and sensor view, boxes coloured by how many they support."""
-    from pathlib import Path
-
-    from unstack.jsonio import read_document
-    from unstack.scene import Scene
-    from unstack.sim.render import render_scene
-
-    if not output.lower().endswith(".png"):
-        raise UnstackError(f"{output}: expected a .png output file")
-    document = read_document(scene_file)
-    scene = Scene.from_document(document)
-    supports = None
-    if show_probabilities:
-        from unstack.cli.learning import scene_supports
-
-        supports = scene_supports(scene, model_path)
-    render_scene(scene, output, base_dir=document.base_dir, title=title or Path(scene_file).name, supports=supports)
-    click.echo(f"{output}: {len(scene.boxes)} boxes, {len(scene.detected)} detected")

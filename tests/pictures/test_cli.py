@@ -1,0 +1,92 @@
+"""``unstack render`` and ``unstack view`` as a user runs them."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from tests.cli.test_commands import unstack
+
+PILE5 = "examples/pile5.scene.json"
+
+
+def test_render_shows_the_decision_in_png_and_svg(tmp_path: Path) -> None:
+    png, svg = tmp_path / "pile.png", tmp_path / "pile.svg"
+    result = unstack("render", PILE5, "-o", str(png), "--plan", "--probabilities", "--threshold", "0.3")
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith(f"{png}: 37 boxes, 5 detected; pick ")
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert unstack("render", PILE5, "-o", str(svg)).returncode == 0
+    assert svg.read_text().lstrip().startswith("<?xml")
+
+
+def test_render_a_stored_decision_and_a_supports_file(tmp_path: Path) -> None:
+    decision = tmp_path / "decision.json"
+    assert unstack("decide", PILE5, "--json", "-o", str(decision)).returncode == 0
+    choice = json.loads(decision.read_text())["choice"]
+    result = unstack("render", PILE5, "--decision", str(decision), "-o", str(tmp_path / "stored.png"))
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.rstrip().endswith(f"pick {choice}")
+    graph = unstack("render", "examples/pile31.supports.json", "-o", str(tmp_path / "graph.png"))
+    assert graph.returncode == 0, graph.stderr
+    assert "support graph of 31 boxes" in graph.stdout
+
+
+def test_render_colours_by_ground_truth_without_a_model(tmp_path: Path) -> None:
+    result = unstack("render", PILE5, "-o", str(tmp_path / "truth.png"), "--colour", "truth")
+    assert result.returncode == 0, result.stderr
+    assert "pick" not in result.stdout
+
+
+@pytest.fixture(scope="module")
+def other_decision(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A decision about other boxes (pile7's) than pile5's."""
+    decision = tmp_path_factory.mktemp("other") / "decision.json"
+    assert unstack("decide", "examples/pile7.supports.json", "--json", "-o", str(decision)).returncode == 0
+    return decision
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (["examples/missing.json", "-o", "{tmp}/x.png"], "missing.json: $: no such file"),
+        ([PILE5, "-o", "{tmp}/x.pdf"], "x.pdf: expected a .png or .svg output file"),
+        ([PILE5, "-o", "{tmp}/x.png", "--threshold", "1.5"], "threshold must be a probability in [0, 1], got 1.5"),
+        ([PILE5, "-o", "{tmp}/x.png", "--decision", "{decision}"], "the decision's boxes do not match"),
+        ([PILE5, "-o", "{tmp}/x.png", "--decision", "examples/pile5.supports.json"], "expected unstack.decision/1"),
+        ([PILE5, "-o", "{tmp}/no/x.png"], "cannot write there"),
+        (["examples/pile31.supports.json", "-o", "{tmp}/x.png", "--colour", "truth"], "no ground truth or geometry"),
+    ],
+)
+def test_render_bad_input_is_one_line(tmp_path: Path, other_decision: Path, arguments: list[str], message: str) -> None:
+    result = unstack("render", *[a.format(tmp=tmp_path, decision=other_decision) for a in arguments])
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert result.stderr.startswith("unstack: error: ") and message in result.stderr, result.stderr
+    assert not list(tmp_path.iterdir())
+
+
+def test_view_writes_one_self_contained_page(tmp_path: Path) -> None:
+    target = tmp_path / "pile.html"
+    result = unstack("view", PILE5, "-o", str(target), "--plan", "--max-points", "3000")
+    assert result.returncode == 0, result.stderr
+    assert " MB" in result.stdout and "pick " in result.stdout
+    page = target.read_text()
+    assert "unloading order: " in page and "3,000 of 66,488 points" in page
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (["examples/pile31.supports.json", "-o", "{tmp}/x.html"], "no geometry to show in 3D"),
+        ([PILE5, "-o", "{tmp}/x.png"], "x.png: expected a .html or .htm output file"),
+        ([PILE5, "-o", "{tmp}/x.html", "--max-points", "-1"], "--max-points"),
+        (["nothing.json", "-o", "{tmp}/x.html"], "nothing.json: $: no such file"),
+    ],
+)
+def test_view_bad_input_is_one_line(tmp_path: Path, arguments: list[str], message: str) -> None:
+    result = unstack("view", *[a.format(tmp=tmp_path) for a in arguments])
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert message in result.stderr
+    assert not list(tmp_path.iterdir())

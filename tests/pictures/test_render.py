@@ -1,0 +1,129 @@
+"""Renders of a pile that show the decision: legible at 40 boxes, the pick marked, PNG and SVG."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from tests.pictures.conftest import wall_values
+from unstack.errors import InvalidArgument
+from unstack.pictures.labels import LABEL_POINTS
+from unstack.pictures.panels import HIGHLIGHT
+from unstack.pictures.render import draw_scene, render_scene
+from unstack.pictures.values import DecisionValues
+from unstack.scene import Scene
+
+
+def _box_labels(figure: Any) -> list[Any]:
+    """The box labels of the sensor view (annotations with text), as drawn."""
+    sensor = figure.axes[1]
+    return [text for text in sensor.texts if text.get_text()]
+
+
+def _ranking(figure: Any) -> Any:
+    return next(axes for axes in figure.axes if axes.get_title().startswith("ranking"))
+
+
+def _overlaps(figure: Any, texts: list[Any]) -> list[tuple[str, str]]:
+    renderer = figure.canvas.get_renderer()
+    extents = [text.get_window_extent(renderer) for text in texts]
+    names = [getattr(text, "get_text", lambda: "legend")() for text in texts]
+    return [
+        (names[i], names[j])
+        for i in range(len(texts))
+        for j in range(i + 1, len(texts))
+        if extents[i].overlaps(extents[j])
+    ]
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_forty_labels_are_legible_and_do_not_overlap(seed: int) -> None:
+    from tests.pictures.conftest import wall_scene
+
+    scene = wall_scene(seed=seed)
+    values = wall_values(scene, seed=seed, order=True)
+    started = time.perf_counter()
+    figure = draw_scene(scene, values=values, arrows=True, threshold=0.8)
+    figure.canvas.draw()
+    seconds = time.perf_counter() - started
+    labels = _box_labels(figure)
+    assert len(labels) == 40
+    assert min(text.get_fontsize() for text in labels) >= 8
+    assert not _overlaps(figure, labels)
+    legend = figure.axes[1].get_legend()
+    assert legend is not None and not _overlaps(figure, [*labels, legend])
+    renderer = figure.canvas.get_renderer()
+    frame = figure.axes[1].get_window_extent(renderer)
+    assert all(frame.contains(*text.get_window_extent(renderer).get_points().mean(axis=0)) for text in labels)
+    ranking = _ranking(figure)
+    ticks = ranking.get_yticklabels()
+    assert len(ticks) == 40 and min(tick.get_fontsize() for tick in ticks) >= 8
+    assert not _overlaps(figure, list(ticks))
+    assert seconds < 30, seconds
+
+
+def test_the_pick_and_the_plan_are_shown(wall: Scene, wall_decision: DecisionValues) -> None:
+    figure = draw_scene(wall, values=wall_decision)
+    labels = {text.get_text(): text for text in _box_labels(figure)}
+    pick = wall_decision.choice
+    assert pick is not None and wall_decision.order[0] == pick
+    chosen = labels[f"1. {pick}  ← pick"]
+    assert chosen.get_color() == HIGHLIGHT and chosen.get_fontweight() == "bold"
+    assert f"40. {wall_decision.order[-1]}" in labels
+    ranking = _ranking(figure)
+    assert ranking.get_yticklabels()[0].get_text() == f"1. {pick}"
+    assert any(type(container).__name__ == "ErrorbarContainer" for container in ranking.containers)  # sampled
+    bar = figure.axes[2]
+    assert "expected cost" in bar.get_ylabel() and "± s.e." in bar.get_ylabel()
+
+
+def test_arrows_follow_the_threshold(wall: Scene, wall_decision: DecisionValues) -> None:
+    assert wall_decision.probabilities is not None
+
+    def arrows(threshold: float) -> int:
+        figure = draw_scene(wall, values=wall_decision, arrows=True, threshold=threshold)
+        return sum(1 for text in figure.axes[1].texts if not text.get_text())
+
+    expected = [len(wall_decision.arrows(t)) for t in (0.2, 0.8, 1.0)]
+    assert [arrows(t) for t in (0.2, 0.8, 1.0)] == expected
+    assert expected[0] > expected[1] > 0
+
+
+def test_truth_colouring_needs_no_decision(wall: Scene) -> None:
+    figure = draw_scene(wall, colour="truth")
+    assert figure.axes[-1].get_ylabel() == "boxes supported (ground truth)"
+    assert len(_box_labels(figure)) == 40
+
+
+@pytest.mark.parametrize("suffix", ["png", "svg"])
+def test_png_and_svg(tmp_path: Path, wall: Scene, wall_decision: DecisionValues, suffix: str) -> None:
+    target = tmp_path / f"pile.{suffix}"
+    render_scene(wall, target, values=wall_decision, arrows=True)
+    head = target.read_bytes()[:8]
+    assert head == b"\x89PNG\r\n\x1a\n" if suffix == "png" else head.startswith(b"<?xml")
+    assert [path.name for path in tmp_path.iterdir()] == [target.name]
+
+
+def test_bad_input_is_refused_before_writing(tmp_path: Path, wall: Scene, wall_decision: DecisionValues) -> None:
+    target = tmp_path / "pile.png"
+    with pytest.raises(InvalidArgument, match=r"threshold must be a probability in \[0, 1\], got 1.5"):
+        render_scene(wall, target, values=wall_decision, threshold=1.5)
+    stranger = DecisionValues(["nowhere", "b00"], [1.0, 2.0], source="d.json")
+    with pytest.raises(InvalidArgument, match=r"d\.json: the decision's boxes do not match .*'nowhere' is not in"):
+        render_scene(wall, target, values=stranger)
+    with pytest.raises(InvalidArgument, match="colouring by expected cost needs a decision"):
+        render_scene(wall, target)
+    with pytest.raises(InvalidArgument, match="colour must be one of cost, truth, none, got 'red'"):
+        render_scene(wall, target, values=wall_decision, colour="red")
+    with pytest.raises(InvalidArgument, match=r"the folder .* does not exist"):
+        render_scene(wall, tmp_path / "no" / "pile.png", values=wall_decision)
+    assert not list(tmp_path.iterdir())
+
+
+def test_label_size_is_the_shared_constant() -> None:
+    assert LABEL_POINTS >= 8
+    assert np.isfinite(LABEL_POINTS)

@@ -1,0 +1,206 @@
+"""``unstack render`` and ``unstack view``: pictures of a decision, drawn by :mod:`unstack.pictures`.
+
+The commands decide (through :mod:`unstack.api`) or read a stored decision, and hand the
+numbers to the pictures as :class:`~unstack.pictures.values.DecisionValues`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import click
+
+from unstack.cli.main import MODEL_HELP
+from unstack.errors import UnstackError
+
+__all__ = ["render", "view"]
+
+DECISION_HELP = "A stored unstack.decision/1 file to show instead of deciding (its boxes must be in the scene)."
+
+
+def _values(loaded: Any, decision_file: str | None, with_plan: bool, model: str | None, seed: int | None) -> Any:
+    """The decision to show: read from ``decision_file``, or decided (and planned) now."""
+    import unstack
+    from unstack.pictures.values import DecisionValues, read_decision_values
+
+    if decision_file is not None:
+        if with_plan:
+            raise UnstackError("--plan decides the unloading order itself; it does not combine with --decision")
+        values = read_decision_values(decision_file)
+        values.check_boxes(loaded.box_ids if isinstance(loaded, unstack.Scene) else loaded.objects, loaded.source)
+        return values
+    if with_plan:
+        result = unstack.plan(loaded, model=model, seed=seed)
+        decision = result.steps[0].decision
+        order: list[str] | None = result.order
+    else:
+        decision = unstack.decide(loaded, model=model, seed=seed)
+        order = None
+    return DecisionValues(
+        decision.objects,
+        decision.expected_costs,
+        decision.expected_cost_errors,
+        choice=decision.choice,
+        order=order,
+        probabilities=decision.marginals,
+        cost_name=f"expected cost ({decision.cost})",
+        source=loaded.source,
+    )
+
+
+def _camera(scene: Any) -> Any:
+    """The sensor that scanned a simulated scene, as a :class:`~unstack.pictures.camera.Camera`."""
+    from unstack.pictures.camera import Camera
+
+    settings = scene.metadata.get("settings")
+    if not isinstance(settings, dict):
+        return Camera()
+    from unstack.sim.settings import SimulationSettings
+
+    try:
+        sensor = SimulationSettings.from_dict(settings).sensor
+    except (KeyError, TypeError, ValueError, UnstackError):
+        return Camera()
+    return Camera(
+        position=(float(sensor.position[0]), float(sensor.position[1]), float(sensor.position[2])),
+        target=(float(sensor.target[0]), float(sensor.target[1]), float(sensor.target[2])),
+        vertical_fov_deg=sensor.vertical_fov_deg,
+        width=sensor.width,
+        height=sensor.height,
+    )
+
+
+def _load(file: str) -> tuple[Any, Path]:
+    """A scene or supports file and its folder (for a simulated scene's per-point labels)."""
+    from unstack.jsonio import read_document, validate_document
+    from unstack.scene import Scene
+    from unstack.supports import Supports
+
+    document = read_document(file)
+    if validate_document(document, ["unstack.supports/1", "unstack.scene/1"]) == "unstack.scene/1":
+        return Scene.from_document(document), document.base_dir
+    return Supports.from_document(document), document.base_dir
+
+
+def _check_suffix(output: str, suffixes: tuple[str, ...]) -> None:
+    from unstack.atomic import check_output_path
+
+    if Path(output).suffix.lower() not in suffixes:
+        raise UnstackError(f"{output}: expected a {' or '.join(suffixes)} output file")
+    check_output_path(output)
+
+
+@click.command()
+@click.argument("file", type=str)
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="PNG or SVG file to write.")
+@click.option("--decision", "decision_file", default=None, help=DECISION_HELP)
+@click.option("--colour", "--color", "colour", type=click.Choice(["cost", "truth", "none"]), default=None,
+              help="Colour boxes by expected cost (the default for a scene with detected boxes), by the ground "
+              "truth (boxes each supports; no model needed), or grey.")  # fmt: skip
+@click.option("--probabilities", "arrows", is_flag=True,
+              help="Draw support arrows: P(X supports Y | consistent) >= --threshold (always drawn for a supports "
+              "file).")  # fmt: skip
+@click.option("--threshold", type=float, default=0.5, show_default=True, help="Smallest probability drawn as an arrow.")
+@click.option("--plan", "with_plan", is_flag=True, help="Number the boxes in unloading order (decide, remove, repeat).")
+@click.option("--model", "model", default=None, help=MODEL_HELP)
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Seed of sampled decisions.")
+@click.option("--title", default=None, help="Title of the picture (default: the file name).")
+def render(
+    file: str,
+    output: str,
+    decision_file: str | None,
+    colour: str | None,
+    arrows: bool,
+    threshold: float,
+    with_plan: bool,
+    model: str | None,
+    seed: int,
+    title: str | None,
+) -> None:
+    """Draw the decision on a scene: oblique view, sensor view and the ranking of expected costs.
+
+    FILE is an unstack.scene/1 file (boxes coloured by expected cost, the pick outlined) or
+    an unstack.supports/1 file (drawn as a support graph: supporters below what they support).
+    """
+    import unstack
+    from unstack.pictures.camera import point_box_labels
+    from unstack.pictures.values import check_threshold
+
+    _check_suffix(output, (".png", ".svg"))
+    check_threshold(threshold)
+    loaded, base_dir = _load(file)
+    title = title or Path(file).name
+    if isinstance(loaded, unstack.Supports):
+        if colour in ("truth", "none"):
+            raise UnstackError(f"{file}: a supports file has no ground truth or geometry; it is coloured by cost")
+        values = _values(loaded, decision_file, with_plan, model, seed)
+        from unstack.pictures.graph import render_support_graph
+
+        render_support_graph(values, output, threshold=threshold, title=title)
+        click.echo(f"{output}: support graph of {len(values.objects)} boxes; pick {values.choice}")
+        return
+    scene = loaded
+    if colour is None:
+        colour = "cost" if scene.detected else ("truth" if scene.ground_truth is not None else "none")
+    needs_decision = colour == "cost" or arrows or with_plan or decision_file is not None
+    if needs_decision and not scene.detected and decision_file is None:
+        raise UnstackError(f"{file}: no detected boxes to decide on; try --colour truth")
+    values = _values(scene, decision_file, with_plan, model, seed) if needs_decision else None
+    from unstack.pictures.render import render_scene
+
+    render_scene(
+        scene,
+        output,
+        values=values,
+        colour=colour,
+        camera=_camera(scene),
+        point_labels=point_box_labels(scene, base_dir),
+        threshold=threshold,
+        arrows=arrows,
+        title=title,
+    )
+    pick = f"; pick {values.choice}" if values is not None else ""
+    click.echo(f"{output}: {len(scene.boxes)} boxes, {len(scene.detected)} detected{pick}")
+
+
+@click.command()
+@click.argument("file", type=str)
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="HTML file to write.")
+@click.option("--decision", "decision_file", default=None, help=DECISION_HELP)
+@click.option("--plan", "with_plan", is_flag=True, help="Add a slider through the unloading order.")
+@click.option("--model", "model", default=None, help=MODEL_HELP)
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Seed of sampled decisions and of the cloud subset.")  # fmt: skip
+@click.option("--max-points", type=click.IntRange(min=0), default=20_000, show_default=True,
+              help="Cloud points shown (a random subset).")  # fmt: skip
+@click.option("--title", default=None, help="Title of the page (default: the file name).")
+def view(
+    file: str,
+    output: str,
+    decision_file: str | None,
+    with_plan: bool,
+    model: str | None,
+    seed: int,
+    max_points: int,
+    title: str | None,
+) -> None:
+    """Write an interactive 3D page of a scene: one HTML file that needs no network.
+
+    Boxes are coloured by expected cost; hover a box for its id, EC and strongest support
+    relations; --plan adds a slider that takes the boxes away in unloading order.
+    """
+    import unstack
+
+    _check_suffix(output, (".html", ".htm"))
+    loaded, _ = _load(file)
+    if isinstance(loaded, unstack.Supports):
+        raise UnstackError(f"{file}: a supports file has no geometry to show in 3D; unstack render draws its graph")
+    values = None
+    if loaded.detected or decision_file is not None:
+        values = _values(loaded, decision_file, with_plan, model, seed)
+    from unstack.pictures.view import write_view
+
+    size = write_view(loaded, output, values=values, max_points=max_points, seed=seed, title=title or Path(file).name)
+    pick = f"; pick {values.choice}" if values is not None else ""
+    click.echo(f"{output}: {len(loaded.boxes)} boxes, {len(loaded.detected)} detected{pick}; {size / 1e6:.1f} MB")
