@@ -18,9 +18,13 @@ b'\\x89PNG'
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from typing import Any
 
-__all__ = ["Plotting", "figure", "pyplot", "save_figure", "subplots"]
+__all__ = ["CURVE_STYLES", "Plotting", "curve_labels", "figure", "pyplot", "save_figure", "subplots"]
+
+#: (marker, line style) per curve: curves stay told apart where they cross or coincide.
+CURVE_STYLES = (("o", "-"), ("s", "--"), ("^", "-."), ("D", ":"), ("v", "-"), ("P", "--"), ("X", "-."))
 
 
 def figure(**options: Any) -> Any:
@@ -110,6 +114,45 @@ def pyplot() -> Plotting:
     True
     """
     return Plotting()
+
+
+def curve_labels(labels: Sequence[str], curves: Sequence[Any], *, tolerance: float = 1e-9) -> list[str]:
+    """Legend labels that say when a curve coincides with an earlier one (it would be hidden under it).
+
+    Parameters
+    ----------
+    labels : sequence of str
+    curves : sequence of array-like
+        The y values of each curve, on the same x values.
+    tolerance : float
+        Largest difference (relative to the largest value) that counts as the same curve.
+
+    Returns
+    -------
+    list of str
+
+    Examples
+    --------
+    >>> curve_labels(["free", "highest", "random"], [[0, 1, 2], [0, 1, 2], [0, 3, 5]])
+    ['free', 'highest (same curve as free)', 'random']
+    """
+    import numpy as np
+
+    arrays = [np.asarray(curve, dtype=np.float64) for curve in curves]
+    scale = max((float(np.nanmax(np.abs(a))) for a in arrays if a.size and np.isfinite(a).any()), default=1.0)
+    result = []
+    for index, (label, values) in enumerate(zip(labels, arrays, strict=True)):
+        twin = next(
+            (
+                labels[earlier]
+                for earlier in range(index)
+                if arrays[earlier].shape == values.shape
+                and np.allclose(arrays[earlier], values, rtol=0.0, atol=tolerance * max(scale, 1e-300), equal_nan=True)
+            ),
+            None,
+        )
+        result.append(f"{label} (same curve as {twin})" if twin is not None else label)
+    return result
 
 
 def save_figure(drawn: Any, output: str | os.PathLike[str], *, dpi: int = 110) -> None:

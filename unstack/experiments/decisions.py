@@ -261,7 +261,7 @@ def evaluate_decisions(
 
 def plot_fig4(result: dict[str, Any], output: str | os.PathLike[str]) -> None:
     """The paper's Fig. 4: MSE(cost) per bin for unstack and the random decision maker, with histograms."""
-    from unstack.figures import pyplot
+    from unstack.figures import curve_labels, pyplot
 
     plt = pyplot()
 
@@ -275,9 +275,14 @@ def plot_fig4(result: dict[str, Any], output: str | os.PathLike[str]) -> None:
         rows = result["bins"][criterion]
         centres = [(row["low"] + row["high"]) / 2 for row in rows]
         width = rows[0]["high"] - rows[0]["low"]
-        for maker, style in (("reasoner", "o-"), ("random", "s--")):
-            values = [row[f"mse_{maker}"] if row[f"mse_{maker}"] is not None else np.nan for row in rows]
-            axes[0, column].plot(centres, values, style, label="unstack" if maker == "reasoner" else "random")
+        curves = {
+            maker: [row[f"mse_{maker}"] if row[f"mse_{maker}"] is not None else np.nan for row in rows]
+            for maker in ("reasoner", "random")
+        }
+        names = curve_labels(["unstack", "random"], list(curves.values()))
+        # random: larger hollow squares on a dashed line, so that unstack's dots show through where they meet
+        axes[0, column].plot(centres, curves["reasoner"], "o-", markersize=5, label=names[0])
+        axes[0, column].plot(centres, curves["random"], "s--", markersize=8, mfc="none", label=names[1])
         axes[0, column].set_ylabel("MSE(cost) (Eq. 14)")
         axes[0, column].legend()
         total = max(result["isets"], 1)

@@ -92,8 +92,10 @@ def plot_fig5a(result: dict[str, Any], output: str | os.PathLike[str]) -> None:
     balanced = result["validation_at_balanced_threshold"]
     axes.plot([balanced["not_supp_recall"]], [balanced["supp_recall"]], "ko", label="threshold balanced on training")
     operating = result["validation_at_paper_recall_threshold"]
-    axes.plot([operating["not_supp_recall"]], [operating["supp_recall"]], "ks", mfc="none",
-              label="threshold for the paper's SUPP recall on training")  # fmt: skip
+    same = all(operating[key] == balanced[key] for key in ("not_supp_recall", "supp_recall"))
+    axes.plot([operating["not_supp_recall"]], [operating["supp_recall"]], "ks", mfc="none", markersize=10,
+              label="threshold for the paper's SUPP recall on training"
+              + (" (same point as the balanced one)" if same else ""))  # fmt: skip
     axes.set_xlabel("not-SUPP recall (validation)")
     axes.set_ylabel("SUPP recall (validation)")
     axes.set_xlim(0.5, 1.0)

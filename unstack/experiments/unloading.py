@@ -274,18 +274,30 @@ def unloading_experiment(
 
 def plot_unloading(result: dict[str, Any], output: str | os.PathLike[str]) -> None:
     """Boxes moved so far against the share of the detected boxes unloaded, per decision maker."""
-    from unstack.figures import pyplot, save_figure
+    from unstack.figures import CURVE_STYLES, curve_labels, pyplot, save_figure
 
     plt = pyplot()
     figure, axis = plt.subplots(figsize=(7, 4.5))
     grid = np.linspace(0.0, 1.0, 21)
-    for maker in result.get("makers", UNLOADING_MAKERS):
+    makers = list(result.get("makers", UNLOADING_MAKERS))
+    means = []
+    for maker in makers:
         curves = []
         for pile in result["piles"]:
             moved = np.cumsum([step["boxes_moved"] for step in pile["runs"][maker]["steps"]])
             share = np.arange(1, len(moved) + 1) / max(len(moved), 1)
             curves.append(np.interp(grid, np.concatenate([[0.0], share]), np.concatenate([[0.0], moved])))
-        axis.plot(100 * grid, np.mean(curves, axis=0), marker="o", markersize=3, label=maker)
+        means.append(np.mean(curves, axis=0))
+    # each maker its own marker and line style; a curve equal to an earlier one says so in the legend
+    # and is drawn with larger hollow markers, so that neither hides the other
+    labels = curve_labels(makers, means)
+    for index, (mean, label) in enumerate(zip(means, labels, strict=True)):
+        marker, line = CURVE_STYLES[index % len(CURVE_STYLES)]
+        hidden = label != makers[index]
+        axis.plot(
+            100 * grid, mean, marker=marker, linestyle=line, markersize=8 if hidden else 4,
+            markerfacecolor="none" if hidden else None, label=label,
+        )  # fmt: skip
     axis.set_xlabel("% of the detected boxes unloaded")
     axis.set_ylabel("boxes moved > 2 cm so far (mean over piles)")
     axis.set_title(f"Unloading {result['configs']} piles of {Path(result['data']).name} in the simulator")
