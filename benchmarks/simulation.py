@@ -33,7 +33,7 @@ def run(configs: int, seed: int, jobs: int, boxes: tuple[int, int]) -> dict[str,
     """One data set in a temporary folder: wall time and per-phase CPU seconds."""
     with tempfile.TemporaryDirectory() as folder:
         start = time.perf_counter()
-        simulate_dataset(folder, SimulationSettings(boxes=boxes), configs=configs, seed=seed, jobs=jobs, progress=False)
+        simulate_dataset(folder, SimulationSettings(boxes=boxes), configs=configs, seed=seed, jobs=jobs)
         wall = time.perf_counter() - start
         timings = [json.loads(line) for line in (Path(folder) / "timings.jsonl").read_text().splitlines()]
     phases = {phase: statistics.mean(t[phase] for t in timings) for phase in REFERENCE}

@@ -55,5 +55,5 @@ def small_dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
         ground_truth=GroundTruthSettings(horizon=0.5),
         sensor=SensorSettings(width=160, height=120, min_pixels=10),
     )
-    simulate_dataset(folder, settings, configs=8, seed=5, progress=False)
+    simulate_dataset(folder, settings, configs=8, seed=5)
     return folder

@@ -12,8 +12,8 @@ import pytest
 
 from tests.cli.test_commands import unstack
 from tests.conftest import REPO
+from unstack.datasets import list_configurations
 from unstack.jsonio import load_schema
-from unstack.sim.dataset import list_configurations
 
 SCENE = "examples/pile5.scene.json"
 
@@ -24,11 +24,14 @@ def model(small_dataset: Path, tmp_path_factory: pytest.TempPathFactory) -> Path
     result = unstack("train", str(small_dataset), "-o", str(target), "--r", "4", "--cv", "3", "--seed", "1")
     assert result.returncode == 0, result.stderr
     assert "chosen: C = " in result.stdout and "gamma = " in result.stdout
-    assert "validation confusion matrix (Fig. 5 layout)" in result.stdout
+    assert "hold-out confusion matrix (Fig. 5 layout)" in result.stdout
     return target
 
 
-def test_train_json_report(small_dataset: Path, tmp_path: Path) -> None:
+@pytest.mark.slow
+def test_train_json_report_holds_hold_out_figures_of_a_model_fitted_on_all_rows(
+    small_dataset: Path, tmp_path: Path
+) -> None:
     result = unstack("train", str(small_dataset), "-o", str(tmp_path / "m.skops"), "--r", "4", "--cv", "3",
                      "--learner", "gradient_boosting", "--features", "extended", "--json")  # fmt: skip
     assert result.returncode == 0, result.stderr
@@ -36,6 +39,7 @@ def test_train_json_report(small_dataset: Path, tmp_path: Path) -> None:
     assert report["learner"] == "gradient_boosting" and report["features"]["feature_set"] == "extended"
     assert report["training"]["r"] == 4
     assert report["validation"]["relations"] == math.ceil(0.3 * report["training"]["relations"])
+    assert report["training"]["fitted_on"] == "all" and report["training"]["validation_size"] == 0.3
     assert len(report["training"]["fingerprint"]) == 64
     decided = unstack("decide", SCENE, "--model", str(tmp_path / "m.skops"), "--json")  # the model's features
     assert decided.returncode == 0, decided.stderr

@@ -45,13 +45,13 @@ def test_render_writes_a_png(dataset: Path, tmp_path: Path) -> None:
         (["--boxes", "40-30"], "box range 40-30 is reversed"),
         (["--boxes", "many"], "--boxes: expected COUNT or LOW-HIGH (for example 30-40), got 'many'"),
         (["--boxes", "500-600"], "600 boxes of size set 'paper2' do not fit"),
-        (["--configs", "-3"], "--configs must be a non-negative count, got -3"),
-        (["--jobs", "0"], "--jobs must be at least 1, got 0"),
+        (["--configs", "-3"], "configs must be a non-negative count, got -3"),
+        (["--jobs", "0"], "jobs must be at least 1, got 0"),
         (["--resolution", "big"], "--resolution: expected WIDTHxHEIGHT in pixels"),
         (["--width", "0"], "--depth, --width and --horizon must be positive, got 2, 0 and 1"),
         (["--boxes", "9", "--sizes", "four", "--depth", "0.6", "--width", "0.8"], "do not fit a 0.6 x 0.8 x 2.39 m"),
         (["--scheduler", "tcp://127.0.0.1:9"], "dask scheduler tcp://127.0.0.1:9 does not answer within 5 s"),
-        (["--scheduler", "nowhere"], "--scheduler: expected an address like tcp://HOST:PORT, got 'nowhere'"),
+        (["--scheduler", "nowhere"], "scheduler: expected an address like tcp://HOST:PORT, got 'nowhere'"),
     ],
 )
 def test_simulate_bad_input_is_one_line(tmp_path: Path, arguments: list[str], message: str) -> None:

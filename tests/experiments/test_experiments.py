@@ -105,9 +105,9 @@ def test_fig5a_on_simulated_piles(small_dataset: Path, tmp_path: Path, split: st
 def test_real7_scores_every_iset(small_dataset: Path) -> None:
     from itertools import combinations
 
+    from unstack.datasets import list_configurations
     from unstack.experiments.real7 import real7
     from unstack.scene import load_scene
-    from unstack.sim.dataset import list_configurations
 
     boxes = len(load_scene(list_configurations(small_dataset)[0]).boxes)
     result = real7(small_dataset, load_model(default_model_path()), sizes=(3,), piles=1)
@@ -146,11 +146,11 @@ def test_unload_command_executes_every_order(small_dataset: Path, tmp_path: Path
 
 @pytest.mark.parametrize(("recall", "expected"), [(0.5, 0.8), (0.75, 0.6), (1.0, 0.3), (0.0, 0.9)])
 def test_recall_threshold_is_the_largest_reaching_the_recall(recall: float, expected: float) -> None:
-    from unstack.experiments.fig5a import _recall_threshold
+    from unstack.experiments.fig5a import recall_threshold
 
     truth = np.array([1, 1, 1, 1, 0, 0])
     probability = np.array([0.9, 0.8, 0.6, 0.3, 0.95, 0.1])
-    threshold = _recall_threshold(truth, probability, recall)
+    threshold = recall_threshold(truth, probability, recall)
     assert threshold == expected
     assert np.mean(probability[truth == 1] >= threshold) >= recall
 

@@ -34,11 +34,13 @@ def test_round_trip(tmp_path: Path, learner: str) -> None:
     grid = {"gb__max_leaf_nodes": [7]} if learner == "gradient_boosting" else GRID
     classifier = SupportClassifier(learner=learner, cv=3, param_grid=grid, random_state=0).fit(features, labels)
     settings = FeatureSettings(offset=0.8, sigma=0.4)
-    save_model(SupportModel.from_classifier(classifier, settings, training={"seed": 7}), tmp_path / "m.skops")
+    held_out = {"relations": 36, "supp_recall": 0.9}
+    wrapped = SupportModel.from_classifier(classifier, settings, training={"seed": 7}, validation=held_out)
+    save_model(wrapped, tmp_path / "m.skops")
     model = load_model(tmp_path / "m.skops")
     assert model.features == settings
     assert model.metadata["learner"] == learner and model.metadata["training"] == {"seed": 7}
-    assert model.metadata["validation"]["relations"] == 36
+    assert model.metadata["validation"] == held_out
     assert np.array_equal(model.support_probability(features), classifier.predict_proba(features)[:, 1])
 
 
@@ -75,15 +77,13 @@ def test_bad_files_are_one_line_errors(tmp_path: Path, fitted: tuple[SupportClas
         assert "\n" not in str(caught.value)
 
 
-def test_a_file_with_untrusted_types_is_refused_without_running_it(tmp_path: Path) -> None:
+def test_a_file_with_untrusted_types_is_refused_naming_them(tmp_path: Path) -> None:
     from sklearn.preprocessing import FunctionTransformer
 
-    calls = tmp_path / "called"
     payload = {"format": MODEL_FORMAT, "metadata": "{}", "estimator": FunctionTransformer(func=os.system)}
     path = write_payload(tmp_path / "evil.skops", payload)
     with pytest.raises(InvalidModel, match=r"refusing to load types that are not trusted: posix.system"):
         load_model(path)
-    assert not calls.exists()
 
 
 def test_the_shipped_default_model_is_the_general_one_with_its_feature_ranges() -> None:

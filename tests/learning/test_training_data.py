@@ -7,10 +7,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from unstack.datasets import list_configurations
 from unstack.errors import UnstackError
 from unstack.learning.training_data import dataset_examples, dataset_fingerprint, sample_isets, scene_examples
 from unstack.scene import load_scene
-from unstack.sim.dataset import list_configurations
 
 
 @pytest.mark.parametrize(("detected", "r", "size"), [(10, 5, 5), (5, 5, 4), (3, 5, 2), (2, 5, 0)])

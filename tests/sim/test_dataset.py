@@ -14,14 +14,9 @@ from pathlib import Path
 import pytest
 
 from tests.sim.conftest import small_settings
+from unstack.datasets import list_configurations, read_manifest
 from unstack.scene import load_scene
-from unstack.sim.dataset import (
-    DatasetConflict,
-    SchedulerUnavailable,
-    list_configurations,
-    read_manifest,
-    simulate_dataset,
-)
+from unstack.sim.dataset import DatasetConflict, SchedulerUnavailable, simulate_dataset
 from unstack.sim.settings import SimulationSettings
 
 
@@ -37,7 +32,7 @@ def digests(folder: Path) -> dict[str, str]:
 @pytest.fixture(scope="module")
 def reference(tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("reference")
-    simulate_dataset(folder, small_settings(), configs=4, seed=21, progress=False)
+    simulate_dataset(folder, small_settings(), configs=4, seed=21)
     return folder
 
 
@@ -57,16 +52,16 @@ def test_a_data_set_folder(reference: Path) -> None:
 
 
 def test_rerunning_skips_finished_configurations(reference: Path, tmp_path: Path) -> None:
-    simulate_dataset(tmp_path, small_settings(), configs=2, seed=21, progress=False)
-    summary = simulate_dataset(tmp_path, small_settings(), configs=4, seed=21, progress=False)
+    simulate_dataset(tmp_path, small_settings(), configs=2, seed=21)
+    summary = simulate_dataset(tmp_path, small_settings(), configs=4, seed=21)
     assert (summary.skipped, summary.made, summary.finished) == (2, 2, 4)
     assert digests(tmp_path) == digests(reference)
-    again = simulate_dataset(tmp_path, small_settings(), configs=4, seed=21, progress=False)
+    again = simulate_dataset(tmp_path, small_settings(), configs=4, seed=21)
     assert again.made == 0
 
 
 def test_two_workers_give_the_same_bytes(reference: Path, tmp_path: Path) -> None:
-    simulate_dataset(tmp_path, small_settings(), configs=4, seed=21, jobs=2, progress=False)
+    simulate_dataset(tmp_path, small_settings(), configs=4, seed=21, jobs=2)
     assert digests(tmp_path) == digests(reference)
 
 
@@ -74,9 +69,7 @@ def test_a_dask_cluster_gives_the_same_bytes(reference: Path, tmp_path: Path) ->
     from distributed import LocalCluster
 
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
-        simulate_dataset(
-            tmp_path, small_settings(), configs=4, seed=21, scheduler=cluster.scheduler_address, progress=False
-        )
+        simulate_dataset(tmp_path, small_settings(), configs=4, seed=21, scheduler=cluster.scheduler_address)
     assert digests(tmp_path) == digests(reference)
 
 
@@ -91,10 +84,10 @@ def test_a_dask_cluster_gives_the_same_bytes(reference: Path, tmp_path: Path) ->
     ],
 )
 def test_a_folder_of_another_data_set_is_refused(tmp_path: Path, change: dict[str, object], message: str) -> None:
-    simulate_dataset(tmp_path, small_settings(), configs=1, seed=21, progress=False)
+    simulate_dataset(tmp_path, small_settings(), configs=1, seed=21)
     arguments: dict[str, object] = {"settings": small_settings(), "seed": 21, **change}
     with pytest.raises(DatasetConflict, match=message):
-        simulate_dataset(tmp_path, arguments["settings"], configs=2, seed=arguments["seed"], progress=False)  # type: ignore[arg-type]
+        simulate_dataset(tmp_path, arguments["settings"], configs=2, seed=arguments["seed"])  # type: ignore[arg-type]
     assert len(list_configurations(tmp_path)) == 1
 
 

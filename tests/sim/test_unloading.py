@@ -6,9 +6,9 @@ from pathlib import Path
 
 import pytest
 
+from unstack.datasets import list_configurations
 from unstack.errors import UnstackError
 from unstack.scene import Scene, load_scene
-from unstack.sim.dataset import list_configurations
 from unstack.sim.unloading import execute_policy, execute_unloading
 
 

@@ -9,10 +9,14 @@ import click
 from rich.console import Console
 from rich.table import Table
 
-from unstack.cli.learning import FEATURES_HELP, ISETS_FROM_HELP, MODEL_HELP
-from unstack.cli.main import finite_seconds
+from unstack.cli.learning import FEATURES_HELP, ISETS_FROM_HELP
+from unstack.cli.main import MODEL_HELP, finite_seconds
 from unstack.cli.progress import progress_bar
 from unstack.errors import UnstackError
+from unstack.learning.classifier import LEARNERS
+from unstack.learning.features import FEATURE_SETS
+from unstack.learning.training import SPLITS
+from unstack.learning.training_data import ISET_DRAWS
 
 __all__ = ["experiment"]
 
@@ -88,13 +92,13 @@ def table1(out: str, max_n: int, full: bool) -> None:
 @click.option("--out", required=True, type=click.Path(), help="Folder for fig5a.json.")
 @click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
 @click.option("--isets", type=int, default=1, show_default=True, help="ISets per configuration.")
-@click.option("--isets-from", "draw", type=click.Choice(["random", "neighbours"]), default="random",
+@click.option("--isets-from", "draw", type=click.Choice(list(ISET_DRAWS)), default="random",
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
-@click.option("--learner", type=click.Choice(["svm", "gradient_boosting", "calibrated_svm"]), default="svm",
+@click.option("--learner", type=click.Choice(list(LEARNERS)), default="svm",
               show_default=True, help="svm: the paper's RBF SVM with probabilities.")  # fmt: skip
-@click.option("--split-by", type=click.Choice(["pairs", "configuration"]), default="pairs", show_default=True,
+@click.option("--split-by", type=click.Choice(list(SPLITS)), default="pairs", show_default=True,
               help="pairs: the paper's split of the relations; configuration: whole piles on one side.")  # fmt: skip
-@click.option("--features", "feature_set", type=click.Choice(["paper", "extended"]), default="paper",
+@click.option("--features", "feature_set", type=click.Choice(list(FEATURE_SETS)), default="paper",
               show_default=True, help=FEATURES_HELP)  # fmt: skip
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets, split and folds.")
 @click.option("--cv", type=int, default=10, show_default=True, help="Cross-validation folds.")
@@ -115,9 +119,9 @@ def fig5a(
     full: bool,
 ) -> None:
     """Fig. 5a: the validation confusion matrix of the SVM on a simulated data set, beside the paper's."""
+    from unstack.datasets import require_configurations
     from unstack.experiments.fig5a import fig5a as run
     from unstack.experiments.fig5a import plot_fig5a
-    from unstack.sim.dataset import require_configurations
 
     if r < 2 or isets < 1 or cv < 2 or jobs < 1:
         raise UnstackError("expected --r >= 2, --isets >= 1, --cv >= 2 and --jobs >= 1")
@@ -170,7 +174,7 @@ def fig5a(
 @click.option("--model", "model_path", default=None, help=MODEL_HELP)
 @click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
 @click.option("--isets", type=int, default=50, show_default=True, help="Test ISets (the paper: 493).")
-@click.option("--isets-from", "draw", type=click.Choice(["random", "neighbours"]), default="random",
+@click.option("--isets-from", "draw", type=click.Choice(list(ISET_DRAWS)), default="random",
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets.")
 @click.option("--full", is_flag=True, help="The paper's size: 493 test ISets (overrides --isets).")
@@ -179,8 +183,8 @@ def decisions(
 ) -> None:
     """Fig. 4 and beyond: MSE(cost), first pick right and physical disturbance of every decision maker."""
     from unstack.cli.main import load_model_option
+    from unstack.datasets import require_configurations
     from unstack.experiments.decisions import DECISION_MAKERS, evaluate_decisions, plot_fig4
-    from unstack.sim.dataset import require_configurations
 
     if full:
         isets = PAPER_TEST_ISETS
@@ -222,9 +226,9 @@ def decisions(
 def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) -> None:
     """The paper's real setting in simulation: every ISet of r = 3, 4, 5 of each 7-box pile."""
     from unstack.cli.main import load_model_option
+    from unstack.datasets import require_configurations
     from unstack.experiments.real7 import real7 as run
     from unstack.experiments.real7 import summary_rows
-    from unstack.sim.dataset import require_configurations
 
     if piles is not None and piles < 1:
         raise UnstackError(f"--piles must be at least 1, got {piles}")
@@ -282,8 +286,8 @@ def unload(
     run started again with the same piles, model, time limit and seed reuses them.
     """
     from unstack.cli.main import load_model_option
+    from unstack.datasets import require_configurations
     from unstack.experiments.unloading import plot_unloading, unloading_experiment
-    from unstack.sim.dataset import require_configurations
 
     found = len(require_configurations(data_dir))
     if full:

@@ -10,8 +10,11 @@ from rich.console import Console, Group
 from rich.table import Table
 from rich.text import Text
 
+from unstack.cli.main import MODEL_HELP
 from unstack.errors import UnstackError
+from unstack.learning.classifier import LEARNERS
 from unstack.learning.features import FEATURE_SETS
+from unstack.learning.training import SPLITS
 from unstack.learning.training_data import ISET_DRAWS
 
 __all__ = ["evaluate", "load_support_model", "metrics_view", "probabilities", "scene_supports", "train"]
@@ -57,16 +60,10 @@ def metrics_view(report: dict[str, Any], title: str) -> Group:
 
 
 ISETS_FROM_HELP = "How ISets are drawn: random detected boxes, or a detected box and its nearest neighbours."
-MODEL_HELP = (
-    "Model file, or a shipped model: general (the default: pose features, five pile families), paper (the "
-    "paper's SVM, for the reproduction) or extended (the paper's piles with contact features)."
-)
 FEATURES_HELP = (
     "paper: the 19 numbers of Eq. 6; extended: those and 17 contact features (gaps, overlaps, cloud); "
     "general: 15 features of the two boxes' poses (oriented footprints, gaps, tilt, separation), no cloud."
 )
-#: Configuration numbers of the n-th data set of a training run start at n times this.
-CONFIGURATION_OFFSET = 100_000
 
 
 def _examples(
@@ -80,33 +77,25 @@ def _examples(
     vary_clouds: bool = False,
     pose_noise: float = 0.0,
 ) -> Any:
-    from dataclasses import replace
-
-    from unstack.learning.training_data import SupportExamples, dataset_examples
-    from unstack.sim.dataset import require_configurations
+    """:func:`unstack.learning.training.pooled_examples` with a progress bar."""
+    from unstack.cli.progress import progress_bar
+    from unstack.datasets import require_configurations
+    from unstack.learning.training import pooled_examples
 
     folders = (data_dirs,) if isinstance(data_dirs, str) else data_dirs
     for folder in folders:
         require_configurations(folder)  # before any progress bar: the error is the only line
-    from unstack.cli.progress import progress_bar
-
-    parts = []
-    for number, folder in enumerate(folders):
-        with progress_bar(f"features {folder}" if len(folders) > 1 else "features") as report:
-            part = dataset_examples(folder, r=r, isets=isets, seed=seed + number, settings=settings, n_jobs=jobs,
-                                    progress=report, draw=draw, vary_clouds=vary_clouds,
-                                    pose_noise=pose_noise)  # fmt: skip
-        parts.append(replace(part, configuration=part.configuration + number * CONFIGURATION_OFFSET))
-    examples = SupportExamples.concatenate(parts)
-    if len(examples.labels) == 0:
-        raise UnstackError(f"{', '.join(folders)}: no ISet of at least 2 detected boxes; nothing to learn from")
-    return examples
+    with progress_bar("features") as report:
+        return pooled_examples(
+            folders, r=r, isets=isets, seed=seed, settings=settings, n_jobs=jobs, draw=draw,
+            vary_clouds=vary_clouds, pose_noise=pose_noise, progress=report,
+        )  # fmt: skip
 
 
 @click.command()
 @click.argument("data_dirs", nargs=-1, required=True, type=click.Path(file_okay=False))
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Model file to write.")
-@click.option("--learner", type=click.Choice(["svm", "gradient_boosting", "calibrated_svm"]), default="svm",
+@click.option("--learner", type=click.Choice(list(LEARNERS)), default="svm",
               show_default=True, help="svm: RBF SVM with LIBSVM probabilities (the paper).")  # fmt: skip
 @click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
 @click.option("--isets", type=int, default=3, show_default=True, help="ISets drawn per configuration.")
@@ -117,7 +106,7 @@ def _examples(
 @click.option("--pose-noise", type=click.FloatRange(0.0, 0.1), default=0.0, show_default=True,
               help="Show each ISet its boxes as a detector reports them: errors of this many metres.")  # fmt: skip
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets, the split and the folds.")
-@click.option("--split-by", type=click.Choice(["pairs", "configuration"]), default="pairs", show_default=True,
+@click.option("--split-by", type=click.Choice(list(SPLITS)), default="pairs", show_default=True,
               help="pairs: the paper's split of the relations; configuration: whole piles on one side.")  # fmt: skip
 @click.option("--cv", type=int, default=10, show_default=True, help="Cross-validation folds on the training part.")
 @click.option("--validation-size", type=float, default=0.3, show_default=True, help="Share held out for validation.")
@@ -150,55 +139,48 @@ def train(
 
     Several DATA_DIRS (pile families, say) are pooled; their piles stay whole in the split.
     """
-    from unstack.learning.classifier import SupportClassifier
+    from unstack.atomic import check_output_path
     from unstack.learning.features import FeatureSettings
-    from unstack.learning.model_file import SupportModel, save_model
-    from unstack.learning.training_data import dataset_fingerprint
-    from unstack.sim.dataset import read_manifest
+    from unstack.learning.model_file import save_model
+    from unstack.learning.training import train_support_model, training_provenance
 
     if r < 2 or isets < 1 or cv < 2 or jobs < 1 or not 0.0 <= validation_size < 1.0:
         raise UnstackError("expected --r >= 2, --isets >= 1, --cv >= 2, --jobs >= 1 and 0 <= --validation-size < 1")
+    check_output_path(output)
     settings = FeatureSettings(offset=offset, sigma=sigma, feature_set=feature_set)
     examples = _examples(data_dirs, r, isets, seed, jobs, settings, draw, vary_clouds, pose_noise)
     console = Console(stderr=as_json)
+    held_out = f"hold-out figures on {validation_size:.0%}, then " if validation_size > 0 else ""
     console.print(
         f"{len(examples.labels)} relations ({int(examples.labels.sum())} SUPP) from "
-        f"{len(set(examples.configuration.tolist()))} configurations; cross-validating {learner} ({cv} folds) ..."
+        f"{len(set(examples.configuration.tolist()))} configurations; {held_out}cross-validating {learner} "
+        f"({cv} folds) on all of them ..."
     )
-    classifier = SupportClassifier(
-        learner=learner, cv=cv, validation_size=validation_size, n_jobs=jobs, random_state=seed
-    ).fit(examples.features, examples.labels, groups=examples.configuration if split_by == "configuration" else None)
-    manifests = [read_manifest(folder) or {} for folder in data_dirs]
-    single = len(data_dirs) == 1
-    training = {
-        "data": str(data_dirs[0]) if single else [str(folder) for folder in data_dirs],
-        "fingerprint": dataset_fingerprint(data_dirs[0]) if single else [dataset_fingerprint(f) for f in data_dirs],
-        "simulation_seed": manifests[0].get("seed") if single else [m.get("seed") for m in manifests],
-        "simulation_settings": manifests[0].get("settings") if single else [m.get("settings") for m in manifests],
-        "vary_clouds": vary_clouds,
-        "pose_noise": pose_noise,
-        "seed": seed,
-        "r": r,
-        "isets_per_configuration": isets,
-        "isets_from": draw,
-        "split_by": split_by,
-        "relations": len(examples.labels),
-        "supp": int(examples.labels.sum()),
-        "validation_size": validation_size,
-    }
-    model = SupportModel.from_classifier(classifier, settings, training=training, training_features=examples.features)
+    provenance = training_provenance(
+        data_dirs, examples, vary_clouds=vary_clouds, pose_noise=pose_noise, seed=seed, r=r,
+        isets_per_configuration=isets, isets_from=draw,
+    )  # fmt: skip
+    run = train_support_model(
+        examples, settings, learner=learner, cv=cv, validation_size=validation_size, split_by=split_by, seed=seed,
+        n_jobs=jobs, provenance=provenance,
+    )  # fmt: skip
+    model = run.model
     save_model(model, output)
+    validation = model.metadata["validation"]
     report = {"model": output, "learner": learner, "features": settings.to_dict(),
               **{k: model.metadata[k] for k in ("best_params", "cv_score")},
-              "validation": classifier.validation_metrics_, "training": {k: v for k, v in training.items()
+              "validation": validation, "training": {k: v for k, v in model.metadata["training"].items()
               if k != "simulation_settings"}}  # fmt: skip
     if as_json:
         click.echo(json.dumps(report, indent=2))
         return
-    params = ", ".join(f"{key.rsplit('__', 1)[-1]} = {value:g}" for key, value in classifier.best_params_.items())
-    console.print(Text.assemble(("chosen: ", "bold"), params, f"  (cross-validated score {classifier.cv_score_:.3f})"))
-    if classifier.validation_metrics_:
-        console.print(metrics_view(classifier.validation_metrics_, "validation confusion matrix (Fig. 5 layout)"))
+    best = model.metadata["best_params"]
+    params = ", ".join(f"{key.rsplit('__', 1)[-1]} = {value:g}" for key, value in best.items())
+    score = model.metadata["cv_score"]
+    console.print(Text.assemble(("chosen: ", "bold"), params, f"  (cross-validated score {score:.3f})"))
+    if validation:
+        console.print(metrics_view(validation, "hold-out confusion matrix (Fig. 5 layout)"))
+        console.print("(of a model fitted on the rest; the saved model is fitted on all relations)")
     console.print(f"model written to {output}")
 
 

@@ -19,12 +19,16 @@ from typing import Any
 
 import click
 
+from unstack.cli.text import printable
 from unstack.errors import UnstackError
+from unstack.reasoner.costs import PAYOFF_COSTS
 
 __all__ = ["cli", "main"]
 
-INPUT_HELP = "An unstack.supports/1 or unstack.scene/1 JSON file; '-' reads standard input."
-MODEL_HELP = "Model file, or a shipped model: paper (the default: the paper's SVM) or extended (better decisions)."
+MODEL_HELP = (
+    "Model file, or a shipped model: general (the default: pose features, five pile families), paper (the "
+    "paper's SVM, for the reproduction) or extended (the paper's piles with contact features)."
+)
 
 #: Commands whose modules load only when they run (their imports are heavy).
 LAZY_COMMANDS = {
@@ -36,19 +40,6 @@ LAZY_COMMANDS = {
     "probabilities": "unstack.cli.learning:probabilities",
     "experiment": "unstack.cli.experiments:experiment",
 }
-
-
-def printable(text: str) -> str:
-    """``text`` with control characters escaped (``\\x1b`` for ESC), safe for a terminal.
-
-    Examples
-    --------
-    >>> printable("box\\x1b[31m")
-    'box\\\\x1b[31m'
-    """
-    if text.isprintable():
-        return text
-    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text)
 
 
 def _fail(message: str) -> None:
@@ -137,11 +128,12 @@ def load_model_option(model: str | None) -> tuple[Any, str]:
 def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
     """The options shared by ``decide`` and ``plan``: method, cost, sampling budget, seed."""
     from unstack.reasoner.costs import COSTS, DEFAULT_COST
+    from unstack.reasoner.decision import METHODS
 
     options = [
         click.option(
             "--method",
-            type=click.Choice(["auto", "exact", "sat", "approx"]),
+            type=click.Choice(list(METHODS)),
             default="auto",
             show_default=True,
             help="exact: weighted preorder counting (<= 8 boxes per group); sat: list worlds with CaDiCaL "
@@ -225,7 +217,7 @@ def decide(file: str, as_json: bool, output: str | None, timing: bool, model: st
 @click.option("--json", "as_json", is_flag=True, help="Print every world as JSON (unstack.payoff/1).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON payoff matrix to this file.")
 @click.option("--limit", type=click.IntRange(min=1), default=20, show_default=True, help="Worlds shown in the table.")
-@click.option("--cost", type=click.Choice(["count", "mass"]), default="count", show_default=True)
+@click.option("--cost", type=click.Choice(list(PAYOFF_COSTS)), default="count", show_default=True)
 @click.option("--model", "model", default=None, help=MODEL_HELP)
 def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str, model: str | None) -> None:
     """Print the payoff matrix (Table II): consistent worlds, their probabilities and action costs.

@@ -12,16 +12,24 @@ __all__ = ["progress_bar"]
 
 @contextmanager
 def progress_bar(description: str) -> Iterator[Callable[[int, int], None]]:
-    """Yield ``report(done, total)``; the bar (with ETA) disappears when the block ends."""
+    """Yield ``report(done, total)``; the bar (with ETA) disappears when the block ends.
+
+    Drawn only when standard error is a terminal: in a pipe or a log the callback does nothing
+    and nothing is written.
+    """
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
 
+    console = Console(stderr=True)
+    if not console.is_terminal:
+        yield lambda done, total: None
+        return
     with Progress(
         f"[progress.description]{description}",
         BarColumn(),
         MofNCompleteColumn(),
         "ETA",
         TimeRemainingColumn(),
-        console=Console(stderr=True),
+        console=console,
         transient=True,
     ) as bar:
         task = bar.add_task(description, total=None)

@@ -10,7 +10,7 @@ from rich.console import Group
 from rich.table import Table
 from rich.text import Text
 
-from unstack.cli.main import printable
+from unstack.cli.text import printable
 from unstack.reasoner.decision import Decision
 from unstack.reasoner.payoff import PayoffMatrix
 from unstack.reasoner.plan import Plan

@@ -107,8 +107,13 @@ def simulate(
         ground_truth=GroundTruthSettings(horizon=horizon),
         sensor=sensor,
     )
-    summary = simulate_dataset(out, settings, configs=configs, seed=seed, jobs=jobs, scheduler=scheduler)
-    from unstack.sim.dataset import read_manifest
+    from unstack.cli.progress import progress_bar
+
+    with progress_bar("simulating") as report:
+        summary = simulate_dataset(
+            out, settings, configs=configs, seed=seed, jobs=jobs, scheduler=scheduler, progress=report
+        )
+    from unstack.datasets import read_manifest
 
     statistics = (read_manifest(summary.folder) or {}).get("statistics", {})
     click.echo(

@@ -201,9 +201,9 @@ def evaluate_decisions(
 
     ``draw``: how the ISets are drawn (see :data:`unstack.learning.training_data.ISET_DRAWS`).
     """
+    from unstack.datasets import require_configurations
     from unstack.learning.training_data import detected_positions, sample_isets
     from unstack.scene import load_scene
-    from unstack.sim.dataset import require_configurations
 
     files = require_configurations(data_dir)
     rng = np.random.default_rng(seed)

@@ -18,14 +18,11 @@ Examples
 from __future__ import annotations
 
 import os
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
-__all__ = ["PAPER_FIG_5A", "SPLITS", "fig5a", "plot_fig5a", "validation_roc"]
-
-#: How the relations are split for validation and cross-validation.
-SPLITS = ("pairs", "configuration")
+__all__ = ["PAPER_FIG_5A", "balanced_threshold", "fig5a", "plot_fig5a", "recall_threshold", "validation_roc"]
 
 #: The paper's Fig. 5a: 145 of 185 SUPP and 351 of 401 not-SUPP validation relations right.
 PAPER_FIG_5A: dict[str, Any] = {
@@ -35,8 +32,14 @@ PAPER_FIG_5A: dict[str, Any] = {
 }
 
 
-def _balanced_threshold(truth: np.ndarray, probability: np.ndarray) -> float:
-    """The threshold whose SUPP and not-SUPP recalls on these relations are closest."""
+def balanced_threshold(truth: np.ndarray, probability: np.ndarray) -> float:
+    """The threshold whose SUPP and not-SUPP recalls on these relations are closest.
+
+    Examples
+    --------
+    >>> balanced_threshold(np.array([0, 0, 1, 1]), np.array([0.1, 0.3, 0.7, 0.9]))
+    0.7
+    """
     candidates = np.unique(np.round(probability, 4))
     best, gap = 0.5, np.inf
     for threshold in candidates:
@@ -47,8 +50,14 @@ def _balanced_threshold(truth: np.ndarray, probability: np.ndarray) -> float:
     return best
 
 
-def _recall_threshold(truth: np.ndarray, probability: np.ndarray, supp_recall: float) -> float:
-    """The largest threshold whose SUPP recall on these relations reaches ``supp_recall``."""
+def recall_threshold(truth: np.ndarray, probability: np.ndarray, supp_recall: float) -> float:
+    """The largest threshold whose SUPP recall on these relations reaches ``supp_recall``.
+
+    Examples
+    --------
+    >>> recall_threshold(np.array([0, 1, 1, 1, 1]), np.array([0.1, 0.2, 0.5, 0.8, 0.9]), 0.75)
+    0.5
+    """
     supp = np.sort(probability[truth == 1])[::-1]
     if len(supp) == 0:
         return 0.5
@@ -130,22 +139,29 @@ def fig5a(
     """
     from unstack.learning.classifier import SupportClassifier
     from unstack.learning.features import FeatureSettings
+    from unstack.learning.holdout import evaluate_holdout
     from unstack.learning.metrics import classification_report
+    from unstack.learning.training import SPLITS
     from unstack.learning.training_data import dataset_examples
 
     if split_by not in SPLITS:
         raise ValueError(f"unknown split {split_by!r}; expected one of {', '.join(SPLITS)}")
     settings = FeatureSettings(feature_set=feature_set)
     examples = dataset_examples(data_dir, r=r, isets=isets, seed=seed, settings=settings, n_jobs=n_jobs, draw=draw)
-    classifier = SupportClassifier(learner=learner, cv=cv, random_state=seed, n_jobs=n_jobs).fit(
-        examples.features, examples.labels, groups=examples.configuration if split_by == "configuration" else None
+    holdout = evaluate_holdout(
+        SupportClassifier(learner=learner, cv=cv, random_state=seed, n_jobs=n_jobs),
+        examples.features,
+        examples.labels,
+        groups=examples.configuration if split_by == "configuration" else None,
+        out_of_fold=True,
     )
-    train_y = examples.labels[classifier.train_indices_]
-    valid_x = examples.features[classifier.validation_indices_]
-    valid_y = examples.labels[classifier.validation_indices_]
-    threshold = _balanced_threshold(train_y, classifier.cv_probabilities_)
-    paper_threshold = _recall_threshold(train_y, classifier.cv_probabilities_, PAPER_FIG_5A["supp_recall"])
-    valid_p = classifier.predict_proba(valid_x)[:, 1]
+    classifier = holdout.classifier
+    out_of_fold = cast(np.ndarray, holdout.out_of_fold)
+    train_y = examples.labels[holdout.train_indices]
+    valid_y = examples.labels[holdout.validation_indices]
+    threshold = balanced_threshold(train_y, out_of_fold)
+    paper_threshold = recall_threshold(train_y, out_of_fold, PAPER_FIG_5A["supp_recall"])
+    valid_p = holdout.validation_probabilities
     at_threshold = classification_report(valid_y, (valid_p >= threshold).astype(float))
     at_paper_threshold = classification_report(valid_y, (valid_p >= paper_threshold).astype(float))
     reported = ("confusion_matrix", "supp_recall", "not_supp_recall", "success_rate")
@@ -158,7 +174,7 @@ def fig5a(
         "relations": len(examples.labels),
         "supp": int(examples.labels.sum()),
         "best_params": {key: float(value) for key, value in classifier.best_params_.items()},
-        "validation": classifier.validation_metrics_,
+        "validation": holdout.validation_metrics,
         "balanced_threshold": threshold,
         "validation_at_balanced_threshold": {key: at_threshold[key] for key in reported},
         "paper_recall_threshold": paper_threshold,

@@ -208,7 +208,7 @@ def unloading_experiment(
     from joblib import Parallel, delayed
 
     from unstack.atomic import atomic_write_text
-    from unstack.sim.dataset import require_configurations
+    from unstack.datasets import require_configurations
 
     if samples is None and time_limit is None:
         samples = UNLOAD_SAMPLES

@@ -18,6 +18,8 @@ from typing import Any
 _HOMES = {
     "LEARNERS": "classifier",
     "SupportClassifier": "classifier",
+    "HoldoutResult": "holdout",
+    "evaluate_holdout": "holdout",
     "FEATURE_NAMES": "features",
     "FeatureSettings": "features",
     "dbaf": "features",

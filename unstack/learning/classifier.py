@@ -1,14 +1,13 @@
 """``SupportClassifier``: P(SUPP(X, Y)) from the 19 support features (§III-A).
 
-A scikit-learn estimator. ``fit`` holds out ``validation_size`` of the data (stratified,
-70/30 by default, as the paper), chooses the hyper-parameters by ``cv``-fold
-cross-validation on the training part (10-fold, as the paper), refits the best model on
-the training part and scores it on the held-out part (``validation_metrics_``).
+A scikit-learn estimator whose ``fit`` only fits: it chooses the hyper-parameters by
+``cv``-fold cross-validation (10-fold, as the paper) and refits the best model on all the
+rows it is given. Hold-out figures (the paper's 70/30 split, Fig. 5) and out-of-fold
+probabilities are evaluation, not fitting: :mod:`unstack.learning.holdout`.
 
-With ``groups`` (for example the configuration each relation comes from), the hold-out
-and the folds keep every group on one side: relations of one pile never appear in both
-training and validation. Without them the split is by relation, as the paper describes it,
-and pairs of one pile land on both sides -- which flatters the validation figures.
+With ``groups`` (for example the configuration each relation comes from), the folds keep
+every group on one side: relations of one pile never appear in both a fold's training and
+its test part. Without them the folds split the relations, as the paper describes it.
 
 Learners (``learner=``):
 
@@ -33,8 +32,8 @@ Examples
 >>> model = SupportClassifier(cv=3, param_grid=grid, random_state=0).fit(X, y)
 >>> model.predict_proba(X[:2]).shape
 (2, 2)
->>> sorted(model.validation_metrics_)[:3]
-['average_entropy', 'balanced_error_rate', 'brier_score']
+>>> model.cv_folds_
+3
 """
 
 from __future__ import annotations
@@ -42,20 +41,13 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from sklearn.base import BaseEstimator, ClassifierMixin, clone
-from sklearn.model_selection import (
-    GridSearchCV,
-    GroupShuffleSplit,
-    StratifiedGroupKFold,
-    StratifiedKFold,
-    cross_val_predict,
-    train_test_split,
-)
+from sklearn.base import BaseEstimator, ClassifierMixin
+from sklearn.model_selection import GridSearchCV, StratifiedGroupKFold, StratifiedKFold
 from sklearn.pipeline import Pipeline
 from sklearn.utils.multiclass import type_of_target, unique_labels
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-__all__ = ["LEARNERS", "SupportClassifier", "default_grid", "make_learner"]
+__all__ = ["LEARNERS", "SupportClassifier", "default_grid", "fold_splitter", "make_learner"]
 
 #: Learner names accepted by ``SupportClassifier(learner=...)``.
 LEARNERS = ("svm", "gradient_boosting", "calibrated_svm")
@@ -94,6 +86,32 @@ def default_grid(name: str) -> dict[str, list[Any]]:
     raise ValueError(f"unknown learner {name!r}; expected one of {', '.join(LEARNERS)}")
 
 
+def fold_splitter(cv: int, y: np.ndarray, groups: np.ndarray | None, random_state: int | None) -> tuple[Any, int, int]:
+    """The cross-validation folds for ``y``: ``(splitter, folds, calibration_folds)``.
+
+    At most ``cv`` folds, fewer when the rarer class (or the number of groups) is small;
+    stratified, and grouped when ``groups`` is given. ``calibration_folds`` is what the SVMs'
+    probability calibration can use inside one fold's training part.
+
+    Examples
+    --------
+    >>> splitter, folds, calibration = fold_splitter(10, np.array([0, 1] * 4), None, 0)
+    >>> folds, calibration
+    (4, 3)
+    """
+    smallest_class = int(np.min(np.unique(y, return_counts=True)[1]))
+    folds = max(2, min(cv, smallest_class))
+    if groups is not None:
+        folds = max(2, min(folds, len(np.unique(groups))))
+    calibration_folds = max(2, min(5, smallest_class * (folds - 1) // folds))
+    splitter = (
+        StratifiedKFold(folds, shuffle=True, random_state=random_state)
+        if groups is None
+        else StratifiedGroupKFold(folds, shuffle=True, random_state=random_state)
+    )
+    return splitter, folds, calibration_folds
+
+
 class SupportClassifier(ClassifierMixin, BaseEstimator):
     """Probability that box X supports box Y, from ``F_XY``.
 
@@ -103,9 +121,7 @@ class SupportClassifier(ClassifierMixin, BaseEstimator):
     param_grid : dict, optional
         Grid for the cross-validation (default: :func:`default_grid` of the learner).
     cv : int
-        Folds of the cross-validation on the training part.
-    validation_size : float
-        Share held out for validation (0 keeps everything for training; no metrics then).
+        Folds of the cross-validation that chooses the hyper-parameters.
     scoring : str
         Model-selection score (balanced accuracy by default: SUPP is the rarer class).
     n_jobs : int, optional
@@ -116,22 +132,17 @@ class SupportClassifier(ClassifierMixin, BaseEstimator):
     ----------
     classes_ : numpy.ndarray
     estimator_ : sklearn.pipeline.Pipeline
-        The best pipeline, refit on the training part.
+        The best pipeline, refit on all the rows given to ``fit``.
     best_params_ : dict
     cv_score_ : float
         Mean cross-validated score of the best parameters.
-    validation_metrics_ : dict
-        :func:`unstack.learning.metrics.classification_report` on the held-out part.
-    train_indices_, validation_indices_ : numpy.ndarray
-        Rows of ``X`` in the training and the held-out part.
-    grouped_ : bool
-        Whether the split kept groups together.
-    cv_probabilities_ : numpy.ndarray
-        Out-of-fold P(SUPP) of each training row (``train_indices_`` order): the chosen
-        hyper-parameters cross-validated on the same folds. A threshold chosen on these
-        is not flattered by the model having seen the rows (in-sample probabilities of a
-        boosted model are far more confident than on new piles).
+    cv_folds_ : int
+        Folds the cross-validation used.
     n_features_in_ : int
+
+    See Also
+    --------
+    unstack.learning.holdout.evaluate_holdout : the paper's 70/30 validation, out-of-fold probabilities.
     """
 
     def __init__(
@@ -140,7 +151,6 @@ class SupportClassifier(ClassifierMixin, BaseEstimator):
         learner: str = "svm",
         param_grid: dict[str, list[Any]] | None = None,
         cv: int = 10,
-        validation_size: float = 0.3,
         scoring: str = "balanced_accuracy",
         n_jobs: int | None = None,
         random_state: int | None = None,
@@ -148,7 +158,6 @@ class SupportClassifier(ClassifierMixin, BaseEstimator):
         self.learner = learner
         self.param_grid = param_grid
         self.cv = cv
-        self.validation_size = validation_size
         self.scoring = scoring
         self.n_jobs = n_jobs
         self.random_state = random_state
@@ -159,12 +168,10 @@ class SupportClassifier(ClassifierMixin, BaseEstimator):
         return tags
 
     def fit(self, X: Any, y: Any, groups: Any = None) -> SupportClassifier:
-        """Split, cross-validate the grid on the training part, refit, validate.
+        """Cross-validate the grid on all rows and refit the best parameters on all rows.
 
-        ``groups``: one label per row; the hold-out and the folds keep each group whole.
+        ``groups``: one label per row; the folds keep each group whole.
         """
-        from unstack.learning.metrics import classification_report
-
         X, y = validate_data(self, X, y)
         target = type_of_target(y, input_name="y", raise_unknown=True)
         if target not in ("binary", "unknown") and len(unique_labels(y)) > 2:
@@ -174,37 +181,10 @@ class SupportClassifier(ClassifierMixin, BaseEstimator):
         self.classes_ = unique_labels(y)
         if len(self.classes_) < 2:
             raise ValueError(f"SupportClassifier needs both classes in y, got only 1 class: {self.classes_.tolist()}")
-        rows = np.arange(len(y))
         group_labels = None if groups is None else np.asarray(groups)
         if group_labels is not None and len(group_labels) != len(y):
             raise ValueError(f"groups has {len(group_labels)} labels for {len(y)} rows")
-        if self.validation_size > 0 and group_labels is not None:
-            splitter = GroupShuffleSplit(n_splits=1, test_size=self.validation_size, random_state=self.random_state)
-            train_rows, valid_rows = next(splitter.split(X, y, group_labels))
-        elif self.validation_size > 0:
-            train_rows, valid_rows = train_test_split(
-                rows, test_size=self.validation_size, stratify=y, random_state=self.random_state
-            )
-        else:
-            train_rows, valid_rows = rows, rows[:0]
-        self.train_indices_, self.validation_indices_ = np.sort(train_rows), np.sort(valid_rows)
-        self.grouped_ = group_labels is not None
-        X_train, y_train = X[self.train_indices_], y[self.train_indices_]
-        X_valid, y_valid = X[self.validation_indices_], y[self.validation_indices_]
-        if len(np.unique(y_train)) < 2:
-            raise ValueError("the training part holds one class only; use more groups or a smaller validation_size")
-        smallest_class = int(np.min(np.unique(y_train, return_counts=True)[1]))
-        folds = max(2, min(self.cv, smallest_class))
-        if group_labels is not None:
-            folds = max(2, min(folds, len(np.unique(group_labels[self.train_indices_]))))
-        # the probability calibration runs inside each fold's training part: fewer folds for tiny data
-        calibration_folds = max(2, min(5, smallest_class * (folds - 1) // folds))
-        splitter = (
-            StratifiedKFold(folds, shuffle=True, random_state=self.random_state)
-            if group_labels is None
-            else StratifiedGroupKFold(folds, shuffle=True, random_state=self.random_state)
-        )
-        train_groups = None if group_labels is None else group_labels[self.train_indices_]
+        splitter, folds, calibration_folds = fold_splitter(self.cv, y, group_labels, self.random_state)
         search = GridSearchCV(
             make_learner(self.learner, self.random_state, calibration_folds=calibration_folds),
             self.param_grid or default_grid(self.learner),
@@ -213,21 +193,11 @@ class SupportClassifier(ClassifierMixin, BaseEstimator):
             n_jobs=self.n_jobs,
             refit=True,
         )
-        search.fit(X_train, y_train, groups=train_groups)
-        positive = list(search.best_estimator_.classes_).index(self.classes_[1])
-        self.cv_probabilities_ = cross_val_predict(
-            clone(search.best_estimator_), X_train, y_train, groups=train_groups, cv=splitter,
-            n_jobs=self.n_jobs, method="predict_proba",
-        )[:, positive]  # fmt: skip
+        search.fit(X, y, groups=group_labels)
         self.estimator_ = search.best_estimator_
         self.best_params_ = dict(search.best_params_)
         self.cv_score_ = float(search.best_score_)
         self.cv_folds_ = folds
-        self.validation_metrics_ = (
-            classification_report(y_valid == self.classes_[1], self._positive_probability(X_valid))
-            if len(y_valid)
-            else {}
-        )
         return self
 
     def _positive_probability(self, X: np.ndarray) -> np.ndarray:

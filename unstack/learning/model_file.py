@@ -107,11 +107,14 @@ class SupportModel:
         *,
         training: dict[str, Any],
         training_features: np.ndarray | None = None,
+        validation: dict[str, Any] | None = None,
     ) -> SupportModel:
         """Wrap a fitted :class:`SupportClassifier`.
 
         With ``training_features`` (the rows it was trained on) the model keeps the range
         of each feature (:func:`feature_ranges`) to tell when an input lies outside it.
+        ``validation``: hold-out figures to keep with it (:func:`unstack.learning.holdout.evaluate_holdout`
+        of the same settings; the model itself is fitted on all the rows).
         """
         from unstack.provenance import package_versions
 
@@ -121,7 +124,7 @@ class SupportModel:
             "best_params": {key: _plain(value) for key, value in classifier.best_params_.items()},
             "cv_score": classifier.cv_score_,
             "cv_folds": classifier.cv_folds_,
-            "validation": classifier.validation_metrics_,
+            "validation": validation or {},
             "training": training,
             "versions": versions,
         }

@@ -25,12 +25,14 @@ import numpy as np
 from unstack.errors import UnstackError
 from unstack.supports import Supports
 
-__all__ = ["COSTS", "DEFAULT_COST", "cost_weights", "expected_costs", "own_costs"]
+__all__ = ["COSTS", "DEFAULT_COST", "PAYOFF_COSTS", "cost_weights", "expected_costs", "own_costs"]
 
 #: The cost models: what unloading a box first costs for each box it supports.
 COSTS = ("load", "count", "mass")
 #: The cost a decision uses unless told otherwise.
 DEFAULT_COST = "load"
+#: The costs a payoff matrix (Table II) tabulates world by world.
+PAYOFF_COSTS = ("count", "mass")
 
 
 def cost_weights(supports: Supports, cost: str) -> np.ndarray:

@@ -1,7 +1,7 @@
 """Simulation (§V): pybullet container piles, ground truth by removal, range sensor, data sets.
 
-Needs the ``sim`` extra (``pip install "unstack[sim]"``): pybullet, dask.distributed and
-matplotlib. Importing this package does not import pybullet; building a world does.
+Needs the ``sim`` extra (``pip install "unstack[sim]"``): pybullet and dask.distributed.
+Importing this package does not import pybullet; building a world does.
 
 Examples
 --------
@@ -11,7 +11,7 @@ Examples
 """
 
 from unstack.sim.configuration import SimulatedConfiguration, configuration_seed, simulate_configuration
-from unstack.sim.dataset import DatasetConflict, SchedulerUnavailable, list_configurations, simulate_dataset
+from unstack.sim.dataset import DatasetConflict, SchedulerUnavailable, simulate_dataset
 from unstack.sim.ground_truth import RemovalResponse, removal_responses, support_labels, transitivity_violations
 from unstack.sim.piles import Pile, build_pile
 from unstack.sim.sensor import Scan, scan_pile
@@ -43,7 +43,6 @@ __all__ = [
     "SimulationSettings",
     "build_pile",
     "configuration_seed",
-    "list_configurations",
     "removal_responses",
     "scan_pile",
     "simulate_configuration",

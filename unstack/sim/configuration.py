@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from unstack.datasets import config_name
 from unstack.provenance import package_versions
 from unstack.scene import Box, Scene
 from unstack.sim.ground_truth import RemovalResponse, removal_responses, support_labels, transitivity_violations
@@ -31,7 +32,6 @@ from unstack.sim.settings import SensorSettings, SimulationSettings
 
 __all__ = [
     "SimulatedConfiguration",
-    "config_name",
     "configuration_seed",
     "jittered_sensor",
     "simulate_configuration",
@@ -64,11 +64,6 @@ class SimulatedConfiguration:
     scene: Scene
     point_boxes: np.ndarray
     timings: dict[str, float]
-
-
-def config_name(index: int) -> str:
-    """File stem of configuration ``index`` in a data set folder."""
-    return f"config-{index:04d}"
 
 
 def configuration_seed(seed: int, index: int) -> np.random.SeedSequence:

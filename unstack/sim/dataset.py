@@ -22,7 +22,7 @@ Examples
 >>> settings = SimulationSettings(boxes=(3, 4), container=Container(depth=1.0),
 ...                               sensor=SensorSettings(width=80, height=60, min_pixels=5))
 >>> folder = tempfile.mkdtemp()
->>> summary = simulate_dataset(folder, settings, configs=2, seed=3, progress=False)
+>>> summary = simulate_dataset(folder, settings, configs=2, seed=3)
 >>> summary.finished, len(list_configurations(folder))
 (2, 2)
 """
@@ -42,25 +42,19 @@ from typing import Any
 import numpy as np
 
 from unstack.atomic import atomic_save_array, atomic_write_text
+from unstack.datasets import DATASET_FORMAT, MANIFEST, TIMINGS, config_name, list_configurations, read_manifest
 from unstack.errors import UnstackError
-from unstack.sim.configuration import SimulatedConfiguration, config_name, simulate_configuration
+from unstack.sim.configuration import SimulatedConfiguration, simulate_configuration
 from unstack.sim.settings import SimulationSettings, json_ready
 
 __all__ = [
-    "DATASET_FORMAT",
     "DatasetConflict",
     "DatasetSummary",
     "SchedulerUnavailable",
     "connect_scheduler",
-    "list_configurations",
-    "read_manifest",
-    "require_configurations",
     "simulate_dataset",
 ]
 
-DATASET_FORMAT = "unstack.dataset/1"
-MANIFEST = "manifest.json"
-TIMINGS = "timings.jsonl"
 SCHEDULER_ADDRESS = re.compile(r"^(?:(?:tcp|tls|ws|wss|ucx)://)?[^\s:/]+:\d+$")
 #: Seconds to wait for a dask scheduler before saying it does not answer.
 SCHEDULER_TIMEOUT = 5.0
@@ -98,44 +92,19 @@ class DatasetSummary:
     seconds: float
 
 
-def list_configurations(folder: str | os.PathLike[str]) -> list[Path]:
-    """The finished scene files of a data set folder, in index order."""
-    return sorted(Path(folder).glob("config-[0-9][0-9][0-9][0-9].json"))
-
-
-def require_configurations(folder: str | os.PathLike[str]) -> list[Path]:
-    """:func:`list_configurations`, or an error naming the folder when it holds none."""
-    files = list_configurations(folder)
-    if not files:
-        raise UnstackError(f"{folder}: expected a data set folder with config-NNNN.json scene files, found none")
-    return files
-
-
-def read_manifest(folder: str | os.PathLike[str]) -> dict[str, Any] | None:
-    """The folder's manifest, or ``None`` if it has none."""
-    path = Path(folder) / MANIFEST
-    if not path.exists():
-        return None
-    from unstack.jsonio import read_document, validate_document
-
-    document = read_document(path)
-    validate_document(document, [DATASET_FORMAT])
-    return document.data
-
-
 def _check_same_dataset(folder: Path, manifest: dict[str, Any], settings: SimulationSettings, seed: int) -> None:
     theirs = manifest.get("settings")
     ours = settings.to_dict()
     if manifest.get("seed") != seed:
         raise DatasetConflict(
             f"{folder / MANIFEST}: $.seed: the folder holds another data set (seed {manifest.get('seed')}, "
-            f"asked for {seed}); choose another --out folder"
+            f"asked for {seed}); choose another folder"
         )
     if theirs != ours:
         differing = sorted(key for key in ours if theirs is None or theirs.get(key) != ours.get(key))
         raise DatasetConflict(
             f"{folder / MANIFEST}: $.settings: the folder holds another data set "
-            f"(settings differ in {', '.join(differing)}); choose another --out folder"
+            f"(settings differ in {', '.join(differing)}); choose another folder"
         )
 
 
@@ -209,11 +178,11 @@ def _run_local(todo: list[int], settings: SimulationSettings, seed: int, jobs: i
 def connect_scheduler(scheduler: str) -> Any:
     """A dask.distributed client, or a one-line error within :data:`SCHEDULER_TIMEOUT`."""
     if not SCHEDULER_ADDRESS.match(scheduler):
-        raise SchedulerUnavailable(f"--scheduler: expected an address like tcp://HOST:PORT, got {scheduler!r}")
+        raise SchedulerUnavailable(f"scheduler: expected an address like tcp://HOST:PORT, got {scheduler!r}")
     try:
         from distributed import Client
     except ImportError as error:  # pragma: no cover - depends on the installation
-        raise UnstackError("--scheduler needs dask.distributed: pip install 'unstack[sim]'") from error
+        raise UnstackError("a dask scheduler needs dask.distributed: pip install 'unstack[sim]'") from error
     try:
         return Client(scheduler, timeout=SCHEDULER_TIMEOUT, set_as_default=False)  # type: ignore[no-untyped-call]
     except (OSError, TimeoutError, ValueError) as error:
@@ -246,7 +215,7 @@ def simulate_dataset(
     seed: int,
     jobs: int = 1,
     scheduler: str | None = None,
-    progress: bool | Callable[[int, int], None] = True,
+    progress: Callable[[int, int], None] | None = None,
 ) -> DatasetSummary:
     """Make (or finish) a simulated data set of ``configs`` configurations in ``folder``.
 
@@ -263,17 +232,17 @@ def simulate_dataset(
         Worker processes on this machine.
     scheduler : str, optional
         Address of a dask.distributed scheduler; the configurations run on its workers.
-    progress : bool or callable
-        Show a rich progress bar with ETA, or call ``progress(done, total)``.
+    progress : callable, optional
+        Called as ``progress(done, total)`` after each configuration (the CLI draws a bar).
 
     Returns
     -------
     DatasetSummary
     """
     if configs < 0:
-        raise UnstackError(f"--configs must be a non-negative count, got {configs}")
+        raise UnstackError(f"configs must be a non-negative count, got {configs}")
     if jobs < 1:
-        raise UnstackError(f"--jobs must be at least 1, got {jobs}")
+        raise UnstackError(f"jobs must be at least 1, got {jobs}")
     start = time.perf_counter()
     target = Path(folder)
     if target.exists() and not target.is_dir():
@@ -291,11 +260,13 @@ def simulate_dataset(
     made = 0
     try:
         results = _run_dask(todo, settings, seed, client) if client else _run_local(todo, settings, seed, jobs)
-        with _progress_reporter(progress, configs, skipped) as report:
-            for result in results:
-                _save_configuration(target, result)
-                made += 1
-                report(skipped + made)
+        if progress is not None:
+            progress(skipped, configs)
+        for result in results:
+            _save_configuration(target, result)
+            made += 1
+            if progress is not None:
+                progress(skipped + made, configs)
     finally:
         if client is not None:
             client.close()
@@ -303,41 +274,3 @@ def simulate_dataset(
     manifest["statistics"] = _statistics(target)
     atomic_write_text(target / MANIFEST, json.dumps(json_ready(manifest), indent=2) + "\n")
     return DatasetSummary(target, len(list_configurations(target)), skipped, made, time.perf_counter() - start)
-
-
-class _progress_reporter:  # noqa: N801 - used as a context manager like a function
-    """A rich progress bar with ETA, a plain callback, or nothing."""
-
-    def __init__(self, progress: bool | Callable[[int, int], None], total: int, done: int) -> None:
-        self.progress = progress
-        self.total = total
-        self.done = done
-        self.bar: Any = None
-        self.task: Any = None
-
-    def __enter__(self) -> Callable[[int], None]:
-        if self.progress is True:
-            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn, TimeRemainingColumn
-
-            self.bar = Progress(
-                "[progress.description]{task.description}",
-                BarColumn(),
-                MofNCompleteColumn(),
-                TimeElapsedColumn(),
-                "ETA",
-                TimeRemainingColumn(),
-                transient=False,
-            )
-            self.bar.start()
-            self.task = self.bar.add_task("simulating", total=self.total, completed=self.done)
-        return self.report
-
-    def report(self, done: int) -> None:
-        if self.bar is not None:
-            self.bar.update(self.task, completed=done)
-        elif callable(self.progress):
-            self.progress(done, self.total)
-
-    def __exit__(self, *exc: object) -> None:
-        if self.bar is not None:
-            self.bar.stop()

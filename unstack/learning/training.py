@@ -1,0 +1,186 @@
+"""Training a support model to ship: pooled examples, hold-out figures, a fit on all rows, provenance.
+
+:func:`pooled_examples` draws ISets from one or more data-set folders (pile families, say)
+and keeps each folder's configurations apart. :func:`train_support_model` reports the
+hold-out figures of the settings (:func:`unstack.learning.holdout.evaluate_holdout`: fitted
+on the training part, scored on the rest) and then fits the model it returns on *all* the
+rows, so no shipped model leaves part of its data unseen. The model keeps where its data
+came from (:func:`training_provenance`).
+
+Examples
+--------
+>>> CONFIGURATION_OFFSET
+100000
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+from typing import Any
+
+from unstack.errors import UnstackError
+from unstack.learning.features import FeatureSettings
+from unstack.learning.holdout import HoldoutResult
+from unstack.learning.model_file import SupportModel
+from unstack.learning.training_data import SupportExamples
+
+__all__ = [
+    "CONFIGURATION_OFFSET",
+    "SPLITS",
+    "TrainingRun",
+    "pooled_examples",
+    "train_support_model",
+    "training_provenance",
+]
+
+#: Configuration numbers of the n-th data set of a training run start at n times this.
+CONFIGURATION_OFFSET = 100_000
+#: How the rows are split for hold-out figures and folds: ``pairs`` (the paper: by relation)
+#: or ``configuration`` (each pile's relations on one side).
+SPLITS = ("pairs", "configuration")
+
+
+def pooled_examples(
+    data_dirs: Sequence[str | os.PathLike[str]],
+    *,
+    r: int,
+    isets: int,
+    seed: int,
+    settings: FeatureSettings,
+    n_jobs: int = 1,
+    draw: str = "random",
+    vary_clouds: bool = False,
+    pose_noise: float = 0.0,
+    progress: Callable[[int, int], None] | None = None,
+) -> SupportExamples:
+    """Examples of several data sets, pooled; the n-th folder is seeded ``seed + n``.
+
+    The configuration numbers of the n-th folder are offset by ``n * CONFIGURATION_OFFSET``,
+    so a split by configuration keeps every pile of every folder whole. ``progress(done,
+    total)`` counts configurations over all folders. Every folder is checked before any work.
+
+    Raises
+    ------
+    UnstackError
+        A folder holds no configuration, or no ISet of two detected boxes was drawn.
+    """
+    from unstack.datasets import require_configurations
+    from unstack.learning.training_data import dataset_examples
+
+    sizes = [len(require_configurations(folder)) for folder in data_dirs]
+    total = sum(sizes)
+    parts = []
+    for number, folder in enumerate(data_dirs):
+        before = sum(sizes[:number])
+
+        def report(done: int, _size: int, before: int = before) -> None:
+            if progress is not None:
+                progress(before + done, total)
+
+        part = dataset_examples(
+            folder, r=r, isets=isets, seed=seed + number, settings=settings, n_jobs=n_jobs, progress=report,
+            draw=draw, vary_clouds=vary_clouds, pose_noise=pose_noise,
+        )  # fmt: skip
+        parts.append(replace(part, configuration=part.configuration + number * CONFIGURATION_OFFSET))
+    examples = SupportExamples.concatenate(parts)
+    if len(examples.labels) == 0:
+        names = ", ".join(str(folder) for folder in data_dirs)
+        raise UnstackError(f"{names}: no ISet of at least 2 detected boxes; nothing to learn from")
+    return examples
+
+
+def training_provenance(
+    data_dirs: Sequence[str | os.PathLike[str]], examples: SupportExamples, **options: Any
+) -> dict[str, Any]:
+    """Where a model's data came from: folders, their fingerprints, simulation seeds and settings.
+
+    ``options`` (the ISet draw, seeds, split...) are recorded as given. One folder is
+    recorded as plain values, several as lists.
+    """
+    from unstack.datasets import read_manifest
+    from unstack.learning.training_data import dataset_fingerprint
+
+    manifests = [read_manifest(folder) or {} for folder in data_dirs]
+    fields: dict[str, list[Any]] = {
+        "data": [str(folder) for folder in data_dirs],
+        "fingerprint": [dataset_fingerprint(folder) for folder in data_dirs],
+        "simulation_seed": [manifest.get("seed") for manifest in manifests],
+        "simulation_settings": [manifest.get("settings") for manifest in manifests],
+    }
+    single: dict[str, Any] = {key: values[0] for key, values in fields.items()} if len(data_dirs) == 1 else fields
+    return {
+        **single,
+        **options,
+        "relations": len(examples.labels),
+        "supp": int(examples.labels.sum()),
+    }
+
+
+@dataclass(frozen=True)
+class TrainingRun:
+    """A model fitted on all its rows, and the hold-out figures of its settings (if asked for)."""
+
+    model: SupportModel
+    holdout: HoldoutResult | None
+
+
+def train_support_model(
+    examples: SupportExamples,
+    settings: FeatureSettings,
+    *,
+    learner: str = "svm",
+    cv: int = 10,
+    validation_size: float = 0.3,
+    split_by: str = "pairs",
+    seed: int = 0,
+    n_jobs: int = 1,
+    provenance: dict[str, Any] | None = None,
+) -> TrainingRun:
+    """Hold-out figures on ``validation_size`` of the rows, then a model fitted on all of them.
+
+    Parameters
+    ----------
+    examples : SupportExamples
+    settings : FeatureSettings
+        The features the examples were computed with.
+    learner, cv, seed, n_jobs
+        Passed to :class:`SupportClassifier <unstack.learning.classifier.SupportClassifier>`.
+    validation_size : float
+        Share held out for the figures (0: no hold-out figures).
+    split_by : {"pairs", "configuration"}
+        ``configuration`` keeps each pile's relations on one side of the split and the folds.
+    provenance : dict, optional
+        :func:`training_provenance`; ``validation_size`` and ``split_by`` are added.
+
+    Returns
+    -------
+    TrainingRun
+    """
+    from sklearn.base import clone
+
+    from unstack.learning.classifier import SupportClassifier
+    from unstack.learning.holdout import evaluate_holdout
+
+    if split_by not in SPLITS:
+        raise ValueError(f"unknown split {split_by!r}; expected one of {', '.join(SPLITS)}")
+    if not 0.0 <= validation_size < 1.0:
+        raise ValueError(f"validation_size must lie in [0, 1), got {validation_size}")
+    groups = examples.configuration if split_by == "configuration" else None
+    template = SupportClassifier(learner=learner, cv=cv, n_jobs=n_jobs, random_state=seed)
+    holdout = (
+        evaluate_holdout(template, examples.features, examples.labels, groups=groups, validation_size=validation_size)
+        if validation_size > 0
+        else None
+    )
+    classifier = clone(template).fit(examples.features, examples.labels, groups=groups)
+    training = {**(provenance or {}), "split_by": split_by, "validation_size": validation_size, "fitted_on": "all"}
+    model = SupportModel.from_classifier(
+        classifier,
+        settings,
+        training=training,
+        training_features=examples.features,
+        validation=None if holdout is None else holdout.validation_metrics,
+    )
+    return TrainingRun(model, holdout)
