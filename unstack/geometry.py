@@ -26,6 +26,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "BOX_FACES",
+    "bounding_box_overlap_xy",
     "bounding_boxes",
     "box_corners",
     "convex_hull_2d",
@@ -34,6 +35,7 @@ __all__ = [
     "points_in_box",
     "polygon_area",
     "polygon_distance",
+    "rotation_angles_deg",
     "rotation_matrix",
     "tilt_deg",
 ]
@@ -93,6 +95,37 @@ def bounding_boxes(boxes: Sequence[Box]) -> np.ndarray:
         result[row, :3] = box.position - half_extent
         result[row, 3:] = box.position + half_extent
     return result
+
+
+def bounding_box_overlap_xy(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """Signed overlap along x and y of axis-aligned bounding boxes ``[min xyz, max xyz]``, row by row.
+
+    Negative where the footprints are apart (minus the gap along that axis).
+
+    Examples
+    --------
+    >>> a = np.array([[0.0, 0.0, 0.0, 1.0, 1.0, 1.0]])
+    >>> b = np.array([[0.5, 1.5, 0.0, 2.0, 2.0, 1.0]])
+    >>> bounding_box_overlap_xy(a, b).tolist()
+    [[0.5, -0.5]]
+    """
+    first, second = np.atleast_2d(first), np.atleast_2d(second)
+    overlap: np.ndarray = np.minimum(first[:, 3:5], second[:, 3:5]) - np.maximum(first[:, :2], second[:, :2])
+    return overlap
+
+
+def rotation_angles_deg(before_xyzw: np.ndarray, after_xyzw: np.ndarray) -> np.ndarray:
+    """Angle of the rotation between two orientations (quaternions ``x, y, z, w``), per row, in degrees.
+
+    Examples
+    --------
+    >>> half_turn = np.array([[0.0, 0.0, 1.0, 0.0]])
+    >>> rotation_angles_deg(np.array([[0.0, 0.0, 0.0, 1.0]]), half_turn).round(6).tolist()
+    [180.0]
+    """
+    dots = np.abs(np.sum(before_xyzw * after_xyzw, axis=-1))
+    angles: np.ndarray = np.degrees(2.0 * np.arccos(np.clip(dots, 0.0, 1.0)))
+    return angles
 
 
 def tilt_deg(box: Box) -> float:

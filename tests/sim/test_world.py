@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from unstack.geometry import rotation_angles_deg
 from unstack.sim.piles import build_pile
 from unstack.sim.settings import SimulationSettings
-from unstack.sim.world import PhysicsWorld, rotation_angles_deg
+from unstack.sim.world import PhysicsWorld
 
 
 def stack(world: PhysicsWorld) -> tuple[int, int]:

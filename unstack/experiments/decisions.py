@@ -89,7 +89,7 @@ class _Iset:
 
 
 def free_pick(boxes: list[Any]) -> int:
-    from unstack.geometry import bounding_boxes
+    from unstack.geometry import bounding_box_overlap_xy, bounding_boxes
 
     bounds = bounding_boxes(boxes)
     free = []
@@ -98,8 +98,7 @@ def free_pick(boxes: list[Any]) -> int:
         for j in range(len(boxes)):
             if i == j:
                 continue
-            overlap_x = min(bounds[i, 3], bounds[j, 3]) - max(bounds[i, 0], bounds[j, 0])
-            overlap_y = min(bounds[i, 4], bounds[j, 4]) - max(bounds[i, 1], bounds[j, 1])
+            overlap_x, overlap_y = bounding_box_overlap_xy(bounds[i], bounds[j])[0]
             above = bounds[j, 2] >= bounds[i, 5] - 0.05 and bounds[j, 5] > bounds[i, 5]
             if overlap_x > 0.02 and overlap_y > 0.02 and above:
                 covered = True

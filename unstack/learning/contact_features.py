@@ -44,6 +44,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from unstack.geometry import bounding_box_overlap_xy
 from unstack.scene import Box
 
 __all__ = ["COLUMN_MARGIN", "CONTACT_FEATURE_NAMES", "contact_features"]
@@ -79,7 +80,7 @@ FACE_TOLERANCE = 0.01
 
 def _geometry(bb_x: np.ndarray, bb_y: np.ndarray) -> np.ndarray:
     """The ten box-only columns for rows of bounding boxes ``[min xyz, max xyz]``."""
-    overlap = np.minimum(bb_x[:, 3:5], bb_y[:, 3:5]) - np.maximum(bb_x[:, :2], bb_y[:, :2])
+    overlap = bounding_box_overlap_xy(bb_x, bb_y)
     area = np.prod(np.clip(overlap, 0.0, None), axis=1)
     area_x = np.prod(bb_x[:, 3:5] - bb_x[:, :2], axis=1)
     area_y = np.prod(bb_y[:, 3:5] - bb_y[:, :2], axis=1)

@@ -23,8 +23,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from unstack.geometry import rotation_angles_deg
 from unstack.sim.settings import GroundTruthSettings
-from unstack.sim.world import PhysicsWorld, rotation_angles_deg
+from unstack.sim.world import PhysicsWorld
 
 __all__ = ["RemovalResponse", "removal_responses", "support_labels", "transitivity_violations"]
 

@@ -157,8 +157,9 @@ def execute_policy(scene: Scene, policy: Callable[[Scene], str], boxes: Sequence
 
 def _execute(scene: Scene, count: int, next_box: Callable[[int, Any, list[str]], str]) -> UnloadRun:
     """Rebuild the pile, then ``count`` times: take out ``next_box(step, world, in_place)`` and measure."""
+    from unstack.geometry import rotation_angles_deg
     from unstack.sim.ground_truth import PARKING, run_horizon
-    from unstack.sim.world import PhysicsWorld, rotation_angles_deg
+    from unstack.sim.world import PhysicsWorld
 
     settings = _scene_settings(scene)
     truth = settings.ground_truth

@@ -27,9 +27,10 @@ from typing import Any
 
 import numpy as np
 
+from unstack.geometry import rotation_angles_deg
 from unstack.sim.settings import SimulationSettings
 
-__all__ = ["PhysicsWorld", "import_pybullet", "rotation_angles_deg"]
+__all__ = ["PhysicsWorld", "import_pybullet"]
 
 #: Wall thickness of the container's static parts (metres).
 WALL = 0.1
@@ -104,20 +105,6 @@ def _direct_client(pybullet: ModuleType, bullet_client: Any) -> Any:
     client._pid = os.getpid()
     client._client = pybullet.connect(pybullet.DIRECT)
     return client
-
-
-def rotation_angles_deg(before_xyzw: np.ndarray, after_xyzw: np.ndarray) -> np.ndarray:
-    """Angle of the rotation between two orientations, per row, in degrees.
-
-    Examples
-    --------
-    >>> half_turn = np.array([[0.0, 0.0, 1.0, 0.0]])
-    >>> rotation_angles_deg(np.array([[0.0, 0.0, 0.0, 1.0]]), half_turn).round(6).tolist()
-    [180.0]
-    """
-    dots = np.abs(np.sum(before_xyzw * after_xyzw, axis=-1))
-    angles: np.ndarray = np.degrees(2.0 * np.arccos(np.clip(dots, 0.0, 1.0)))
-    return angles
 
 
 class PhysicsWorld:
