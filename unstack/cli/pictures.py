@@ -106,6 +106,7 @@ def _check_suffix(output: str, suffixes: tuple[str, ...]) -> None:
 @click.option("--model", "model", default=None, help=MODEL_HELP)
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Seed of sampled decisions.")
 @click.option("--title", default=None, help="Title of the picture (default: the file name).")
+@click.option("--dpi", type=click.IntRange(20, 600), default=110, show_default=True, help="Resolution of a PNG.")
 def render(
     file: str,
     output: str,
@@ -117,6 +118,7 @@ def render(
     model: str | None,
     seed: int,
     title: str | None,
+    dpi: int,
 ) -> None:
     """Draw the decision on a scene: oblique view, sensor view and the ranking of expected costs.
 
@@ -137,15 +139,12 @@ def render(
         values = _values(loaded, decision_file, with_plan, model, seed)
         from unstack.pictures.graph import render_support_graph
 
-        render_support_graph(values, output, threshold=threshold, title=title)
+        render_support_graph(values, output, threshold=threshold, title=title, dpi=dpi)
         click.echo(f"{output}: support graph of {len(values.objects)} boxes; pick {values.choice}")
         return
     scene = loaded
-    if colour is None:
-        colour = "cost" if scene.detected else ("truth" if scene.ground_truth is not None else "none")
+    colour = colour or "cost"  # a scene always has detected boxes to decide on
     needs_decision = colour == "cost" or arrows or with_plan or decision_file is not None
-    if needs_decision and not scene.detected and decision_file is None:
-        raise UnstackError(f"{file}: no detected boxes to decide on; try --colour truth")
     values = _values(scene, decision_file, with_plan, model, seed) if needs_decision else None
     from unstack.pictures.render import render_scene
 
@@ -159,6 +158,7 @@ def render(
         threshold=threshold,
         arrows=arrows,
         title=title,
+        dpi=dpi,
     )
     pick = f"; pick {values.choice}" if values is not None else ""
     click.echo(f"{output}: {len(scene.boxes)} boxes, {len(scene.detected)} detected{pick}")
@@ -196,9 +196,7 @@ def view(
     loaded, _ = _load(file)
     if isinstance(loaded, unstack.Supports):
         raise UnstackError(f"{file}: a supports file has no geometry to show in 3D; unstack render draws its graph")
-    values = None
-    if loaded.detected or decision_file is not None:
-        values = _values(loaded, decision_file, with_plan, model, seed)
+    values = _values(loaded, decision_file, with_plan, model, seed)
     from unstack.pictures.view import write_view
 
     size = write_view(loaded, output, values=values, max_points=max_points, seed=seed, title=title or Path(file).name)

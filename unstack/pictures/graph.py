@@ -168,11 +168,16 @@ def draw_support_graph(values: DecisionValues, *, threshold: float = 0.5, title:
 
 
 def render_support_graph(
-    values: DecisionValues, output: str | os.PathLike[str], *, threshold: float = 0.5, title: str | None = None
+    values: DecisionValues,
+    output: str | os.PathLike[str],
+    *,
+    threshold: float = 0.5,
+    title: str | None = None,
+    dpi: int = 110,
 ) -> None:
     """Draw :func:`draw_support_graph` into a PNG or SVG file, atomically."""
     from unstack.atomic import atomic_save_figure, check_output_path
 
     check_output_path(output)
     figure = draw_support_graph(values, threshold=threshold, title=title)
-    atomic_save_figure(figure, output, dpi=110, bbox_inches="tight", pad_inches=0.08)
+    atomic_save_figure(figure, output, dpi=dpi, bbox_inches="tight", pad_inches=0.08)

@@ -331,6 +331,8 @@ def draw_scene(
 def render_scene(
     scene: Scene,
     output: str | os.PathLike[str],
+    *,
+    dpi: int = 110,
     **options: Any,
 ) -> None:
     """Draw ``scene`` (see :func:`draw_scene` for ``options``) into a PNG or SVG file, atomically.
@@ -340,10 +342,12 @@ def render_scene(
     scene : Scene
     output : path
         ``.png`` or ``.svg`` (the suffix says which).
+    dpi : int
+        Resolution of a PNG (dots per inch).
     **options
         As for :func:`draw_scene`.
     """
     from unstack.atomic import atomic_save_figure, check_output_path
 
     check_output_path(output)
-    atomic_save_figure(draw_scene(scene, **options), output, dpi=110, bbox_inches="tight", pad_inches=0.08)
+    atomic_save_figure(draw_scene(scene, **options), output, dpi=dpi, bbox_inches="tight", pad_inches=0.08)

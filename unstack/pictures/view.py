@@ -1,7 +1,9 @@
 """An interactive 3D page of a pile: one self-contained HTML file (plotly's JavaScript inlined).
 
 Detected boxes are solid and coloured by expected cost (a colour bar), outlined in black
-(the pick in magenta); undetected boxes are faint grey; the point cloud is subsampled.
+(the pick in magenta); undetected boxes are faint grey; the point cloud is cut to the boxes'
+surroundings, without the floor and the points on detected boxes (they would hide the pile),
+and subsampled.
 Hovering over a box shows its id, its EC (± standard error where sampled) and its
 strongest support relations. With an unloading order, a slider steps through it, taking
 the boxes away one by one. The page needs no network: open it from a disk or a mail.
@@ -32,13 +34,15 @@ from typing import Any
 import numpy as np
 
 from unstack.errors import InvalidArgument
-from unstack.geometry import BOX_FACES, box_corners
+from unstack.geometry import BOX_FACES, box_corners, points_in_box
 from unstack.pictures.values import DecisionValues
 from unstack.scene import Box, Scene
 
 __all__ = ["build_view", "hover_text", "write_view"]
 
 HIGHLIGHT = "#e6007e"
+#: Cloud points farther than this (m) outside the boxes' bounding box are left out.
+NEAR = 0.15
 #: Triangles of a box: each face of :data:`BOX_FACES` split along a diagonal.
 TRIANGLES = np.array([tri for a, b, c, d in BOX_FACES for tri in ((a, b, c), (a, c, d))], dtype=np.int64)
 
@@ -135,6 +139,15 @@ def build_view(
     top = max(top, 1e-9)
     traces: list[Any] = []
     points = scene.points
+    if len(points):  # the cloud near the boxes, off the floor and off the detected boxes: context, not clutter
+        corners = np.concatenate([box_corners(box) for box in scene.boxes])
+        low, high = corners.min(axis=0) - NEAR, corners.max(axis=0) + NEAR
+        keep = np.all((points >= low) & (points <= high), axis=1) & (points[:, 2] > low[2] + NEAR)
+        for box in scene.boxes:  # a detected box's own points would only speckle its faces
+            if box.id in detected:
+                keep &= ~points_in_box(points, box, margin=0.04)
+        points = points[keep]
+    near = len(points)
     if len(points) > max_points:
         points = points[np.sort(np.random.default_rng(seed).choice(len(points), max_points, replace=False))]
     traces.append(
@@ -143,9 +156,9 @@ def build_view(
             y=points[:, 1],
             z=points[:, 2],
             mode="markers",
-            marker={"size": 1.2, "color": "rgba(90,90,90,0.45)"},
+            marker={"size": 1.0, "color": "rgba(120,120,120,0.25)"},
             hoverinfo="skip",
-            name=f"cloud ({len(points):,} of {len(scene.points):,} points)",
+            name=f"cloud ({len(points):,} of {near:,} points: near the boxes, not on a detected one)",
         )
     )
     hidden = [box for box in scene.boxes if box.id not in detected]
@@ -209,7 +222,7 @@ def build_view(
             "xaxis": {"title": {"text": "x (into container, m)"}},
             "yaxis": {"title": {"text": "y (m)"}},
             "zaxis": {"title": {"text": "z (m)"}},
-            "camera": {"eye": {"x": -1.9, "y": -1.1, "z": 1.0}},  # from the door side
+            "camera": {"eye": {"x": -1.6, "y": -0.95, "z": 0.85}},  # from the door side
         },
     )
     if values is not None and values.order:
