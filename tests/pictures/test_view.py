@@ -16,10 +16,13 @@ from unstack.pictures.view import build_view, hover_text, write_view
 from unstack.scene import Scene
 
 
-def test_the_page_holds_the_decision(wall: Scene, wall_decision: DecisionValues) -> None:
-    figure = build_view(wall, values=wall_decision, max_points=500, seed=1)
+def test_the_page_holds_the_decision(wall: Scene, wall_decision: DecisionValues, rng: np.random.Generator) -> None:
+    behind = np.column_stack([rng.uniform(1.45, 1.5, 2000), rng.uniform(-1, 1, 2000), rng.uniform(0.3, 1.4, 2000)])
+    scene = Scene(wall.boxes, points=np.concatenate([wall.points, behind]), detected=wall.detected)
+    figure = build_view(scene, values=wall_decision, max_points=500, seed=1)
     cloud = figure.data[0]
-    assert len(cloud.x) == 500
+    assert len(cloud.x) == 500 and min(cloud.x) >= 1.45  # subsampled; points on detected boxes left out
+    assert "500 of 2,000 points" in cloud.name
     meshes = {trace.name: trace for trace in figure.data if trace.type == "mesh3d"}
     assert set(meshes) == set(wall_decision.objects)
     pick = wall_decision.choice
