@@ -69,11 +69,6 @@ class Document:
         self.source = source
         self.base_dir = base_dir
 
-    @property
-    def format(self) -> str:
-        """The document's ``format`` tag."""
-        return str(self.data["format"])
-
 
 def format_json_path(parts: Iterable[str | int]) -> str:
     """Render a sequence of keys and indices as a JSONPath such as ``$.boxes[0].size``."""

@@ -18,7 +18,7 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -92,8 +92,8 @@ class Box:
     id: str
     size: np.ndarray
     position: np.ndarray
-    orientation_xyzw: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 0.0, 1.0]))
-    mass: float | None = None
+    orientation_xyzw: np.ndarray
+    mass: float | None
 
     def __init__(
         self,
@@ -222,9 +222,9 @@ class Scene:
     boxes: tuple[Box, ...]
     points: np.ndarray
     detected: tuple[str, ...]
-    ground_truth: np.ndarray | None = None
-    metadata: dict[str, Any] = field(default_factory=dict)
-    source: str = "<array>"
+    ground_truth: np.ndarray | None
+    metadata: dict[str, Any]
+    source: str
 
     def __init__(
         self,

@@ -16,7 +16,7 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -60,10 +60,10 @@ class Supports:
 
     objects: tuple[str, ...]
     probabilities: np.ndarray
-    masses: np.ndarray | None = None
-    metadata: dict[str, Any] = field(default_factory=dict)
-    source: str = "<array>"
-    hidden_load: np.ndarray | None = None
+    masses: np.ndarray | None
+    metadata: dict[str, Any]
+    source: str
+    hidden_load: np.ndarray | None
 
     def __init__(
         self,

@@ -51,11 +51,11 @@ from typing import Any
 
 import numpy as np
 
+from unstack.sim.settings import DISPLACEMENT_THRESHOLD
+
 __all__ = ["DECISION_MAKERS", "evaluate_decisions", "paired_difference", "squared_regret"]
 
 DECISION_MAKERS = ("reasoner", "count", "priors", "highest", "free", "random")
-#: Displacement above which a box counts as disturbed (the ground truth's threshold).
-DISTURBED = 0.02
 
 
 def squared_regret(costs: np.ndarray, choice: int) -> float:
@@ -134,7 +134,8 @@ def _iset_result(scene: Any, ids: list[str], model: Any) -> _Iset:
     removal = scene.metadata.get("simulation", {}).get("removal", {})
     displacement = np.asarray(removal.get("displacement_m", np.zeros((len(scene.boxes),) * 2)))
     rows = displacement[index]
-    disturbance = np.column_stack([(rows > DISTURBED).sum(axis=1), np.where(rows > DISTURBED, rows, 0).sum(axis=1)])
+    disturbed = rows > DISPLACEMENT_THRESHOLD
+    disturbance = np.column_stack([disturbed.sum(axis=1), np.where(disturbed, rows, 0).sum(axis=1)])
     return _Iset(
         str(scene.source),
         ids,

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from unstack.geometry import rotation_angles_deg
-from unstack.sim.settings import GroundTruthSettings
+from unstack.sim.settings import DISPLACEMENT_THRESHOLD, ROTATION_THRESHOLD_DEG, GroundTruthSettings
 from unstack.sim.world import PhysicsWorld
 
 __all__ = ["RemovalResponse", "removal_responses", "support_labels", "transitivity_violations"]
@@ -45,15 +45,12 @@ class RemovalResponse:
         ``[x, y]``: how far box y turned (degrees).
     baseline_displacement, baseline_rotation_deg : float
         Largest drift of any box over the same horizon without removal (creep).
-    simulated_seconds : float
-        Simulated time of all the runs.
     """
 
     displacement: np.ndarray
     rotation_deg: np.ndarray
     baseline_displacement: float
     baseline_rotation_deg: float
-    simulated_seconds: float
 
 
 def run_horizon(world: PhysicsWorld, settings: GroundTruthSettings, watched: list[int]) -> float:
@@ -82,7 +79,7 @@ def removal_responses(world: PhysicsWorld, settings: GroundTruthSettings) -> Rem
     start_positions, start_orientations = world.poses(bodies)
     displacement = np.zeros((n, n))
     rotation = np.zeros((n, n))
-    simulated = run_horizon(world, settings, bodies)
+    run_horizon(world, settings, bodies)
     positions, orientations = world.poses(bodies)
     baseline_displacement = float(np.max(np.linalg.norm(positions - start_positions, axis=1), initial=0.0))
     baseline_rotation = float(np.max(rotation_angles_deg(start_orientations, orientations), initial=0.0))
@@ -92,7 +89,7 @@ def removal_responses(world: PhysicsWorld, settings: GroundTruthSettings) -> Rem
         client.resetBasePositionAndOrientation(body, parking.tolist(), [0.0, 0.0, 0.0, 1.0])
         client.resetBaseVelocity(body, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
         others = bodies[:x] + bodies[x + 1 :]
-        simulated += run_horizon(world, settings, others)
+        run_horizon(world, settings, others)
         positions, orientations = world.poses(bodies)
         moved = np.linalg.norm(positions - start_positions, axis=1)
         turned = rotation_angles_deg(start_orientations, orientations)
@@ -101,15 +98,15 @@ def removal_responses(world: PhysicsWorld, settings: GroundTruthSettings) -> Rem
         rotation[x] = turned
     client.restoreState(stateId=state)
     client.removeState(state)
-    return RemovalResponse(displacement, rotation, baseline_displacement, baseline_rotation, simulated)
+    return RemovalResponse(displacement, rotation, baseline_displacement, baseline_rotation)
 
 
 def support_labels(
     displacement: np.ndarray,
     rotation_deg: np.ndarray,
     *,
-    displacement_threshold: float = 0.02,
-    rotation_threshold_deg: float = 5.0,
+    displacement_threshold: float = DISPLACEMENT_THRESHOLD,
+    rotation_threshold_deg: float = ROTATION_THRESHOLD_DEG,
 ) -> np.ndarray:
     """0/1 support matrix from raw removal responses: ``[x, y] = 1`` iff y moved or turned.
 

@@ -68,7 +68,6 @@ class Pile:
 
     world: PhysicsWorld
     boxes: list[PileBox] = field(default_factory=list)
-    simulated_seconds: float = 0.0
     refills: int = 0
 
     def close(self) -> None:
@@ -206,15 +205,15 @@ def build_pile(settings: SimulationSettings, *, count: int, seed: int | np.rando
             stalled = 0
             while len(pile.boxes) < count:
                 dropped = _drop_wave(world, pile, min(settings.pile.wave_size, count - len(pile.boxes)), rng)
-                pile.simulated_seconds += world.settle()
+                world.settle()
                 stalled = stalled + 1 if dropped == 0 else 0
                 if stalled >= 3:
                     break
             world.open_door()
-            pile.simulated_seconds += world.settle()
+            world.settle()
             fallen = _delete_fallen(world, pile)
             if fallen:
-                pile.simulated_seconds += world.settle()
+                world.settle()
             if len(pile.boxes) == count:
                 pile.refills = round_index
                 return pile

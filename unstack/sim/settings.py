@@ -26,7 +26,9 @@ from unstack.errors import UnstackError
 
 __all__ = [
     "ARRANGEMENTS",
+    "DISPLACEMENT_THRESHOLD",
     "FAMILIES",
+    "ROTATION_THRESHOLD_DEG",
     "SIZE_SETS",
     "Container",
     "GroundTruthSettings",
@@ -66,11 +68,6 @@ class Container:
     depth: float = 2.0
     width: float = 2.35
     height: float = 2.39
-
-    @property
-    def floor_area(self) -> float:
-        """Floor area in square metres."""
-        return self.depth * self.width
 
 
 @dataclass(frozen=True)
@@ -124,6 +121,13 @@ class PileSettings:
     fallen_share: float = 0.1
 
 
+#: A box that moved more than this (metres) was disturbed: by a removal (ground truth,
+#: Section V) or by a pick (unloading, decisions). The one home of the 2 cm threshold.
+DISPLACEMENT_THRESHOLD = 0.02
+#: ... or turned more than this (degrees).
+ROTATION_THRESHOLD_DEG = 5.0
+
+
 @dataclass(frozen=True)
 class GroundTruthSettings:
     """Support by removal: X supports Y when taking X away makes Y move.
@@ -149,8 +153,8 @@ class GroundTruthSettings:
     horizon: float = 1.0
     early_exit_after: float = 0.15
     early_exit_speed: float = 0.01
-    displacement_threshold: float = 0.02
-    rotation_threshold_deg: float = 5.0
+    displacement_threshold: float = DISPLACEMENT_THRESHOLD
+    rotation_threshold_deg: float = ROTATION_THRESHOLD_DEG
     creep_displacement: float = 0.002
     creep_rotation_deg: float = 0.5
 
