@@ -36,6 +36,7 @@ _SHIFT_B = np.uint64(25)
 _SHIFT_C = np.uint64(27)
 _SHIFT_FLOAT = np.uint64(11)
 _TO_UNIT = 1.0 / 9007199254740992.0  # 2**-53
+_STRIDE = 5  # unstack.reasoner.block_gibbs.BLOCK_STRIDE: bit a * 5 + b of a block's table mask
 
 
 @njit(cache=True, nogil=True)
@@ -421,15 +422,128 @@ def _flip_pairs(
 
 
 @njit(cache=True, nogil=True)
+def _block_update(
+    members: np.ndarray,
+    size: int,
+    count: int,
+    masks: np.ndarray,
+    log_weights: np.ndarray,
+    cumulative: np.ndarray,
+    clean_marginals: np.ndarray,
+    successors: np.ndarray,
+    predecessors: np.ndarray,
+    rng: np.ndarray,
+    chain: int,
+    record: bool,
+    sums: np.ndarray,
+    pair_sums: np.ndarray,
+) -> None:
+    """Redraw the relations inside one block from their exact conditional (block Gibbs).
+
+    The relations across the block forbid or force relations inside it (see
+    :mod:`unstack.reasoner.block_gibbs`); the block's preorders that respect them are weighed
+    by ``log_weights`` and one is drawn. With ``record`` the conditional marginal of every
+    pair inside the block is added to ``sums``. A block with no relation across draws from
+    ``cumulative`` and records ``clean_marginals`` (no pass over its table).
+    """
+    inside = np.int64(0)
+    for a in range(size):
+        inside |= np.int64(1) << members[a]
+    forbidden = np.int64(0)
+    forced = np.int64(0)
+    linked = False
+    for a in range(size):
+        u = members[a]
+        if (predecessors[u] | successors[u]) & ~inside:
+            linked = True
+    if not linked:
+        target = _uniform(rng, chain) * cumulative[count - 1]
+        low, high = 0, count - 1
+        while low < high:
+            middle = (low + high) // 2
+            if cumulative[middle] > target:
+                high = middle
+            else:
+                low = middle + 1
+        pick = masks[low]
+        if record:
+            for a in range(size):
+                for b in range(size):
+                    if a != b:
+                        sums[members[a], members[b]] += clean_marginals[a * _STRIDE + b]
+    else:
+        for a in range(size):
+            u = members[a]
+            in_u = predecessors[u] & ~inside
+            out_u = successors[u] & ~inside
+            for b in range(size):
+                if a == b:
+                    continue
+                v = members[b]
+                in_v = predecessors[v] & ~inside
+                out_v = successors[v] & ~inside
+                bit = np.int64(1) << (a * _STRIDE + b)
+                if out_u & in_v:
+                    forced |= bit
+                elif (in_u & ~in_v) or (out_v & ~out_u):
+                    forbidden |= bit
+        top = -np.inf
+        for t in range(count):
+            m = masks[t]
+            if (m & forbidden) == 0 and (m & forced) == forced and log_weights[t] > top:
+                top = log_weights[t]
+        if top == -np.inf:
+            return  # cannot happen from a consistent state of non-zero weight
+        total = 0.0
+        pair_sums[:] = 0.0
+        for t in range(count):
+            m = masks[t]
+            if (m & forbidden) == 0 and (m & forced) == forced:
+                w = np.exp(log_weights[t] - top)
+                total += w
+                if record:
+                    for k in range(_STRIDE * _STRIDE):
+                        if (m >> k) & 1:
+                            pair_sums[k] += w
+        if record:
+            for a in range(size):
+                for b in range(size):
+                    if a != b:
+                        sums[members[a], members[b]] += pair_sums[a * _STRIDE + b] / total
+        target = _uniform(rng, chain) * total
+        pick = np.int64(-1)
+        for t in range(count):
+            m = masks[t]
+            if (m & forbidden) == 0 and (m & forced) == forced:
+                pick = m
+                target -= np.exp(log_weights[t] - top)
+                if target < 0.0:
+                    break
+    for a in range(size):
+        u = members[a]
+        for b in range(size):
+            if a == b:
+                continue
+            v = members[b]
+            if pick & (np.int64(1) << (a * _STRIDE + b)):
+                successors[u] |= np.int64(1) << v
+                predecessors[v] |= np.int64(1) << u
+            else:
+                successors[u] &= ~(np.int64(1) << v)
+                predecessors[v] &= ~(np.int64(1) << u)
+
+
+@njit(cache=True, nogil=True)
 def _add_conditionals(
-    probabilities: np.ndarray, successors: np.ndarray, predecessors: np.ndarray, sums: np.ndarray
+    probabilities: np.ndarray, successors: np.ndarray, predecessors: np.ndarray, sums: np.ndarray, block_of: np.ndarray
 ) -> None:
     """Add ``P(S_ij = 1 | every other relation)`` of the current state to ``sums``: ``p_ij``
-    for a free pair, else its current value."""
+    for a free pair, else its current value. Pairs inside a block are skipped (the block
+    update adds their conditional given the relations across)."""
     n = probabilities.shape[0]
     for i in range(n):
         for j in range(n):
-            if i == j:
+            if i == j or (block_of[i] >= 0 and block_of[i] == block_of[j]):
                 continue
             if _pair_is_free(i, j, successors, predecessors):
                 sums[i, j] += probabilities[i, j]
@@ -451,9 +565,18 @@ def _run_chain(
     record: bool,
     sums: np.ndarray,
     scatter: bool,
+    block_members: np.ndarray,
+    block_sizes: np.ndarray,
+    block_counts: np.ndarray,
+    block_masks: np.ndarray,
+    block_log_weights: np.ndarray,
+    block_cumulative: np.ndarray,
+    block_marginals: np.ndarray,
+    block_of: np.ndarray,
 ) -> int:
     """Run ``sweeps`` sweeps of one chain; add the estimates when ``record``."""
     n = probabilities.shape[0]
+    pair_sums = np.zeros(_STRIDE * _STRIDE)
     order = np.empty(n, dtype=np.int64)
     candidates_supported = np.empty(tries + 1, dtype=np.int64)
     candidates_supporters = np.empty(tries + 1, dtype=np.int64)
@@ -479,8 +602,25 @@ def _run_chain(
                 scatter,
             ):
                 accepted += 1
+        for k in range(block_sizes.shape[0]):
+            _block_update(
+                block_members[k],
+                block_sizes[k],
+                block_counts[k],
+                block_masks[k],
+                block_log_weights[k],
+                block_cumulative[k],
+                block_marginals[k],
+                successors,
+                predecessors,
+                rng,
+                chain,
+                record,
+                sums,
+                pair_sums,
+            )
         if record:
-            _add_conditionals(probabilities, successors, predecessors, sums)
+            _add_conditionals(probabilities, successors, predecessors, sums, block_of)
     return accepted
 
 
@@ -497,7 +637,15 @@ def run_chains(
     record: bool,
     sums: np.ndarray,
     accepted: np.ndarray,
-    scatter: bool = False,
+    scatter: bool,
+    block_members: np.ndarray,
+    block_sizes: np.ndarray,
+    block_counts: np.ndarray,
+    block_masks: np.ndarray,
+    block_log_weights: np.ndarray,
+    block_cumulative: np.ndarray,
+    block_marginals: np.ndarray,
+    block_of: np.ndarray,
 ) -> None:
     """Advance every chain by ``sweeps`` sweeps (chains run in parallel).
 
@@ -507,7 +655,9 @@ def run_chains(
     ``rng``: ``(chains,)`` uint64 states; ``sums``: ``(chains, n, n)``, the conditionals
     of every recorded sweep are added; ``scatter``: take every first proposal (to spread
     the starting worlds of the chains);
-    ``accepted``: ``(chains,)`` counts of moves that changed the state.
+    ``accepted``: ``(chains,)`` counts of moves that changed the state;
+    ``block_*``: the blocks redrawn exactly after every sweep
+    (:class:`~unstack.reasoner.block_gibbs.BlockTables`; no blocks: zero rows).
     """
     for c in prange(successors.shape[0]):
         accepted[c] += _run_chain(
@@ -523,4 +673,12 @@ def run_chains(
             record,
             sums[c],
             scatter,
+            block_members,
+            block_sizes,
+            block_counts,
+            block_masks,
+            block_log_weights,
+            block_cumulative,
+            block_marginals,
+            block_of,
         )

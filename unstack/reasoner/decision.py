@@ -35,6 +35,7 @@ from unstack.reasoner.confidence import choice_probability
 from unstack.reasoner.costs import COSTS, DEFAULT_COST, cost_weights, expected_costs, own_costs
 from unstack.reasoner.marginals import EXACT_MAX_BOXES
 from unstack.reasoner.pruning import Evidence, propagate_evidence
+from unstack.reasoner.reuse import WARM_BURN_IN, WorkCache
 from unstack.reasoner.sampling import SAMPLING_MAX_BOXES, SampledMarginals
 from unstack.supports import Supports
 
@@ -292,9 +293,35 @@ def _group_marginals(
     method: str,
     max_boxes: int | None,
     sampling: dict[str, Any],
+    cache: WorkCache | None = None,
 ) -> _GroupResult:
     """Conditional marginals (and world count or sampling errors) of one group of linked boxes."""
     probabilities = evidence.probabilities[np.ix_(group, group)]
+    if cache is None:
+        return _compute_group(supports, probabilities, group, method, max_boxes, sampling, None)
+    ids = tuple(supports.objects[i] for i in group)
+    key = (ids, method, max_boxes, probabilities.tobytes(), sampling.get("samples"), sampling.get("time_limit"))
+    found = cache.results.get(key)
+    if found is not None:
+        cache.reused += 1
+        return found  # type: ignore[no-any-return]
+    result = _compute_group(supports, probabilities, group, method, max_boxes, sampling, cache)
+    cache.results[key] = result
+    if result.sampled is not None and result.sampled.final_worlds is not None:
+        cache.chains[ids] = result.sampled.final_worlds
+    return result
+
+
+def _compute_group(
+    supports: Supports,
+    probabilities: np.ndarray,
+    group: np.ndarray,
+    method: str,
+    max_boxes: int | None,
+    sampling: dict[str, Any],
+    cache: WorkCache | None,
+) -> _GroupResult:
+    """:func:`_group_marginals` without the cache (a sampled group may start warm from it)."""
     exact_errors = np.zeros_like(probabilities)
     if method == "sat":
         from unstack.reasoner.worlds import SAT_MAX_BOXES, enumerate_worlds
@@ -305,6 +332,9 @@ def _group_marginals(
     if method == "approx":
         from unstack.reasoner.sampling import _sampled_marginals
 
+        warm = None if cache is None else cache.warm_start(tuple(supports.objects[i] for i in group))
+        if warm is not None:
+            sampling = sampling | {"warm": warm, "burn_in": WARM_BURN_IN}
         result = _sampled_marginals(np.ascontiguousarray(probabilities), **sampling)
         return _GroupResult(result.marginals, None, result.standard_errors, result)
     from unstack.reasoner.marginals import _exact_marginals
@@ -386,6 +416,7 @@ def decide(
     time_limit: float | None = None,
     samples: int | None = None,
     seed: int | None = None,
+    cache: WorkCache | None = None,
 ) -> Decision:
     """Choose the box to unload first (Eq. 12) from pairwise support probabilities.
 
@@ -416,6 +447,10 @@ def decide(
         given either); reproducible for a ``seed``.
     seed : int, optional
         Seed of the sampler and of the choice probability.
+    cache : WorkCache, optional
+        Work kept from earlier decisions on related scenes (an unloading plan's steps):
+        unchanged groups are reused, sampled groups start from earlier chains
+        (:mod:`unstack.reasoner.reuse`).
 
     Returns
     -------
@@ -472,7 +507,7 @@ def decide(
         if group_method == "approx":
             budget["time_limit"] = _time_share(deadline, group, waiting)
             waiting -= len(group)
-        result = _group_marginals(supports, evidence, group, group_method, max_boxes, budget)
+        result = _group_marginals(supports, evidence, group, group_method, max_boxes, budget, cache)
         results.append(result)
         block = np.ix_(group, group)
         marginals[block] = result.marginals

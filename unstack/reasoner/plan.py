@@ -5,6 +5,11 @@ until one box is left. Each step records the chosen box and its expected cost am
 boxes that remained at that step. The probabilities of the remaining boxes are not
 re-estimated: the plan is what the reasoner would do without a new scan after each pick.
 
+The steps share their work (:mod:`unstack.reasoner.reuse`): groups of linked boxes that the
+pick left unchanged keep their marginals, and the group that lost the box is sampled from
+where the previous step's chains ended. A ``progress(done, total)`` callback hears of every
+step; the library prints nothing.
+
 Examples
 --------
 >>> from unstack.supports import Supports
@@ -15,11 +20,13 @@ Examples
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 from unstack.reasoner.costs import DEFAULT_COST
 from unstack.reasoner.decision import Decision, decide
+from unstack.reasoner.reuse import WorkCache
 from unstack.supports import Supports
 
 __all__ = ["PLAN_FORMAT", "Plan", "PlanStep", "unloading_plan"]
@@ -101,6 +108,7 @@ def unloading_plan(
     time_limit: float | None = None,
     samples: int | None = None,
     seed: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> Plan:
     """Order every box by repeated minimum-EC decisions (see the module docstring).
 
@@ -111,6 +119,8 @@ def unloading_plan(
     method, cost, time_limit, samples, seed
         As in :func:`~unstack.reasoner.decision.decide`, applied to each step (so with a
         seed and no ``time_limit`` the plan is reproducible).
+    progress : callable, optional
+        Called as ``progress(done, total)`` after every step (``total`` picks in all).
 
     Returns
     -------
@@ -129,6 +139,7 @@ def unloading_plan(
     """
     remaining = list(supports.objects) if isinstance(supports, Supports) else []
     steps: list[PlanStep] = []
+    work = WorkCache()
     while True:
         decision = decide(
             supports.subset(remaining) if steps else supports,
@@ -137,9 +148,12 @@ def unloading_plan(
             time_limit=time_limit,
             samples=samples,
             seed=seed,
+            cache=work,
         )
         chosen = decision.objects.index(decision.choice)
         steps.append(PlanStep(decision.choice, float(decision.expected_costs[chosen]), tuple(remaining), decision))
         remaining.remove(decision.choice)
+        if progress is not None:
+            progress(len(steps), len(supports.objects))
         if not remaining:
             return Plan(supports.objects, tuple(steps))

@@ -61,6 +61,7 @@ __all__ = [
     "DEFAULT_TRIES",
     "SAMPLING_MAX_BOXES",
     "SampledMarginals",
+    "restrict_worlds",
     "sample_worlds",
     "sampled_marginals",
 ]
@@ -112,6 +113,9 @@ class SampledMarginals:
     seed : int or None
     seconds : float
         Wall time.
+    final_worlds : numpy.ndarray, shape (chains, n), int64, optional
+        Last state of every chain (bit masks of the boxes each box supports): a warm start
+        for a related scene (see ``start`` of :func:`sampled_marginals`).
     """
 
     marginals: np.ndarray
@@ -124,6 +128,7 @@ class SampledMarginals:
     acceptance: float
     seed: int | None
     seconds: float
+    final_worlds: np.ndarray | None = None
 
     def errors_of(self, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Estimate and covariance of ``marginals @ weights`` (the expected costs).
@@ -156,8 +161,10 @@ class SampledMarginals:
         within = values.var(axis=1, ddof=1).mean(axis=0)
         between = batches * values.mean(axis=1).var(axis=0, ddof=1)
         pooled = (batches - 1) / batches * within + between / batches
+        # rounding alone (a group drawn exactly as one block records the same value every sweep)
+        tiny = 1e-24 * np.maximum(1.0, values.mean(axis=(0, 1)) ** 2)
         with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = np.where(within > 0, pooled / within, np.where(between > 0, np.inf, 1.0))
+            ratio = np.where(within > tiny, pooled / within, np.where(between > tiny, np.inf, 1.0))
         result: np.ndarray = np.sqrt(ratio)
         return result
 
@@ -180,6 +187,32 @@ def _start_state(probabilities: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return successors, predecessors
 
 
+def _transposed(successors: np.ndarray, n: int) -> np.ndarray:
+    """Predecessor masks from successor masks (``(..., n)`` int64 arrays)."""
+    bits = np.left_shift(np.int64(1), np.arange(n, dtype=np.int64))
+    member = (successors[..., :, None] & bits) != 0  # [..., i, j]: i supports j
+    result: np.ndarray = (member * bits[:, None]).sum(axis=-2).astype(np.int64)
+    return result
+
+
+def restrict_worlds(worlds: np.ndarray, keep: np.ndarray) -> np.ndarray:
+    """Chain states on the boxes ``keep`` (indices, in order) from states on more boxes.
+
+    A preorder restricted to a subset of the boxes is a preorder of the subset, so the
+    result is a consistent start for :func:`sampled_marginals` on those boxes.
+
+    Examples
+    --------
+    >>> restrict_worlds(np.array([[0b110, 0b100, 0]]), np.array([0, 2])).tolist()  # 0 -> 1 -> 2
+    [[2, 0]]
+    """
+    keep = np.asarray(keep, dtype=np.int64)
+    member = (worlds[..., keep, None] >> keep) & 1  # [..., a, b]: keep[a] supports keep[b]
+    bits = np.left_shift(np.int64(1), np.arange(len(keep), dtype=np.int64))
+    result: np.ndarray = (member * bits).sum(axis=-1).astype(np.int64)
+    return result
+
+
 def _log_tables(probabilities: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``log p`` and ``log(1 - p)``, with ``-inf`` where the factor is 0."""
     with np.errstate(divide="ignore"):
@@ -200,8 +233,19 @@ class _Chains:
     proposal (scattered starts), then ``burn_in`` ordinary sweeps.
     """
 
-    def __init__(self, probabilities: np.ndarray, *, chains: int, seed: int | None, burn_in: int, tries: int) -> None:
+    def __init__(
+        self,
+        probabilities: np.ndarray,
+        *,
+        chains: int,
+        seed: int | None,
+        burn_in: int,
+        tries: int,
+        blocks: bool = True,
+        start: np.ndarray | None = None,
+    ) -> None:
         from unstack.reasoner._sampler_kernels import run_chains
+        from unstack.reasoner.block_gibbs import block_tables, strong_blocks
 
         n = probabilities.shape[0]
         if n > SAMPLING_MAX_BOXES:
@@ -216,7 +260,12 @@ class _Chains:
         self.tries = tries
         self.accepted = np.zeros(chains, dtype=np.int64)
         self.sums = np.zeros((chains, n, n))
-        self.advance(1, scatter=True)
+        self.blocks = block_tables(probabilities, strong_blocks(probabilities) if blocks else [])
+        if start is None:
+            self.advance(1, scatter=True)
+        else:
+            self.successors[:] = start
+            self.predecessors[:] = _transposed(start, n)
         self.advance(burn_in)
 
     def advance(self, sweeps: int, *, record: bool = False, scatter: bool = False) -> None:
@@ -234,6 +283,14 @@ class _Chains:
                 self.sums,
                 self.accepted,
                 scatter,
+                self.blocks.members,
+                self.blocks.sizes,
+                self.blocks.counts,
+                self.blocks.masks,
+                self.blocks.log_weights,
+                self.blocks.cumulative,
+                self.blocks.marginals,
+                self.blocks.block_of,
             )
 
 
@@ -246,6 +303,7 @@ def sampled_marginals(
     chains: int = DEFAULT_CHAINS,
     burn_in: int = DEFAULT_BURN_IN,
     tries: int = DEFAULT_TRIES,
+    blocks: bool = True,
 ) -> SampledMarginals:
     """Estimate the conditional marginals of the consistent worlds by MCMC.
 
@@ -268,6 +326,10 @@ def sampled_marginals(
         Sweeps per chain discarded first.
     tries : int
         Proposals per move (the move picks among them and the current relations).
+    blocks : bool
+        Redraw blocks of strongly linked boxes exactly after every sweep and record their
+        exact conditional marginals (:mod:`unstack.reasoner.block_gibbs`); ``False`` runs
+        the single-box moves alone.
 
     Returns
     -------
@@ -284,7 +346,15 @@ def sampled_marginals(
     p = check_matrix(probabilities)
     _check_sampling(samples, time_limit, seed, chains=chains, burn_in=burn_in, tries=tries)
     return _sampled_marginals(
-        p, samples=samples, time_limit=time_limit, seed=seed, chains=chains, burn_in=burn_in, tries=tries, start=start
+        p,
+        samples=samples,
+        time_limit=time_limit,
+        seed=seed,
+        chains=chains,
+        burn_in=burn_in,
+        tries=tries,
+        start=start,
+        blocks=blocks,
     )
 
 
@@ -312,15 +382,18 @@ def _sampled_marginals(
     burn_in: int = DEFAULT_BURN_IN,
     tries: int = DEFAULT_TRIES,
     start: float | None = None,
+    blocks: bool = True,
+    warm: np.ndarray | None = None,
 ) -> SampledMarginals:
-    """:func:`sampled_marginals` on checked arguments."""
+    """:func:`sampled_marginals` on checked arguments; ``warm``: ``(chains, n)`` consistent
+    starting worlds (skips the scattering sweep)."""
     start = time.perf_counter() if start is None else start
     n = p.shape[0]
     if samples is None and time_limit is None:
         samples = DEFAULT_SAMPLES
     deadline = None if time_limit is None else start + time_limit
     per_chain = None if samples is None else -(-samples // chains)
-    state = _Chains(p, chains=chains, seed=seed, burn_in=burn_in, tries=tries)
+    state = _Chains(p, chains=chains, seed=seed, burn_in=burn_in, tries=tries, blocks=blocks, start=warm)
 
     batches = np.zeros((chains, _MAX_BATCHES, n, n))
     batch_length = _ROUND_SWEEPS  # sweeps per chain in one batch
@@ -368,6 +441,7 @@ def _sampled_marginals(
         acceptance=float(state.accepted.sum() / moves) if moves else 1.0,
         seed=seed,
         seconds=time.perf_counter() - start,
+        final_worlds=state.successors.copy(),
     )
 
 
