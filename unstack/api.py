@@ -24,6 +24,7 @@ from __future__ import annotations
 import os
 import threading
 import weakref
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Union
 
@@ -295,6 +296,7 @@ def plan(
     seed: int | None = None,
     samples: int | None = None,
     time_limit: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> Plan:
     """An unloading order: decide, take the chosen box out, decide again on the rest.
 
@@ -303,7 +305,11 @@ def plan(
     scene_or_supports : Scene or Supports
         A scene gets its probabilities from ``model`` once, before the first step.
     model, method, cost, seed, samples, time_limit
-        As in :func:`decide` (the budget applies to each step).
+        As in :func:`decide` (the budget applies to each step; without one each step
+        samples :data:`~unstack.reasoner.plan.PLAN_SAMPLES` sweeps per group, from where
+        the previous step's chains ended).
+    progress : callable, optional
+        ``progress(done, total)`` after every step.
 
     Returns
     -------
@@ -325,4 +331,6 @@ def plan(
     from unstack.reasoner.plan import unloading_plan
 
     supports = _supports(scene_or_supports, model)
-    return unloading_plan(supports, method=method, cost=cost, seed=seed, samples=samples, time_limit=time_limit)
+    return unloading_plan(
+        supports, method=method, cost=cost, seed=seed, samples=samples, time_limit=time_limit, progress=progress
+    )

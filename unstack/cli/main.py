@@ -251,12 +251,17 @@ def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str, 
 def plan(file: str, as_json: bool, output: str | None, model: str | None, **reasoning: Any) -> None:
     """Order all detected boxes by repeated decisions: pick, remove from the set, decide again.
 
-    With sampling, the budget (--samples or --time-limit) applies to each step.
+    With sampling, the budget (--samples or --time-limit) applies to each step; without one
+    each step samples 1024 sweeps per group, starting from the previous step's chains, so a
+    seed reproduces the plan. A progress bar on a terminal counts the steps.
     """
     import unstack
+    from unstack.cli.progress import progress_bar
 
     _check_output(output)
-    result = unstack.plan(_load_input(file, model), model=model, **reasoning)
+    supports = _load_input(file, model)
+    with progress_bar("planning: steps") as report:
+        result = unstack.plan(supports, model=model, progress=report, **reasoning)
     document = result.to_dict()
     _write_output(output, document)
     _print_warnings(result.warnings)

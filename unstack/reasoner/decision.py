@@ -248,11 +248,13 @@ def choose(objects: tuple[str, ...], costs: np.ndarray) -> tuple[str, tuple[str,
     return tied[0], tied
 
 
-def _group_methods(method: str, sizes: list[int], n: int, time_limit: float | None) -> list[str]:
+def _group_methods(
+    method: str, sizes: list[int], n: int, time_limit: float | None, max_boxes: int | None = None
+) -> list[str]:
     """The method of each group of linked boxes (``sizes``: boxes per group, of ``n``)."""
     if method != "auto":
         return [method] * len(sizes)
-    exact_limit = EXACT_MAX_BOXES
+    exact_limit = EXACT_MAX_BOXES if max_boxes is None else max_boxes
     if time_limit is not None and time_limit < AUTO_EXACT8_SECONDS:
         exact_limit = min(exact_limit, 7)
     methods = []
@@ -437,7 +439,8 @@ def decide(
         without it); ``count``: Eq. 11 exactly (number of supported boxes); ``mass``: their
         total mass (needs masses). See :mod:`unstack.reasoner.costs`.
     max_boxes : int, optional
-        Override the exact methods' size limit.
+        Override the exact methods' size limit (with ``auto``: the largest group counted
+        exactly; larger ones are sampled).
     time_limit : float, optional
         Seconds for the whole decision: the sampled groups share what the exact ones leave.
         Not reproducible (the sweeps that fit depend on the machine's load).
@@ -491,7 +494,7 @@ def decide(
     weights = cost_weights(supports, cost)
     evidence = _propagate(supports)
     groups = support_components(evidence.probabilities)
-    methods = _group_methods(method, [len(group) for group in groups], n, time_limit)
+    methods = _group_methods(method, [len(group) for group in groups], n, time_limit, max_boxes)
     seeds = _group_seeds(len(groups), seed)
     deadline = None if time_limit is None else start + time_limit
     waiting = sum(len(group) for group, method in zip(groups, methods, strict=True) if method == "approx")
