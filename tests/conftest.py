@@ -1,7 +1,9 @@
-"""Shared fixtures: seeded random probability matrices and example files."""
+"""Shared fixtures and helpers: seeded random probability matrices, example files, the CLI in a subprocess."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -11,6 +13,20 @@ from unstack.supports import Supports
 
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLES = REPO / "examples"
+#: The five-box example supports file, relative to the repository (the CLI runs there).
+PILE5 = "examples/pile5.supports.json"
+
+
+def unstack(*args: str, stdin: str | None = None, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    """Run ``python -m unstack ARGS`` in the repository (or ``cwd``); output captured as text."""
+    return subprocess.run(
+        [sys.executable, "-m", "unstack", *args],
+        input=stdin,
+        capture_output=True,
+        text=True,
+        cwd=cwd or REPO,
+        timeout=300,
+    )
 
 
 def random_probabilities(n: int, rng: np.random.Generator, *, hard: float = 0.0) -> np.ndarray:
@@ -24,6 +40,18 @@ def random_probabilities(n: int, rng: np.random.Generator, *, hard: float = 0.0)
 
 def supports_of(probabilities: np.ndarray) -> Supports:
     return Supports([f"b{i}" for i in range(len(probabilities))], probabilities)
+
+
+#: Packages whose doctests build physics worlds or run experiments: slow.
+SLOW_DOCTEST_PACKAGES = ("unstack/sim/", "unstack/experiments/")
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Mark the doctests of the simulator and the experiments slow (they cannot carry a marker)."""
+    for item in items:
+        path = item.path.as_posix()
+        if isinstance(item, pytest.DoctestItem) and any(part in path for part in SLOW_DOCTEST_PACKAGES):
+            item.add_marker(pytest.mark.slow)
 
 
 @pytest.fixture
@@ -43,7 +71,7 @@ def examples() -> Path:
 
 @pytest.fixture(scope="session")
 def small_dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A simulated data set of six small piles, made once per test session."""
+    """A simulated data set of eight small piles (7-9 boxes), made once per test session."""
     from unstack.sim.dataset import simulate_dataset
     from unstack.sim.settings import Container, GroundTruthSettings, SensorSettings, SimulationSettings
 

@@ -14,12 +14,14 @@ def run(repo: Path, *args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run([sys.executable, "-m", *args], cwd=repo, capture_output=True, text=True, timeout=600)
 
 
+@pytest.mark.slow
 def test_ruff_is_clean(repo: Path) -> None:
     folders = [name for name in ("unstack", "tests", "benchmarks", "docs") if (repo / name).is_dir()]
     result = run(repo, "ruff", "check", *folders)
     assert result.returncode == 0, result.stdout + result.stderr
 
 
+@pytest.mark.slow
 def test_mypy_is_clean(repo: Path) -> None:
     result = run(repo, "mypy")
     assert result.returncode == 0, result.stdout + result.stderr

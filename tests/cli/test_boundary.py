@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tests.cli.test_commands import PILE5, unstack
+from tests.conftest import PILE5, unstack
 
 REPO = Path(__file__).resolve().parents[2]
 

@@ -3,28 +3,14 @@
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import jsonschema
 import numpy as np
 import pytest
 
+from tests.conftest import PILE5, unstack
 from unstack.jsonio import load_schema
-
-PILE5 = "examples/pile5.supports.json"
-
-
-def unstack(*args: str, stdin: str | None = None, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "unstack", *args],
-        input=stdin,
-        capture_output=True,
-        text=True,
-        cwd=cwd or Path(__file__).resolve().parents[2],
-        timeout=300,
-    )
 
 
 def test_decide_prints_a_table() -> None:

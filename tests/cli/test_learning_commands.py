@@ -10,10 +10,11 @@ import jsonschema
 import numpy as np
 import pytest
 
-from tests.cli.test_commands import unstack
-from tests.conftest import REPO
+from tests.conftest import REPO, unstack
 from unstack.datasets import list_configurations
 from unstack.jsonio import load_schema
+
+pytestmark = pytest.mark.slow  # trains and evaluates models in subprocesses
 
 SCENE = "examples/pile5.scene.json"
 
@@ -28,7 +29,6 @@ def model(small_dataset: Path, tmp_path_factory: pytest.TempPathFactory) -> Path
     return target
 
 
-@pytest.mark.slow
 def test_train_json_report_holds_hold_out_figures_of_a_model_fitted_on_all_rows(
     small_dataset: Path, tmp_path: Path
 ) -> None:

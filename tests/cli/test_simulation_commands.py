@@ -6,7 +6,9 @@ from pathlib import Path
 
 import pytest
 
-from tests.cli.test_commands import unstack
+from tests.conftest import unstack
+
+pytestmark = pytest.mark.slow  # simulates piles in subprocesses
 
 SMALL = ["--boxes", "3-4", "--sizes", "four", "--depth", "1.0", "--resolution", "96x72", "--min-pixels", "5",
          "--horizon", "0.5"]  # fmt: skip

@@ -8,10 +8,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.cli.test_commands import unstack
-from unstack.experiments.decisions import DECISION_MAKERS, _Iset, _scores, evaluate_decisions, squared_regret
+from tests.conftest import unstack
+from unstack.experiments.decisions import (
+    DECISION_MAKERS,
+    IsetOutcome,
+    decision_scores,
+    evaluate_decisions,
+    squared_regret,
+)
 from unstack.experiments.table1 import OEIS_A000798, PAPER_TABLE_I, table1
 from unstack.learning.model_file import default_model_path, load_model
+
+pytestmark = pytest.mark.slow  # runs experiments on a simulated data set
 
 
 def test_table1_reproduces_the_paper() -> None:
@@ -21,19 +29,19 @@ def test_table1_reproduces_the_paper() -> None:
         assert row["all_worlds"] == 2 ** (row["n"] * (row["n"] - 1))
 
 
-def handmade(costs: list[float], picks: dict[str, int]) -> _Iset:
+def handmade(costs: list[float], picks: dict[str, int]) -> IsetOutcome:
     r = len(costs)
     disturbance = np.column_stack([np.arange(r), np.arange(r) * 0.1])
-    return _Iset("x", [f"b{k}" for k in range(r)], np.array(costs), picks, disturbance, 1.0, 0.0, 0.0)
+    return IsetOutcome("x", [f"b{k}" for k in range(r)], np.array(costs), picks, disturbance, 1.0, 0.0, 0.0)
 
 
 def test_random_scores_are_exact_expectations() -> None:
     iset = handmade([2.0, 0.0, 1.0], {"reasoner": 1, "priors": 0, "highest": 2, "free": 1})
-    random = _scores([iset], "random")
+    random = decision_scores([iset], "random")
     assert random["squared_regret"][0] == pytest.approx((4 + 0 + 1) / 3)
     assert random["first_pick_right"][0] == pytest.approx(1 / 3)
     assert random["moved"][0] == pytest.approx(1.0)
-    chosen = _scores([iset], "priors")
+    chosen = decision_scores([iset], "priors")
     assert chosen["squared_regret"][0] == squared_regret(iset.costs, 0) == 4.0
     assert chosen["first_pick_right"][0] == 0.0 and chosen["moved"][0] == 0
 

@@ -10,6 +10,8 @@ from unstack.learning.model_file import default_model_path, load_model
 from unstack.learning.probabilities import scene_support_probabilities
 from unstack.reasoner.decision import decide
 
+pytestmark = pytest.mark.slow  # decides every canonical scene with the shipped model
+
 
 @pytest.fixture(scope="module")
 def default_model():  # type: ignore[no-untyped-def]

@@ -77,7 +77,7 @@ def reference_cloud(bb_x: np.ndarray, bb_y: np.ndarray, points: np.ndarray) -> l
 @settings(max_examples=40, deadline=None)
 @given(st.integers(0, 2**32 - 1))
 def test_cloud_columns_match_numpy_masks(seed: int) -> None:
-    from unstack.learning.features import bounding_boxes
+    from unstack.geometry import bounding_boxes
 
     rng = np.random.default_rng(seed)
     turns = rng.normal(size=(4, 4))

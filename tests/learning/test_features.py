@@ -61,11 +61,11 @@ def test_kdtree_counts_points_that_coincide_with_a_query() -> None:
 
 
 def test_auto_picks_the_tree_only_for_narrow_kernels(cloud: tuple[np.ndarray, np.ndarray]) -> None:
-    from unstack.learning.features import _choose_method
+    from unstack.learning.features import choose_dbaf_method
 
     points, _ = cloud
-    assert _choose_method(points, 0.5, 1e-9) == "direct"
-    assert _choose_method(points, 0.02, 1e-9) == "kdtree"
+    assert choose_dbaf_method(points, 0.5, 1e-9) == "direct"
+    assert choose_dbaf_method(points, 0.02, 1e-9) == "kdtree"
 
 
 def test_an_empty_cloud_gives_zeros() -> None:

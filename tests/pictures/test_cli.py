@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.cli.test_commands import unstack
+from tests.conftest import unstack
 
 PILE5 = "examples/pile5.scene.json"
 

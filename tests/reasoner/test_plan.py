@@ -9,8 +9,7 @@ import jsonschema
 import numpy as np
 import pytest
 
-from tests.cli.test_commands import unstack
-from tests.conftest import random_probabilities, supports_of
+from tests.conftest import random_probabilities, supports_of, unstack
 from unstack.jsonio import load_schema
 from unstack.reasoner.decision import decide
 from unstack.reasoner.plan import unloading_plan

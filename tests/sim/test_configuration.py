@@ -8,10 +8,13 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from tests.sim.conftest import small_settings
 from unstack.sim.configuration import simulate_configuration
 from unstack.sim.settings import SimulationSettings
+
+pytestmark = pytest.mark.slow  # builds physics worlds
 
 
 def fingerprint(settings: SimulationSettings, seed: int, index: int) -> str:

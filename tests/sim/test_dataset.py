@@ -19,6 +19,8 @@ from unstack.scene import load_scene
 from unstack.sim.dataset import DatasetConflict, SchedulerUnavailable, simulate_dataset
 from unstack.sim.settings import SimulationSettings
 
+pytestmark = pytest.mark.slow  # simulates data sets
+
 
 def digests(folder: Path) -> dict[str, str]:
     """SHA-256 of every configuration file (scene JSON and arrays)."""

@@ -14,6 +14,8 @@ from unstack.sim.ground_truth import removal_responses, support_labels, transiti
 from unstack.sim.settings import SimulationSettings
 from unstack.sim.world import PhysicsWorld
 
+pytestmark = pytest.mark.slow  # runs removals in the physics engine
+
 
 def test_a_column_of_three(settings: SimulationSettings) -> None:
     with PhysicsWorld(settings, door=False) as world:

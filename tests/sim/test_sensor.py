@@ -11,6 +11,8 @@ from unstack.sim.sensor import scan_pile
 from unstack.sim.settings import SensorSettings, SimulationSettings
 from unstack.sim.world import PhysicsWorld
 
+pytestmark = pytest.mark.slow  # renders range images
+
 BOXES = [  # centre, size: in view of the default sensor at the door
     ([0.5, 0.3, 0.2], [0.6, 0.4, 0.4]),
     ([0.7, -0.4, 0.55], [0.4, 0.3, 0.3]),

@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from unstack.geometry import rotation_angles_deg
 from unstack.sim.piles import build_pile
 from unstack.sim.settings import SimulationSettings
 from unstack.sim.world import PhysicsWorld
+
+pytestmark = pytest.mark.slow  # steps the physics engine
 
 
 def stack(world: PhysicsWorld) -> tuple[int, int]:

@@ -53,7 +53,15 @@ import numpy as np
 
 from unstack.sim.settings import DISPLACEMENT_THRESHOLD
 
-__all__ = ["DECISION_MAKERS", "evaluate_decisions", "paired_difference", "squared_regret"]
+__all__ = [
+    "DECISION_MAKERS",
+    "IsetOutcome",
+    "decision_scores",
+    "evaluate_decisions",
+    "iset_outcome",
+    "paired_difference",
+    "squared_regret",
+]
 
 DECISION_MAKERS = ("reasoner", "count", "priors", "highest", "free", "random")
 
@@ -77,7 +85,9 @@ def paired_difference(other: np.ndarray, ours: np.ndarray) -> dict[str, float | 
 
 
 @dataclass(frozen=True)
-class _Iset:
+class IsetOutcome:
+    """One ISet of Fig. 4: its true costs, each decision maker's pick, and what each pick disturbs."""
+
     scene_file: str
     ids: list[str]
     costs: np.ndarray  # ground-truth cost of unloading each box first (Eq. 11)
@@ -110,7 +120,8 @@ def free_pick(boxes: list[Any]) -> int:
     return max(candidates, key=lambda i: heights[i])
 
 
-def _iset_result(scene: Any, ids: list[str], model: Any) -> _Iset:
+def iset_outcome(scene: Any, ids: list[str], model: Any) -> IsetOutcome:
+    """Decide one ISet of a simulated scene with ``model`` and every decision maker; score the picks."""
     from unstack.learning.metrics import classification_report
     from unstack.learning.probabilities import scene_support_probabilities
     from unstack.reasoner.decision import choose, decide
@@ -136,7 +147,7 @@ def _iset_result(scene: Any, ids: list[str], model: Any) -> _Iset:
     rows = displacement[index]
     disturbed = rows > DISPLACEMENT_THRESHOLD
     disturbance = np.column_stack([disturbed.sum(axis=1), np.where(disturbed, rows, 0).sum(axis=1)])
-    return _Iset(
+    return IsetOutcome(
         str(scene.source),
         ids,
         costs,
@@ -148,8 +159,17 @@ def _iset_result(scene: Any, ids: list[str], model: Any) -> _Iset:
     )
 
 
-def _scores(isets: list[_Iset], maker: str) -> dict[str, np.ndarray]:
-    """Per-ISet squared regret, first-pick-right indicator and disturbance for a decision maker."""
+def decision_scores(isets: list[IsetOutcome], maker: str) -> dict[str, np.ndarray]:
+    """Per-ISet squared regret, first-pick-right indicator and disturbance for a decision maker.
+
+    ``random`` is scored by its exact expectation over the ISet's boxes.
+
+    Examples
+    --------
+    >>> outcome = IsetOutcome("s", ["a", "b"], np.array([0.0, 1.0]), {"count": 0}, np.zeros((2, 2)), 1.0, 0.0, 0.0)
+    >>> decision_scores([outcome], "random")["first_pick_right"].tolist()
+    [0.5]
+    """
     if maker == "random":
         regret = np.array([np.mean([squared_regret(s.costs, k) for k in range(len(s.ids))]) for s in isets])
         right = np.array([np.mean(s.costs == s.costs.min()) for s in isets])
@@ -170,7 +190,7 @@ BINS = {
 }
 
 
-def _binned(isets: list[_Iset], scores: dict[str, dict[str, np.ndarray]]) -> dict[str, Any]:
+def _binned(isets: list[IsetOutcome], scores: dict[str, dict[str, np.ndarray]]) -> dict[str, Any]:
     result: dict[str, Any] = {}
     for criterion, edges in BINS.items():
         values = np.array([getattr(s, criterion) for s in isets])
@@ -208,7 +228,7 @@ def evaluate_decisions(
     files = require_configurations(data_dir)
     rng = np.random.default_rng(seed)
     per_scene = int(np.ceil(isets / len(files)))
-    results: list[_Iset] = []
+    results: list[IsetOutcome] = []
     for path in files:
         if len(results) >= isets:
             break
@@ -222,10 +242,10 @@ def evaluate_decisions(
             positions=detected_positions(scene),
         )
         for ids in drawn:
-            results.append(_iset_result(scene, list(ids), model))
+            results.append(iset_outcome(scene, list(ids), model))
             if progress is not None:
                 progress(len(results), isets)
-    scores = {maker: _scores(results, maker) for maker in DECISION_MAKERS}
+    scores = {maker: decision_scores(results, maker) for maker in DECISION_MAKERS}
     summary = {
         maker: {
             "mse_cost": float(values["squared_regret"].mean()),

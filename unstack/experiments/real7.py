@@ -19,7 +19,7 @@ import os
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from unstack.experiments.decisions import DECISION_MAKERS, _iset_result, _scores
+from unstack.experiments.decisions import DECISION_MAKERS, decision_scores, iset_outcome
 
 __all__ = ["PAPER_FIRST_PICK_RIGHT", "PAPER_REAL7", "real7", "summary_rows"]
 
@@ -49,11 +49,11 @@ def real7(
         results = []
         for scene in scenes:
             for ids in itertools.combinations(scene.box_ids, r):
-                results.append(_iset_result(scene, list(ids), model))
+                results.append(iset_outcome(scene, list(ids), model))
                 done += 1
                 if progress is not None:
                     progress(done, total)
-        scores = {maker: _scores(results, maker) for maker in DECISION_MAKERS}
+        scores = {maker: decision_scores(results, maker) for maker in DECISION_MAKERS}
         per_size[str(r)] = {
             "isets": len(results),
             **{

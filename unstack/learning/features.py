@@ -55,7 +55,7 @@ __all__ = [
     "FEATURE_NAMES",
     "FEATURE_SETS",
     "FeatureSettings",
-    "bounding_boxes",
+    "choose_dbaf_method",
     "dbaf",
     "dbaf_features",
     "feature_names",
@@ -176,7 +176,15 @@ def _dbaf_kdtree(points: np.ndarray, queries: np.ndarray, sigma: float, toleranc
     return sums
 
 
-def _choose_method(points: np.ndarray, sigma: float, tolerance: float) -> str:
+def choose_dbaf_method(points: np.ndarray, sigma: float, tolerance: float) -> str:
+    """``"kdtree"`` when the kernel's truncation ball covers a small part of the cloud, else ``"direct"``.
+
+    Examples
+    --------
+    >>> cloud = np.random.default_rng(0).uniform(0, 2, size=(100, 3))
+    >>> choose_dbaf_method(cloud, 0.5, 1e-9), choose_dbaf_method(cloud, 0.02, 1e-9)
+    ('direct', 'kdtree')
+    """
     extent = np.ptp(points, axis=0)
     volume = float(np.prod(np.maximum(extent, 2.0 * sigma)))
     ball = 4.0 / 3.0 * math.pi * _truncation_radius(sigma, tolerance) ** 3
@@ -217,7 +225,7 @@ def dbaf(
     queries = np.ascontiguousarray(queries, dtype=np.float64).reshape(-1, 3)
     if len(points) == 0:
         return np.zeros(len(queries))
-    chosen = _choose_method(points, sigma, tolerance) if method == "auto" else method
+    chosen = choose_dbaf_method(points, sigma, tolerance) if method == "auto" else method
     if chosen == "kdtree":
         sums = _dbaf_kdtree(points, queries, sigma, tolerance)
     else:
