@@ -430,6 +430,7 @@ def _block_update(
     log_weights: np.ndarray,
     cumulative: np.ndarray,
     clean_marginals: np.ndarray,
+    pair_table: np.ndarray,
     successors: np.ndarray,
     predecessors: np.ndarray,
     rng: np.ndarray,
@@ -444,7 +445,8 @@ def _block_update(
     :mod:`unstack.reasoner.block_gibbs`); the block's preorders that respect them are weighed
     by ``log_weights`` and one is drawn. With ``record`` the conditional marginal of every
     pair inside the block is added to ``sums``. A block with no relation across draws from
-    ``cumulative`` and records ``clean_marginals`` (no pass over its table).
+    ``cumulative`` and records ``clean_marginals`` (no pass over its table). ``pair_table``:
+    the table's masks as 0/1 floats, one row per preorder.
     """
     inside = np.int64(0)
     for a in range(size):
@@ -502,9 +504,9 @@ def _block_update(
                 w = np.exp(log_weights[t] - top)
                 total += w
                 if record:
-                    for k in range(_STRIDE * _STRIDE):
-                        if (m >> k) & 1:
-                            pair_sums[k] += w
+                    row = pair_table[t]
+                    for k in range(_STRIDE * _STRIDE):  # vectorised: no branch on the bits
+                        pair_sums[k] += w * row[k]
         if record:
             for a in range(size):
                 for b in range(size):
@@ -572,6 +574,7 @@ def _run_chain(
     block_log_weights: np.ndarray,
     block_cumulative: np.ndarray,
     block_marginals: np.ndarray,
+    block_pairs: np.ndarray,
     block_of: np.ndarray,
 ) -> int:
     """Run ``sweeps`` sweeps of one chain; add the estimates when ``record``."""
@@ -611,6 +614,7 @@ def _run_chain(
                 block_log_weights[k],
                 block_cumulative[k],
                 block_marginals[k],
+                block_pairs[k],
                 successors,
                 predecessors,
                 rng,
@@ -645,6 +649,7 @@ def run_chains(
     block_log_weights: np.ndarray,
     block_cumulative: np.ndarray,
     block_marginals: np.ndarray,
+    block_pairs: np.ndarray,
     block_of: np.ndarray,
 ) -> None:
     """Advance every chain by ``sweeps`` sweeps (chains run in parallel).
@@ -680,5 +685,6 @@ def run_chains(
             block_log_weights,
             block_cumulative,
             block_marginals,
+            block_pairs,
             block_of,
         )

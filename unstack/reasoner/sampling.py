@@ -290,6 +290,7 @@ class _Chains:
                 self.blocks.log_weights,
                 self.blocks.cumulative,
                 self.blocks.marginals,
+                self.blocks.pairs,
                 self.blocks.block_of,
             )
 
