@@ -54,9 +54,20 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
             item.add_marker(pytest.mark.slow)
 
 
+#: Randomised tests run once per seed: an invariant that holds for one draw only is caught.
+SEEDS = (20261122, 1, 2)
+
+
+@pytest.fixture(params=SEEDS, ids=lambda seed: f"seed{seed}")
+def rng(request: pytest.FixtureRequest) -> np.random.Generator:
+    """A seeded generator; every test that takes it runs for each of :data:`SEEDS`."""
+    return np.random.default_rng(request.param)
+
+
 @pytest.fixture
-def rng() -> np.random.Generator:
-    return np.random.default_rng(20261122)
+def fixed_rng() -> np.random.Generator:
+    """One seeded generator, for tests whose fits are too slow to repeat per seed."""
+    return np.random.default_rng(SEEDS[0])
 
 
 @pytest.fixture

@@ -15,6 +15,7 @@ import unstack
 from unstack.errors import InvalidArgument, InvalidFile
 
 
+@pytest.mark.slow
 def test_a_scene_is_decided_through_the_default_model(examples: Path) -> None:
     scene = unstack.load(examples / "pile5.scene.json")
     assert isinstance(scene, unstack.Scene)
@@ -25,6 +26,7 @@ def test_a_scene_is_decided_through_the_default_model(examples: Path) -> None:
     assert supports.metadata["model"].startswith("default:")
 
 
+@pytest.mark.slow
 def test_a_shipped_model_is_named_and_loaded_once(examples: Path) -> None:
     scene = unstack.load_scene(examples / "pile5.scene.json")
     extended = unstack.load_model("extended")

@@ -9,6 +9,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.slow  # imports the CLI in fresh interpreters
+
 # scipy is not on the list: numba imports it at start-up whenever it is installed (its version
 # check in numba/__init__.py), and the learning part depends on it. The reasoner's own code must
 # still not import it (checked below).

@@ -12,9 +12,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 
 import unstack
 from unstack.threads import PARALLEL_KERNELS
+
+pytestmark = pytest.mark.slow  # runs decisions in four threads
 
 
 def _dense(n: int, seed: int) -> unstack.Supports:

@@ -8,8 +8,11 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from tests.conftest import PILE5, unstack
+
+pytestmark = pytest.mark.slow  # runs the CLI in subprocesses
 
 REPO = Path(__file__).resolve().parents[2]
 

@@ -12,6 +12,8 @@ import pytest
 from tests.conftest import PILE5, unstack
 from unstack.jsonio import load_schema
 
+pytestmark = pytest.mark.slow  # runs the CLI in subprocesses
+
 
 def test_decide_prints_a_table() -> None:
     result = unstack("decide", PILE5)

@@ -11,6 +11,8 @@ import pytest
 
 from tests.conftest import REPO
 
+pytestmark = pytest.mark.slow  # builds the mkdocs site
+
 SCHEMAS = sorted((REPO / "unstack" / "schemas").glob("*.schema.json"))
 
 

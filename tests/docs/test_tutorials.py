@@ -12,6 +12,8 @@ import pytest
 from tests.conftest import REPO
 from tests.docs.snippets import Snippet, snippets
 
+pytestmark = pytest.mark.slow  # runs every command and code block of the docs
+
 DOCS = REPO / "docs"
 PYTHON_SNIPPETS = snippets(DOCS, "python")
 CONSOLE_SNIPPETS = [s for s in snippets(DOCS, "console") if not s.code.startswith("pip ")]

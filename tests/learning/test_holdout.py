@@ -9,13 +9,15 @@ from sklearn.metrics import roc_auc_score
 from unstack.learning.classifier import SupportClassifier
 from unstack.learning.holdout import evaluate_holdout, holdout_split, out_of_fold_probabilities
 
+pytestmark = pytest.mark.slow  # fits classifiers with cross-validation
+
 SMALL_GRID = {"svc__estimator__C": [1.0, 10.0], "svc__estimator__gamma": [0.1]}
 MEMORISING_GRID = {"gb__learning_rate": [0.3], "gb__max_leaf_nodes": [31], "gb__max_iter": [200]}
 
 
-def separable(rng: np.random.Generator, n: int = 160) -> tuple[np.ndarray, np.ndarray]:
-    features = rng.normal(size=(n, 19))
-    labels = (features[:, 0] + 0.5 * features[:, 1] + 0.3 * rng.normal(size=n) > 0.6).astype(int)
+def separable(generator: np.random.Generator, n: int = 160) -> tuple[np.ndarray, np.ndarray]:
+    features = generator.normal(size=(n, 19))
+    labels = (features[:, 0] + 0.5 * features[:, 1] + 0.3 * generator.normal(size=n) > 0.6).astype(int)
     return features, labels
 
 
@@ -31,8 +33,8 @@ def test_the_split_covers_every_row_once_and_keeps_groups_whole(seed: int) -> No
     assert len(held_out) == 48
 
 
-def test_the_holdout_scores_a_model_that_never_saw_the_held_out_rows(rng: np.random.Generator) -> None:
-    features, labels = separable(rng)
+def test_the_holdout_scores_a_model_that_never_saw_the_held_out_rows(fixed_rng: np.random.Generator) -> None:
+    features, labels = separable(fixed_rng)
     result = evaluate_holdout(SupportClassifier(cv=3, param_grid=SMALL_GRID, random_state=0), features, labels)
     assert result.validation_metrics["relations"] == len(result.validation_indices) == 48
     assert result.validation_metrics["success_rate"] > 0.7
@@ -43,8 +45,8 @@ def test_the_holdout_scores_a_model_that_never_saw_the_held_out_rows(rng: np.ran
     np.testing.assert_allclose(refit.predict_proba(held_out)[:, 1], result.validation_probabilities)
 
 
-def test_out_of_fold_probabilities_are_not_memorised(rng: np.random.Generator) -> None:
-    features, labels = rng.normal(size=(200, 5)), rng.integers(0, 2, 200)  # nothing to learn
+def test_out_of_fold_probabilities_are_not_memorised(fixed_rng: np.random.Generator) -> None:
+    features, labels = fixed_rng.normal(size=(200, 5)), fixed_rng.integers(0, 2, 200)  # nothing to learn
     model = SupportClassifier(learner="gradient_boosting", cv=4, param_grid=MEMORISING_GRID, random_state=0)
     model.fit(features, labels)
     assert roc_auc_score(labels, model.predict_proba(features)[:, 1]) > 0.95  # the trees memorise their rows
@@ -53,8 +55,8 @@ def test_out_of_fold_probabilities_are_not_memorised(rng: np.random.Generator) -
     assert abs(roc_auc_score(labels, out_of_fold) - 0.5) < 0.15  # but not the held-out folds
 
 
-def test_evaluate_holdout_returns_out_of_fold_probabilities_of_the_training_part(rng: np.random.Generator) -> None:
-    features, labels = separable(rng)
+def test_evaluate_holdout_returns_out_of_fold_probabilities_of_the_training_part(fixed_rng: np.random.Generator) -> None:
+    features, labels = separable(fixed_rng)
     template = SupportClassifier(cv=3, param_grid=SMALL_GRID, random_state=0)
     result = evaluate_holdout(template, features, labels, out_of_fold=True)
     assert result.out_of_fold is not None and result.out_of_fold.shape == result.train_indices.shape

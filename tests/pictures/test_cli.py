@@ -9,6 +9,8 @@ import pytest
 
 from tests.conftest import unstack
 
+pytestmark = pytest.mark.slow  # renders pictures through the CLI in subprocesses
+
 PILE5 = "examples/pile5.scene.json"
 
 

@@ -15,6 +15,8 @@ from unstack.pictures.values import DecisionValues
 from unstack.pictures.view import build_view, hover_text, write_view
 from unstack.scene import Scene
 
+pytestmark = pytest.mark.slow  # writes plotly pages and opens one in headless Chromium
+
 
 def test_the_page_holds_the_decision(wall: Scene, wall_decision: DecisionValues, rng: np.random.Generator) -> None:
     behind = np.column_stack([rng.uniform(1.45, 1.5, 2000), rng.uniform(-1, 1, 2000), rng.uniform(0.3, 1.4, 2000)])

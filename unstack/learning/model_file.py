@@ -5,7 +5,9 @@ A model file is a skops file holding a dict of three entries: ``"format"``
 parameters, validation metrics, the fingerprint of the training data) and ``"estimator"``
 (the fitted scikit-learn pipeline). Loading checks, before anything is built, that every
 type in the file is one skops trusts by default (scikit-learn and numpy types; no custom
-class, no pickle), then validates the metadata against its schema.
+class, no pickle), then reads the metadata: a JSON object whose ``features`` entry must
+rebuild the :class:`FeatureSettings` (there is no JSON Schema for the metadata; a file
+without it, or with settings that do not fit, is refused with one line).
 
 Examples
 --------
