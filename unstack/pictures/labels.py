@@ -17,6 +17,7 @@ False
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from typing import Any
 
@@ -96,21 +97,14 @@ def place_labels(
     for index, (anchor, text) in enumerate(zip(anchors, texts, strict=True)):
         weight = weights[index] if weights is not None else "normal"
         colour = colours[index] if colours is not None else "black"
+        annotate = functools.partial(
+            axes.annotate, text, xy=tuple(anchor), textcoords="offset points", ha="center", va="center",
+            fontsize=fontsize, fontweight=weight, color=colour, zorder=20, annotation_clip=False,
+        )  # fmt: skip
+
         chosen: Any = None
         for offset in _candidates(step, rings):
-            trial = axes.annotate(
-                text,
-                xy=tuple(anchor),
-                xytext=offset,
-                textcoords="offset points",
-                ha="center",
-                va="center",
-                fontsize=fontsize,
-                fontweight=weight,
-                color=colour,
-                zorder=20,
-                annotation_clip=False,
-            )
+            trial = annotate(xytext=offset)
             extent = trial.get_window_extent(renderer).expanded(1.0, 1.0).padded(margin)
             inside = frame.x0 <= extent.x0 and extent.x1 <= frame.x1 and frame.y0 <= extent.y0 and extent.y1 <= frame.y1
             if inside and not any(extent.overlaps(other) for other in taken):
@@ -120,21 +114,8 @@ def place_labels(
             trial.remove()
         offset, extent = chosen if chosen is not None else ((0.0, 0.0), None)
         moved = offset != (0.0, 0.0)
-        label = axes.annotate(
-            text,
-            xy=tuple(anchor),
-            xytext=offset,
-            textcoords="offset points",
-            ha="center",
-            va="center",
-            fontsize=fontsize,
-            fontweight=weight,
-            color=colour,
-            zorder=20,
-            bbox=style,
-            annotation_clip=False,
-            arrowprops={"arrowstyle": "-", "color": "0.25", "lw": 0.6, "shrinkA": 0, "shrinkB": 0} if moved else None,
-        )
+        leader = {"arrowstyle": "-", "color": "0.25", "lw": 0.6, "shrinkA": 0, "shrinkB": 0}
+        label = annotate(xytext=offset, bbox=style, arrowprops=leader if moved else None)
         if extent is None:
             extent = text_extents([label])[0].padded(margin)
         taken.append(extent)
