@@ -38,7 +38,9 @@ def test_table_i_by_exact_engine(n: int, count: int) -> None:
     assert exact_marginals(uniform(n)).consistent_worlds == count
 
 
-@pytest.mark.parametrize(("n", "count"), sorted(TABLE_I.items()))
+@pytest.mark.parametrize(
+    ("n", "count"), [pytest.param(n, count, marks=[pytest.mark.slow] if n == 6 else []) for n, count in TABLE_I.items()]
+)
 def test_table_i_by_sat_enumeration(n: int, count: int) -> None:
     assert len(enumerate_worlds(supports_of(uniform(n)))) == count
 

@@ -33,6 +33,7 @@ def test_a_column_is_unloaded_from_the_top() -> None:
     assert unloading_plan(supports_of(column)).order == ["b3", "b2", "b1", "b0"]
 
 
+@pytest.mark.slow
 def test_plan_command(tmp_path: Path) -> None:
     result = unstack("plan", "examples/pile5.supports.json", "--json", "-o", str(tmp_path / "plan.json"))
     assert result.returncode == 0, result.stderr

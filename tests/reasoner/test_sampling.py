@@ -103,8 +103,15 @@ def test_more_samples_give_smaller_errors(rng: np.random.Generator) -> None:
 
 
 def test_time_limit_bounds_the_run(rng: np.random.Generator) -> None:
+    """A 0.2 s limit ends the run within a generous margin (shared CI machines are slow and noisy)."""
+    import time
+
     p = random_probabilities(rng, 20, "pile")
+    sampled_marginals(p, samples=10, seed=0)  # compile the kernels outside the timed run
+    start = time.perf_counter()
     result = sampled_marginals(p, time_limit=0.2, seed=0)
+    elapsed = time.perf_counter() - start
+    assert elapsed < 0.2 + 5.0, elapsed
     assert result.samples > 0 and len(result.batch_marginals) >= 2 * result.chains
 
 

@@ -51,7 +51,7 @@ def test_marginals_match_the_oracle(matrix: np.ndarray) -> None:
 @pytest.mark.parametrize("hard", [0.0, 0.3])
 def test_five_boxes_match_the_compiled_walk(rng: np.random.Generator, hard: float) -> None:
     """A sixth box with no possible relation sends the same group through the compiled walk."""
-    from unstack.reasoner.marginals import _exact_marginals
+    from unstack.reasoner.marginals import exact_marginals
 
     for _ in range(5):
         p = random_probabilities(5, rng, hard=hard)
@@ -61,7 +61,7 @@ def test_five_boxes_match_the_compiled_walk(rng: np.random.Generator, hard: floa
             continue
         padded = np.zeros((6, 6))
         padded[:5, :5] = p
-        compiled = _exact_marginals(padded)
+        compiled = exact_marginals(padded)
         np.testing.assert_allclose(compiled.marginals[:5, :5], marginals, atol=1e-12)
         assert compiled.consistent_worlds == worlds
         assert compiled.log_partition == pytest.approx(log_partition, abs=1e-9)
