@@ -42,12 +42,18 @@ def supports_of(probabilities: np.ndarray) -> Supports:
     return Supports([f"b{i}" for i in range(len(probabilities))], probabilities)
 
 
-#: Packages whose doctests build physics worlds or run experiments: slow.
-SLOW_DOCTEST_PACKAGES = ("unstack/sim/", "unstack/experiments/")
+#: Modules whose doctests build physics worlds, run experiments, fit or load learned models: slow.
+SLOW_DOCTEST_PACKAGES = (
+    "unstack/sim/",
+    "unstack/experiments/",
+    "unstack/learning/",
+    "unstack/__init__.py",
+    "unstack/api.py",
+)
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """Mark the doctests of the simulator and the experiments slow (they cannot carry a marker)."""
+    """Mark the doctests of :data:`SLOW_DOCTEST_PACKAGES` slow (a doctest cannot carry a marker)."""
     for item in items:
         path = item.path.as_posix()
         if isinstance(item, pytest.DoctestItem) and any(part in path for part in SLOW_DOCTEST_PACKAGES):

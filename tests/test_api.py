@@ -64,6 +64,7 @@ def test_wrong_arguments_are_invalid_arguments(examples: Path) -> None:
         unstack.decide(unstack.load_scene(examples / "pile5.scene.json"), model=3.0)  # type: ignore[arg-type]
 
 
+@pytest.mark.slow
 def test_plan_from_a_scene_and_from_supports(examples: Path) -> None:
     plan = unstack.plan(unstack.load_scene(examples / "pile5.scene.json"), seed=0)
     assert sorted(plan.order) == sorted(plan.objects)
@@ -98,6 +99,7 @@ def test_the_public_api_is_listed_in_the_reference(repo: Path) -> None:
             assert f"unstack.{name}" in reference, name
 
 
+@pytest.mark.slow
 def test_ranking_and_json_of_a_scene_decision(examples: Path) -> None:
     decision = unstack.decide(unstack.load_scene(examples / "pile5.scene.json"))
     ranking = decision.ranking()

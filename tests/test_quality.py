@@ -45,3 +45,9 @@ def test_readme_main_job_names_a_bundled_example(repo: Path) -> None:
     command = readme_command(repo, "<!-- main-job -->")
     example = command.split("unstack decide ", 1)[1].split()[0]
     assert (repo / example).is_file()
+
+
+def test_the_readme_names_the_fast_lane_and_tests_carry_the_slow_marker(repo: Path) -> None:
+    assert readme_command(repo, "<!-- fast-lane -->") == 'pytest -m "not slow"'
+    marked = [path for path in (repo / "tests").rglob("test_*.py") if "pytest.mark.slow" in path.read_text()]
+    assert len(marked) >= 20, marked

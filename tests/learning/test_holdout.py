@@ -55,7 +55,9 @@ def test_out_of_fold_probabilities_are_not_memorised(fixed_rng: np.random.Genera
     assert abs(roc_auc_score(labels, out_of_fold) - 0.5) < 0.15  # but not the held-out folds
 
 
-def test_evaluate_holdout_returns_out_of_fold_probabilities_of_the_training_part(fixed_rng: np.random.Generator) -> None:
+def test_evaluate_holdout_returns_out_of_fold_probabilities_of_the_training_part(
+    fixed_rng: np.random.Generator,
+) -> None:
     features, labels = separable(fixed_rng)
     template = SupportClassifier(cv=3, param_grid=SMALL_GRID, random_state=0)
     result = evaluate_holdout(template, features, labels, out_of_fold=True)

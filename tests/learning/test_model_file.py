@@ -26,6 +26,7 @@ def fitted() -> tuple[SupportClassifier, np.ndarray]:
     return SupportClassifier(cv=3, param_grid=GRID, random_state=0).fit(features, labels), features
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("learner", ["svm", "gradient_boosting", "calibrated_svm"])
 def test_round_trip(tmp_path: Path, learner: str) -> None:
     rng = np.random.default_rng(2)

@@ -21,6 +21,7 @@ def test_isets_are_strict_subsets(detected: int, r: int, size: int, rng: np.rand
     assert len(isets) == (4 if size else 0)
 
 
+@pytest.mark.slow  # simulates the small data set
 def test_labels_are_the_ground_truth(small_dataset: Path) -> None:
     scene = load_scene(list_configurations(small_dataset)[0])
     examples = scene_examples(scene, r=4, isets=3, seed=1)
@@ -31,6 +32,7 @@ def test_labels_are_the_ground_truth(small_dataset: Path) -> None:
     assert examples.features.shape == (3 * 4 * 3, 19)
 
 
+@pytest.mark.slow  # simulates the small data set
 def test_examples_do_not_depend_on_the_number_of_processes(small_dataset: Path) -> None:
     one = dataset_examples(small_dataset, r=4, isets=2, seed=3, n_jobs=1)
     two = dataset_examples(small_dataset, r=4, isets=2, seed=3, n_jobs=2)
@@ -38,6 +40,7 @@ def test_examples_do_not_depend_on_the_number_of_processes(small_dataset: Path) 
     assert sorted(set(one.configuration.tolist())) == list(range(len(list_configurations(small_dataset))))
 
 
+@pytest.mark.slow  # simulates the small data set
 def test_fingerprint_changes_with_the_data(small_dataset: Path, tmp_path: Path) -> None:
     assert dataset_fingerprint(small_dataset) == dataset_fingerprint(small_dataset)
     assert dataset_fingerprint(small_dataset) != dataset_fingerprint(tmp_path)
@@ -60,6 +63,7 @@ def test_neighbour_isets_are_the_nearest_boxes_to_a_centre(rng: np.random.Genera
         )
 
 
+@pytest.mark.slow  # simulates the small data set
 def test_neighbour_isets_hold_more_support_relations(small_dataset: Path) -> None:
     near = dataset_examples(small_dataset, r=4, isets=6, seed=0, draw="neighbours")
     assert near.features.shape[1] == 19 and len(near.labels) > 0

@@ -14,6 +14,8 @@ from unstack.pictures.graph import draw_support_graph, layers, render_support_gr
 from unstack.pictures.panels import HIGHLIGHT
 from unstack.pictures.values import DecisionValues
 
+pytestmark = pytest.mark.slow  # draws full matplotlib figures
+
 
 def test_layers_put_supporters_below(rng: np.random.Generator) -> None:
     n = 12

@@ -17,6 +17,8 @@ from unstack.pictures.render import draw_scene, render_scene
 from unstack.pictures.values import DecisionValues
 from unstack.scene import Scene
 
+pytestmark = pytest.mark.slow  # draws full matplotlib figures
+
 
 def _box_labels(figure: Any) -> list[Any]:
     """The box labels of the sensor view (annotations with text), as drawn."""

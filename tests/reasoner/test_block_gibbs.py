@@ -68,6 +68,7 @@ def test_block_gibbs_agrees_with_the_exact_engine(rng: np.random.Generator, link
     assert np.all(np.abs(costs - exact.sum(axis=1)) <= 5 * np.sqrt(np.diag(covariance)) + 2e-3)
 
 
+@pytest.mark.slow
 def test_hard_evidence_inside_a_block_is_respected(rng: np.random.Generator) -> None:
     p = weak_groups(rng, [4, 4], 0.01)
     p[0, 1] = 1.0

@@ -71,6 +71,7 @@ def test_independent_components_up_to_forty_boxes(rng: np.random.Generator) -> N
     assert np.all(result.marginals[p == 0] == 0.0)
 
 
+@pytest.mark.slow
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(arrays(np.float64, (5, 5), elements=st.sampled_from([0.0, 0.05, 0.3, 0.5, 0.9, 1.0])), st.integers(0, 2**32))
 def test_every_sampled_world_is_consistent_and_respects_evidence(matrix: np.ndarray, seed: int) -> None:
