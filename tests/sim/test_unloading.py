@@ -4,12 +4,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from unstack.datasets import list_configurations
 from unstack.errors import UnstackError
 from unstack.scene import Scene, load_scene
-from unstack.sim.unloading import execute_policy, execute_unloading
+from unstack.sim.unloading import execute_policy, execute_unloading, reachable_boxes, unload_container
 
 pytestmark = pytest.mark.slow  # executes unloading orders in the physics engine
 
@@ -81,3 +82,86 @@ def test_the_next_scan_shows_where_a_disturbed_box_went(pile: Scene) -> None:
 def test_a_policy_must_pick_a_box_left_to_unload(pile: Scene) -> None:
     with pytest.raises(UnstackError, match="the policy picked 'nope', not one of the boxes left to unload"):
         execute_policy(pile, lambda current: "nope", pile.detected)
+
+
+def highest_first(current: Scene) -> str:
+    return max(current.detected, key=lambda box_id: (current.box(box_id).position[2], box_id))
+
+
+@pytest.fixture
+def pile_with_a_hidden_box(small_dataset: Path) -> Scene:
+    """The first pile of the small data set in which the sensor cannot see every box."""
+    for path in list_configurations(small_dataset):
+        scene = load_scene(path)
+        if len(scene.detected) < len(scene.boxes):
+            return scene
+    raise AssertionError("the small data set has no pile with a hidden box")
+
+
+def test_unloading_a_container_detects_again_after_every_pick(pile_with_a_hidden_box: Scene) -> None:
+    pile = pile_with_a_hidden_box
+    seen: list[Scene] = []
+
+    def recording(current: Scene) -> str:
+        seen.append(current)
+        return highest_first(current)
+
+    run = unload_container(pile, recording)
+    assert run.stopped in ("container empty", "nothing detected and reachable")
+    if run.stopped == "container empty":
+        assert sorted(run.order) == sorted(pile.box_ids)
+    assert len(run.order) == len(seen) == len(run.steps) and len(set(run.order)) == len(run.order)
+    candidates = set().union(*(set(current.detected) for current in seen))
+    assert set(run.order) <= candidates
+    hidden = set(pile.box_ids) - set(pile.detected)
+    assert hidden & candidates  # a box the first scan could not see is found once the boxes before it are gone
+    for number, current in enumerate(seen):
+        assert len(current.boxes) == len(pile.boxes) - number
+        assert set(current.detected) <= {box.id for box in current.boxes}
+
+
+def test_a_pick_limit_stops_the_run_and_says_so(pile: Scene) -> None:
+    run = unload_container(pile, highest_first, max_picks=2)
+    assert len(run.order) == 2 and run.stopped == "pick limit"
+    assert run.to_dict()["stopped"] == "pick limit"
+
+
+def test_detector_noise_moves_the_reported_boxes_reproducibly(pile: Scene) -> None:
+    reported: list[list[np.ndarray]] = []
+
+    def recording(current: Scene) -> str:
+        reported.append([box.position.copy() for box in current.boxes])
+        return highest_first(current)
+
+    first = unload_container(pile, recording, detector_noise=0.01, max_picks=1, seed=4)
+    again = unload_container(pile, recording, detector_noise=0.01, max_picks=1, seed=4)
+    assert first.to_dict() == again.to_dict()
+    np.testing.assert_array_equal(reported[0], reported[1])
+    unload_container(pile, recording, max_picks=1, seed=4)  # the true poses
+    errors = np.linalg.norm(np.array(reported[0]) - np.array(reported[2]), axis=1)
+    assert 0 < errors.max() < 0.1
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        ({"reach": "roof"}, "unknown reach rule 'roof'; expected one of door, any"),
+        ({"detector_noise": -0.1}, "detector_noise must be a finite number of metres >= 0, got -0.1"),
+        ({"max_picks": -1}, "max_picks must be at least 0, got -1"),
+    ],
+)
+def test_bad_unloading_settings_are_refused(pile: Scene, arguments: dict[str, object], message: str) -> None:
+    with pytest.raises(UnstackError, match=message):
+        unload_container(pile, highest_first, **arguments)  # type: ignore[arg-type]
+
+
+def test_a_box_blocked_in_front_and_on_top_is_out_of_reach() -> None:
+    from unstack.scene import Box
+
+    blocked = Box("blocked", [0.4, 0.4, 0.4], [0.6, 0.0, 0.2])
+    in_front = Box("in_front", [0.4, 0.4, 0.4], [0.19, 0.0, 0.2])
+    on_top = Box("on_top", [0.4, 0.4, 0.4], [0.6, 0.0, 0.61])
+    beside = Box("beside", [0.4, 0.4, 0.4], [0.6, 0.41, 0.2])
+    boxes = [blocked, in_front, on_top, beside]
+    assert reachable_boxes(boxes, ["blocked", "in_front", "on_top", "beside"]) == ["in_front", "on_top", "beside"]
+    assert reachable_boxes(boxes, ["blocked"], "any") == ["blocked"]

@@ -26,9 +26,10 @@ from pathlib import Path
 
 import numpy as np
 
+from unstack.detector import detector_poses
 from unstack.errors import UnstackError
 from unstack.learning.features import FeatureSettings, pair_features
-from unstack.scene import Box, Scene, load_scene
+from unstack.scene import Scene, load_scene
 
 __all__ = [
     "ISET_DRAWS",
@@ -36,7 +37,6 @@ __all__ = [
     "dataset_examples",
     "dataset_fingerprint",
     "detected_positions",
-    "detector_poses",
     "sample_isets",
     "scene_examples",
 ]
@@ -140,31 +140,6 @@ def sample_isets(
         distances = np.linalg.norm(positions - positions[centre], axis=1)
         nearest = np.argsort(distances, kind="stable")[:size]
         result.append(sorted(detected[k] for k in nearest))
-    return result
-
-
-#: Yaw error of :func:`detector_poses` per metre of position error (degrees per metre).
-YAW_PER_METRE = 200.0
-
-
-def detector_poses(boxes: Sequence[Box], noise: float, rng: np.random.Generator) -> list[Box]:
-    """The boxes as a detector might report them: normal position errors of ``noise`` metres
-    across (x, y) and half of it vertically, yaw errors of ``YAW_PER_METRE * noise`` degrees.
-
-    Examples
-    --------
-    >>> moved = detector_poses([Box("a", [0.4, 0.4, 0.3], [1.0, 0.0, 0.15])], 0.01, np.random.default_rng(0))
-    >>> bool(np.linalg.norm(moved[0].position - [1.0, 0.0, 0.15]) < 0.1)
-    True
-    """
-    from scipy.spatial.transform import Rotation
-
-    result = []
-    for box in boxes:
-        shift = rng.normal(0.0, noise, size=3) * [1.0, 1.0, 0.5]
-        yaw = Rotation.from_euler("z", rng.normal(0.0, YAW_PER_METRE * noise), degrees=True)
-        orientation = (yaw * Rotation.from_quat(box.orientation_xyzw)).as_quat()
-        result.append(Box(box.id, box.size, box.position + shift, orientation, box.mass))
     return result
 
 

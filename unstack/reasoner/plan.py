@@ -1,9 +1,10 @@
 """An unloading plan: repeated decisions, each on the boxes still in place.
 
 Decide on all detected boxes, take the chosen box out of the set, decide again on the rest,
-until every box is taken (the last step decides on a single box). Each step records the chosen box and its expected cost among the
-boxes that remained at that step. The probabilities of the remaining boxes are not
-re-estimated: the plan is what the reasoner would do without a new scan after each pick.
+until every box is taken (the last step decides on a single box). Each step records the
+chosen box and its expected cost among the boxes that remained at that step. The
+probabilities of the remaining boxes are not re-estimated: the plan is what the reasoner
+would do without a new scan after each pick.
 
 The steps share their work (:mod:`unstack.reasoner.reuse`): groups of linked boxes that the
 pick left unchanged keep their marginals, and the group that lost the box is sampled from

@@ -18,6 +18,7 @@ Examples
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -27,10 +28,25 @@ import numpy as np
 from unstack.errors import UnstackError
 from unstack.scene import Scene
 
-__all__ = ["UnloadRun", "UnloadStep", "execute_policy", "execute_unloading"]
+__all__ = [
+    "REACH_RULES",
+    "UnloadRun",
+    "UnloadStep",
+    "execute_policy",
+    "execute_unloading",
+    "reachable_boxes",
+    "unload_container",
+]
 
 #: Seconds of simulation to let a rebuilt pile find its contacts before the first removal.
 RESETTLE_SECONDS = 0.5
+#: Which detected boxes a gripper can take (:func:`reachable_boxes`): ``door`` -- a box whose
+#: door-facing side or top is at most half covered by another box; ``any`` -- every detected box.
+REACH_RULES = ("door", "any")
+#: Share of a face another box may cover before the face is blocked.
+BLOCKED_SHARE = 0.5
+#: How close (metres) a box must come to a face to cover it.
+COVER_GAP = 0.03
 
 
 @dataclass(frozen=True)
@@ -64,6 +80,7 @@ class UnloadRun:
     order: tuple[str, ...]
     steps: tuple[UnloadStep, ...]
     resettle_drift_m: float
+    stopped: str = "order done"
 
     @property
     def boxes_moved(self) -> int:
@@ -80,6 +97,7 @@ class UnloadRun:
             "boxes_moved": self.boxes_moved,
             "displacement_m": self.displacement_m,
             "resettle_drift_m": self.resettle_drift_m,
+            "stopped": self.stopped,
             "steps": [step.to_dict() for step in self.steps],
         }
 
@@ -110,7 +128,7 @@ def execute_unloading(scene: Scene, order: Sequence[str]) -> UnloadRun:
     unknown = [box_id for box_id in order if box_id not in scene.box_ids]
     if unknown or len(set(order)) != len(order):
         raise UnstackError(f"{scene.source}: the order names unknown or repeated boxes: {unknown or list(order)}")
-    return _execute(scene, len(order), lambda number, _world, _in_place: order[number])
+    return _execute(scene, lambda number, _world, _in_place: order[number] if number < len(order) else None)
 
 
 def execute_policy(scene: Scene, policy: Callable[[Scene], str], boxes: Sequence[str]) -> UnloadRun:
@@ -152,11 +170,148 @@ def execute_policy(scene: Scene, policy: Callable[[Scene], str], boxes: Sequence
         remaining.remove(choice)
         return choice
 
-    return _execute(scene, len(remaining), sense_and_pick)
+    return _execute(
+        scene, lambda number, world, in_place: sense_and_pick(number, world, in_place) if remaining else None
+    )
 
 
-def _execute(scene: Scene, count: int, next_box: Callable[[int, Any, list[str]], str]) -> UnloadRun:
-    """Rebuild the pile, then ``count`` times: take out ``next_box(step, world, in_place)`` and measure."""
+def reachable_boxes(boxes: Sequence[Any], candidates: Sequence[str], rule: str = "door") -> list[str]:
+    """The ``candidates`` a gripper at the door can take, by ``rule`` (:data:`REACH_RULES`).
+
+    ``door``: a box is reachable when its door-facing side (the face towards -x) or its top
+    is at most :data:`BLOCKED_SHARE` covered by the axis-aligned bounding box of another box
+    within :data:`COVER_GAP` of that face. ``any``: every candidate.
+
+    Examples
+    --------
+    >>> from unstack.scene import Box
+    >>> front = Box("front", [0.4, 0.4, 0.4], [0.2, 0.0, 0.2])
+    >>> behind = Box("behind", [0.4, 0.4, 0.4], [0.6, 0.0, 0.2])
+    >>> on_top = Box("on_top", [0.4, 0.4, 0.4], [0.6, 0.0, 0.6])
+    >>> reachable_boxes([front, behind, on_top], ["front", "behind", "on_top"])
+    ['front', 'on_top']
+    """
+    from unstack.geometry import bounding_boxes
+
+    if rule not in REACH_RULES:
+        raise UnstackError(f"unknown reach rule {rule!r}; expected one of {', '.join(REACH_RULES)}")
+    if rule == "any":
+        return list(candidates)
+    ids = [box.id for box in boxes]
+    bounds = bounding_boxes(list(boxes))
+
+    def covered(i: int, normal: int, across: tuple[int, int], towards: int) -> bool:
+        """Whether another box covers face ``normal`` of box i (towards -1: its low side, +1: high)."""
+        face = bounds[i]
+        area = np.prod([face[3 + a] - face[a] for a in across])
+        for j in range(len(boxes)):
+            if j == i:
+                continue
+            other = bounds[j]
+            gap = face[normal] - other[3 + normal] if towards < 0 else other[normal] - face[3 + normal]
+            if gap > COVER_GAP or gap < -0.5 * (face[3 + normal] - face[normal]):
+                continue
+            overlap = np.prod([max(0.0, min(face[3 + a], other[3 + a]) - max(face[a], other[a])) for a in across])
+            if overlap > BLOCKED_SHARE * area:
+                return True
+        return False
+
+    result = []
+    for box_id in candidates:
+        i = ids.index(box_id)
+        front_free = not covered(i, 0, (1, 2), -1)
+        top_free = not covered(i, 2, (0, 1), +1)
+        if front_free or top_free:
+            result.append(box_id)
+    return result
+
+
+def unload_container(
+    scene: Scene,
+    policy: Callable[[Scene], str],
+    *,
+    detector_noise: float = 0.0,
+    reach: str = "door",
+    max_picks: int | None = None,
+    seed: int = 0,
+) -> UnloadRun:
+    """Unload the container as a robot does: scan, detect, pick, and again, until it is empty.
+
+    Before every pick the sensor of the scene scans the pile as it is then, and the detected
+    boxes are found again by the rule of the data sets: a box is detected when the sensor sees
+    at least ``sensor.min_pixels`` of it. A box hidden behind others is detected once the boxes
+    in front are gone. The detected boxes the gripper can reach (:func:`reachable_boxes`) are
+    the candidates; ``policy`` gets a scene whose ``detected`` are those candidates, with the
+    poses a detector reports (:func:`unstack.detector.detector_poses` with ``detector_noise``
+    metres; 0 gives the true poses), and the point cloud of the scan. The run stops when the
+    container is empty, after ``max_picks`` picks, or when no box is both detected and
+    reachable (:attr:`UnloadRun.stopped` says which).
+
+    Parameters
+    ----------
+    scene : Scene
+        A simulated scene (``unstack simulate``).
+    policy : callable
+        ``policy(current_scene) -> box id`` among ``current_scene.detected``.
+    detector_noise : float
+        Position error of the detector (metres; yaw errors follow, see :mod:`unstack.detector`).
+    reach : {"door", "any"}
+    max_picks : int, optional
+    seed : int
+        Seeds the scans' depth noise and the detector errors, step by step.
+
+    Returns
+    -------
+    UnloadRun
+    """
+    from unstack.detector import detector_poses
+    from unstack.scene import Box
+    from unstack.sim.sensor import scan_pile
+
+    if reach not in REACH_RULES:
+        raise UnstackError(f"unknown reach rule {reach!r}; expected one of {', '.join(REACH_RULES)}")
+    if not (detector_noise >= 0 and np.isfinite(detector_noise)):
+        raise UnstackError(f"detector_noise must be a finite number of metres >= 0, got {detector_noise}")
+    if max_picks is not None and max_picks < 0:
+        raise UnstackError(f"max_picks must be at least 0, got {max_picks}")
+    settings = _scene_settings(scene)
+    limit = len(scene.boxes) if max_picks is None else min(max_picks, len(scene.boxes))
+    stopped = ["container empty" if limit == len(scene.boxes) else "pick limit"]
+
+    def sense_and_pick(number: int, world: Any, in_place: list[str]) -> str | None:
+        if number >= limit or not in_place:
+            return None
+        positions, orientations = world.poses([world.boxes[scene.box_ids.index(box_id)] for box_id in in_place])
+        true_boxes = [
+            Box(box_id, scene.box(box_id).size, position, orientation, mass=scene.box(box_id).mass)
+            for box_id, position, orientation in zip(in_place, positions, orientations / np.linalg.norm(
+                orientations, axis=1, keepdims=True), strict=True)
+        ]  # fmt: skip
+        step_seed = np.random.SeedSequence(seed, spawn_key=(number,))
+        scan = scan_pile(world, settings.sensor, seed=step_seed)
+        seen = {scene.box_ids[k] for k in np.flatnonzero(scan.pixel_counts >= settings.sensor.min_pixels)}
+        detected = [box_id for box_id in in_place if box_id in seen]
+        candidates = reachable_boxes(true_boxes, detected, reach)
+        if not candidates:
+            stopped[0] = "nothing detected and reachable"
+            return None
+        reported = (
+            detector_poses(true_boxes, detector_noise, np.random.default_rng(step_seed))
+            if detector_noise
+            else true_boxes
+        )
+        current = Scene(reported, scan.points, candidates, metadata=scene.metadata, source=scene.source)
+        choice = policy(current)
+        if choice not in candidates:
+            raise UnstackError(f"{scene.source}: the policy picked {choice!r}, not one of the reachable detected boxes")
+        return choice
+
+    run = _execute(scene, sense_and_pick)
+    return UnloadRun(run.order, run.steps, run.resettle_drift_m, stopped[0])
+
+
+def _execute(scene: Scene, next_box: Callable[[int, Any, list[str]], str | None]) -> UnloadRun:
+    """Rebuild the pile, then take out ``next_box(step, world, in_place)`` and measure, until it says None."""
     from unstack.geometry import rotation_angles_deg
     from unstack.sim.ground_truth import PARKING, run_horizon
     from unstack.sim.world import PhysicsWorld
@@ -175,8 +330,10 @@ def _execute(scene: Scene, count: int, next_box: Callable[[int, Any, list[str]],
         in_place = list(scene.box_ids)
         steps = []
         order = []
-        for number in range(count):
+        for number in itertools.count():
             box_id = next_box(number, world, list(in_place))
+            if box_id is None:
+                break
             order.append(box_id)
             in_place.remove(box_id)
             watched = [bodies[other] for other in in_place]
