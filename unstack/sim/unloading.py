@@ -34,6 +34,7 @@ __all__ = [
     "UnloadStep",
     "execute_policy",
     "execute_unloading",
+    "fallen_boxes",
     "reachable_boxes",
     "unload_container",
 ]
@@ -47,6 +48,10 @@ REACH_RULES = ("door", "any")
 BLOCKED_SHARE = 0.5
 #: How close (metres) a box must come to a face to cover it.
 COVER_GAP = 0.03
+#: A box has fallen when a removal drops it more than this (metres) ...
+FALL_DROP = 0.2
+#: ... or tips it more than this (degrees between its old and new vertical axis).
+FALL_TILT_DEG = 45.0
 
 
 @dataclass(frozen=True)
@@ -57,6 +62,7 @@ class UnloadStep:
     moved: tuple[str, ...]
     displacement_m: float
     max_displacement_m: float
+    fallen: tuple[str, ...] = ()
 
     @property
     def boxes_moved(self) -> int:
@@ -70,6 +76,7 @@ class UnloadStep:
             "boxes_moved": self.boxes_moved,
             "displacement_m": self.displacement_m,
             "max_displacement_m": self.max_displacement_m,
+            "fallen": list(self.fallen),
         }
 
 
@@ -347,12 +354,42 @@ def _execute(scene: Scene, next_box: Callable[[int, Any, list[str]], str | None]
             disturbed = (moved > truth.displacement_threshold) | (
                 rotation_angles_deg(before_turn, after_turn) > truth.rotation_threshold_deg
             )
+            fallen = fallen_boxes(before, before_turn, after, after_turn)
             steps.append(
                 UnloadStep(
                     box_id,
                     tuple(in_place[k] for k in np.flatnonzero(disturbed)),
                     float(moved[disturbed].sum()),
                     float(moved.max(initial=0.0)),
+                    tuple(in_place[k] for k in np.flatnonzero(fallen)),
                 )
             )
     return UnloadRun(tuple(order), tuple(steps), drift)
+
+
+def fallen_boxes(before: np.ndarray, before_turn: np.ndarray, after: np.ndarray, after_turn: np.ndarray) -> np.ndarray:
+    """Which boxes dropped more than :data:`FALL_DROP` or tipped more than :data:`FALL_TILT_DEG`.
+
+    Positions and quaternions (``x, y, z, w``) per row, before and after a removal. Turning
+    about the vertical does not count: only the body axis that stood most upright is followed.
+
+    Examples
+    --------
+    >>> still = np.array([[0.0, 0.0, 0.0, 1.0]] * 3)
+    >>> turned = np.array([[0.0, 0.0, 0.0, 1.0], [0.0, 0.0, 0.7071, 0.7071], [0.7071, 0.0, 0.0, 0.7071]])
+    >>> at = np.zeros((3, 3)); dropped = at - [[0.0, 0.0, 0.3], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]]
+    >>> fallen_boxes(at, still, dropped, turned).tolist()
+    [True, False, True]
+    """
+    from unstack.geometry import rotation_matrix
+
+    dropped = before[:, 2] - after[:, 2] > FALL_DROP
+    tipped = np.zeros(len(before), dtype=bool)
+    for k in range(len(before)):
+        rotation_before = rotation_matrix(before_turn[k] / np.linalg.norm(before_turn[k]))
+        rotation_after = rotation_matrix(after_turn[k] / np.linalg.norm(after_turn[k]))
+        up = int(np.argmax(np.abs(rotation_before[2])))  # the body axis that stood most upright
+        tilt_before = np.degrees(np.arccos(np.clip(abs(rotation_before[2, up]), 0.0, 1.0)))
+        tilt_after = np.degrees(np.arccos(np.clip(abs(rotation_after[2, up]), 0.0, 1.0)))
+        tipped[k] = tilt_after - tilt_before > FALL_TILT_DEG
+    return np.asarray(dropped | tipped)
