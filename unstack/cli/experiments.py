@@ -13,10 +13,12 @@ from unstack.cli.learning import FEATURES_HELP, ISETS_FROM_HELP
 from unstack.cli.main import MODEL_HELP, finite_seconds
 from unstack.cli.progress import progress_bar
 from unstack.errors import UnstackError
+from unstack.experiments.container import CONTAINER_MAKERS, CONTAINER_SAMPLES
 from unstack.learning.classifier import LEARNERS
 from unstack.learning.features import FEATURE_SETS
 from unstack.learning.training import SPLITS
 from unstack.learning.training_data import ISET_DRAWS
+from unstack.sim.unloading import REACH_RULES
 
 __all__ = ["experiment"]
 
@@ -333,6 +335,82 @@ def unload(
         )
     Console().print(table)
     click.echo(f"results in {folder / 'unloading.json'} and {folder / 'unloading.png'}")
+
+
+@experiment.command()
+@click.argument("data_dir", type=click.Path(file_okay=False))
+@click.option("--out", required=True, type=click.Path(), help="Folder for container.json.")
+@click.option("--model", "model_path", default=None, help=MODEL_HELP)
+@click.option("--piles", type=click.IntRange(min=1), default=2, show_default=True, help="Piles (the first N).")
+@click.option("--makers", default=",".join(CONTAINER_MAKERS), show_default=True,
+              help="Comma-separated decision makers.")  # fmt: skip
+@click.option("--detector-noise", type=click.FloatRange(0.0, 0.1), default=0.0, show_default=True,
+              help="Position error of the box detector (m); yaw errors follow.")  # fmt: skip
+@click.option(
+    "--reach",
+    type=click.Choice(list(REACH_RULES)),
+    default="door",
+    show_default=True,
+    help="door: a box whose door-facing side or top is at most half covered; any: every detected box.",
+)
+@click.option("--max-picks", type=click.IntRange(min=1), default=None, help="Stop each pile after this many picks.")
+@click.option("--samples", type=click.IntRange(min=1), default=CONTAINER_SAMPLES, show_default=True,
+              help="Recorded sweeps per sampled group in each decision.")  # fmt: skip
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True)
+@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Piles run in parallel.")
+def container(
+    data_dir: str,
+    out: str,
+    model_path: str | None,
+    piles: int,
+    makers: str,
+    detector_noise: float,
+    reach: str,
+    max_picks: int | None,
+    samples: int,
+    seed: int,
+    jobs: int,
+) -> None:
+    """Empty whole containers as a robot does: scan and detect again before every pick.
+
+    Every decision maker unloads the same piles; boxes moved, fallen and calm picks are
+    compared with unstack's (paired over piles). Resumable: OUT/container-piles keeps each
+    pile's result.
+    """
+    from unstack.cli.main import load_model_option
+    from unstack.datasets import require_configurations
+    from unstack.experiments.container import container_experiment, container_policies
+
+    require_configurations(data_dir)
+    chosen = tuple(name.strip() for name in makers.split(",") if name.strip())
+    model, name = load_model_option(model_path)
+    container_policies(model, seed=seed, makers=chosen)  # an unknown maker is one line, before any work
+    folder = _out(out)
+    with progress_bar("piles") as report:
+        result = container_experiment(
+            data_dir, model, piles=piles, makers=chosen, detector_noise=detector_noise, reach=reach,
+            max_picks=max_picks, samples=samples, seed=seed, progress=report,
+            checkpoints=folder / "container-piles", n_jobs=jobs,
+        )  # fmt: skip
+    result["model"] = name
+    _write_json(folder / "container.json", result)
+    table = Table(title=f"Emptying {result['piles']} piles of {data_dir}, detecting again before every pick")
+    for column in ("decision maker", "picks", "boxes moved", "minus unstack's", "fallen", "minus unstack's", "calm"):
+        table.add_column(column, justify="right")
+    for maker in result["makers"]:
+        row = result["summary"][maker]
+        paired = result["against_unstack"].get(maker, {})
+        table.add_row(
+            maker,
+            f"{row['picks_per_pile']:.1f}",
+            f"{row['boxes_moved_per_pile']:.2f}",
+            _paired(paired.get("boxes_moved")),
+            f"{row['boxes_fallen_per_pile']:.2f}",
+            _paired(paired.get("boxes_fallen")),
+            f"{100 * row['calm_picks_per_pile']:.0f} %",
+        )
+    Console().print(table)
+    click.echo(f"results in {folder / 'container.json'}")
 
 
 @experiment.command()

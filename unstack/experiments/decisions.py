@@ -44,7 +44,7 @@ Examples
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -61,6 +61,7 @@ __all__ = [
     "iset_outcome",
     "paired_difference",
     "squared_regret",
+    "uncovered_boxes",
 ]
 
 DECISION_MAKERS = ("reasoner", "count", "priors", "highest", "free", "random")
@@ -98,12 +99,24 @@ class IsetOutcome:
     average_entropy: float
 
 
-def free_pick(boxes: list[Any]) -> int:
+def uncovered_boxes(boxes: Sequence[Any], among: Sequence[int] | None = None) -> list[int]:
+    """Indices (of ``among``, default all) of the boxes no other box of ``boxes`` covers from above.
+
+    A box covers another when their footprints' bounding boxes overlap by more than 2 cm both
+    ways and it starts at most 5 cm below the other's top and ends above it.
+
+    Examples
+    --------
+    >>> from unstack.scene import Box
+    >>> low, high = Box("low", [0.4, 0.4, 0.4], [0, 0, 0.2]), Box("high", [0.4, 0.4, 0.4], [0, 0, 0.6])
+    >>> uncovered_boxes([low, high])
+    [1]
+    """
     from unstack.geometry import bounding_box_overlap_xy, bounding_boxes
 
-    bounds = bounding_boxes(boxes)
+    bounds = bounding_boxes(list(boxes))
     free = []
-    for i in range(len(boxes)):
+    for i in range(len(boxes)) if among is None else among:
         covered = False
         for j in range(len(boxes)):
             if i == j:
@@ -115,8 +128,13 @@ def free_pick(boxes: list[Any]) -> int:
                 break
         if not covered:
             free.append(i)
+    return free
+
+
+def free_pick(boxes: list[Any]) -> int:
+    """The footprint rule: the highest box that no other covers from above (the highest if all are covered)."""
     heights = [boxes[i].position[2] for i in range(len(boxes))]
-    candidates = free or list(range(len(boxes)))
+    candidates = uncovered_boxes(boxes) or list(range(len(boxes)))
     return max(candidates, key=lambda i: heights[i])
 
 

@@ -1,0 +1,61 @@
+"""Emptying containers as a robot does, with every decision maker."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import unstack
+from unstack.errors import UnstackError
+from unstack.experiments.container import CONTAINER_MAKERS, container_experiment
+from unstack.learning.model_file import default_model_path, load_model
+
+pytestmark = pytest.mark.slow  # physics runs of every decision maker
+
+
+@pytest.fixture(scope="module")
+def result(small_dataset: Path) -> dict[str, object]:
+    model = load_model(default_model_path())
+    return container_experiment(small_dataset, model, piles=1, max_picks=3, samples=64, seed=2)
+
+
+def test_every_maker_unloads_the_same_pile_within_the_pick_limit(result: dict[str, object]) -> None:
+    assert result["makers"] == list(CONTAINER_MAKERS)
+    runs = result["runs"][0]["runs"]  # type: ignore[index]
+    for maker in CONTAINER_MAKERS:
+        assert 1 <= len(runs[maker]["order"]) <= 3
+        assert runs[maker]["stopped"] in ("pick limit", "container empty", "nothing detected and reachable")
+        assert all("fallen" in step for step in runs[maker]["steps"])
+    summary = result["summary"]  # type: ignore[index]
+    assert set(summary["unstack"]) == {  # type: ignore[index]
+        "picks_per_pile", "boxes_moved_per_pile", "boxes_fallen_per_pile", "calm_picks_per_pile", "boxes_moved_per_pick",
+    }  # fmt: skip
+    assert set(result["against_unstack"]) == set(CONTAINER_MAKERS) - {"unstack"}  # type: ignore[arg-type]
+
+
+def test_the_lookahead_first_pick_moves_no_more_than_any_other_makers(result: dict[str, object]) -> None:
+    runs = result["runs"][0]["runs"]  # type: ignore[index]
+    first = {maker: runs[maker]["steps"][0]["boxes_moved"] for maker in CONTAINER_MAKERS}
+    assert first["lookahead"] == min(first.values()), first
+
+
+def test_an_unknown_maker_is_refused_before_any_work(small_dataset: Path) -> None:
+    with pytest.raises(UnstackError, match=r"unknown decision makers \['tallest'\]"):
+        container_experiment(small_dataset, load_model(default_model_path()), makers=("unstack", "tallest"))
+
+
+def test_the_cli_writes_the_results_and_resumes(small_dataset: Path, tmp_path: Path) -> None:
+    arguments = ["experiment", "container", str(small_dataset), "--out", str(tmp_path), "--piles", "1",
+                 "--makers", "unstack,highest,nearest_door", "--max-picks", "2", "--samples", "64"]  # fmt: skip
+    first = unstack(*arguments)
+    assert first.returncode == 0, first.stderr
+    assert "highest" in first.stdout and "container.json" in first.stdout
+    document = json.loads((tmp_path / "container.json").read_text())
+    assert document["makers"] == ["unstack", "highest", "nearest_door"] and document["piles"] == 1
+    again = unstack(*arguments)
+    assert again.returncode == 0, again.stderr
+    assert json.loads((tmp_path / "container.json").read_text())["runs"] == document["runs"]
+    bad = unstack("experiment", "container", str(small_dataset), "--out", str(tmp_path), "--makers", "tallest")
+    assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "unknown decision makers" in bad.stderr
