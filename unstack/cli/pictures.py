@@ -13,6 +13,7 @@ import click
 
 from unstack.cli.main import MODEL_HELP
 from unstack.errors import UnstackError
+from unstack.pictures.render import COLOURINGS
 
 __all__ = ["render", "view"]
 
@@ -95,7 +96,7 @@ def _check_suffix(output: str, suffixes: tuple[str, ...]) -> None:
 @click.argument("file", type=str)
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="PNG or SVG file to write.")
 @click.option("--decision", "decision_file", default=None, help=DECISION_HELP)
-@click.option("--colour", "--color", "colour", type=click.Choice(["cost", "truth", "none"]), default=None,
+@click.option("--colour", "--color", "colour", type=click.Choice(list(COLOURINGS)), default=None,
               help="Colour boxes by expected cost (the default for a scene with detected boxes), by the ground "
               "truth (boxes each supports; no model needed), or grey.")  # fmt: skip
 @click.option("--probabilities", "arrows", is_flag=True,
