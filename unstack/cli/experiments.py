@@ -18,6 +18,7 @@ from unstack.learning.classifier import LEARNERS
 from unstack.learning.features import FEATURE_SETS
 from unstack.learning.training import SPLITS
 from unstack.learning.training_data import ISET_DRAWS
+from unstack.reasoner.costs import COSTS, DEFAULT_COST
 from unstack.sim.unloading import REACH_RULES
 
 __all__ = ["experiment"]
@@ -264,6 +265,8 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of the sampler and the random order.")  # fmt: skip
 @click.option("--full", is_flag=True, help="Every configuration of the data set (overrides --configs).")
+@click.option("--cost", type=click.Choice(list(COSTS)), default=DEFAULT_COST, show_default=True,
+              help="Cost of unstack's decisions: load (hidden load counted), count (Eq. 11) or mass.")  # fmt: skip
 @click.option("--closed-loop", is_flag=True,
               help="Also unstack and highest-first sensing the pile again before each pick (3x slower).")  # fmt: skip
 @click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Piles run in parallel.")
@@ -278,6 +281,7 @@ def unload(
     time_limit: float | None,
     seed: int,
     full: bool,
+    cost: str,
     closed_loop: bool,
     jobs: int,
     scheduler: str | None,
@@ -304,7 +308,7 @@ def unload(
             result = unloading_experiment(
                 data_dir, model, configs=configs, samples=None if time_limit else samples, time_limit=time_limit,
                 seed=seed, progress=report,
-                checkpoints=folder / "unloading-piles", closed_loop=closed_loop, n_jobs=jobs, client=client,
+                checkpoints=folder / "unloading-piles", closed_loop=closed_loop, cost=cost, n_jobs=jobs, client=client,
             )  # fmt: skip
     finally:
         if client is not None:

@@ -42,6 +42,8 @@ from typing import Any
 
 import numpy as np
 
+from unstack.reasoner.costs import DEFAULT_COST
+
 __all__ = [
     "CLOSED_LOOP_MAKERS",
     "UNLOADING_MAKERS",
@@ -74,7 +76,7 @@ def _repeated(pick: Callable[[list[str]], str], boxes: list[str]) -> list[str]:
 
 
 def closed_loop_policies(
-    model: Any, *, seed: int, samples: int | None = None, time_limit: float | None = None
+    model: Any, *, seed: int, samples: int | None = None, time_limit: float | None = None, cost: str = DEFAULT_COST
 ) -> dict[str, Callable[[Any], str]]:
     """The closed-loop decision makers: each maps the freshly sensed scene to the box to take."""
     from unstack.learning.probabilities import scene_support_probabilities
@@ -82,7 +84,7 @@ def closed_loop_policies(
 
     def reasoner(scene: Any) -> str:
         supports = scene_support_probabilities(scene, model)
-        return str(decide(supports, samples=samples, time_limit=time_limit, seed=seed).choice)
+        return str(decide(supports, cost=cost, samples=samples, time_limit=time_limit, seed=seed).choice)
 
     def highest(scene: Any) -> str:
         return str(min(scene.detected, key=lambda box_id: (-scene.box(box_id).position[2], box_id)))
@@ -91,7 +93,13 @@ def closed_loop_policies(
 
 
 def unloading_orders(
-    scene: Any, model: Any, *, seed: int, samples: int | None = None, time_limit: float | None = None
+    scene: Any,
+    model: Any,
+    *,
+    seed: int,
+    samples: int | None = None,
+    time_limit: float | None = None,
+    cost: str = DEFAULT_COST,
 ) -> dict[str, list[str]]:
     """The order of the scene's detected boxes for every decision maker."""
     from unstack.experiments.decisions import free_pick
@@ -101,7 +109,7 @@ def unloading_orders(
 
     supports = scene_support_probabilities(scene, model)
     detected = list(scene.detected)
-    plan = unloading_plan(supports, samples=samples, time_limit=time_limit, seed=seed)
+    plan = unloading_plan(supports, cost=cost, samples=samples, time_limit=time_limit, seed=seed)
 
     def raw_priors(remaining: list[str]) -> str:
         subset = supports.subset(remaining)
@@ -120,7 +128,7 @@ def unloading_orders(
     }
 
 
-def _pile_key(path: Path, model: Any, budget: Budget, seed: int, closed_loop: bool) -> dict[str, Any]:
+def _pile_key(path: Path, model: Any, budget: Budget, seed: int, closed_loop: bool, cost: str) -> dict[str, Any]:
     """What a pile's result depends on: the scene file, the model, the budget, the seed, the makers."""
     import hashlib
     import json
@@ -134,6 +142,7 @@ def _pile_key(path: Path, model: Any, budget: Budget, seed: int, closed_loop: bo
         "time_limit": budget[1],
         "seed": seed,
         "closed_loop": closed_loop,
+        "cost": cost,
     }
 
 
@@ -153,16 +162,18 @@ def _finished_pile(checkpoints: Path | None, key: dict[str, Any]) -> dict[str, A
 
 
 def _run_pile(
-    path: Path, number: int, model: Any, budget: Budget, seed: int, closed_loop: bool
+    path: Path, number: int, model: Any, budget: Budget, seed: int, closed_loop: bool, cost: str = DEFAULT_COST
 ) -> tuple[int, dict[str, Any]]:
     """Every decision maker's run on one pile (``number`` is passed back for the caller's order)."""
     from unstack.scene import load_scene
     from unstack.sim.unloading import execute_policy, execute_unloading
 
     scene = load_scene(path)
-    orders = unloading_orders(scene, model, samples=budget[0], time_limit=budget[1], seed=seed)
+    orders = unloading_orders(scene, model, samples=budget[0], time_limit=budget[1], seed=seed, cost=cost)
     executed = {maker: execute_unloading(scene, orders[maker]).to_dict() for maker in orders}
-    policies = closed_loop_policies(model, samples=budget[0], time_limit=budget[1], seed=seed) if closed_loop else {}
+    policies = {}
+    if closed_loop:
+        policies = closed_loop_policies(model, samples=budget[0], time_limit=budget[1], seed=seed, cost=cost)
     for maker, policy in policies.items():
         executed[maker] = execute_policy(scene, policy, scene.detected).to_dict()
     return number, {"scene": path.name, "boxes": len(scene.boxes), "detected": len(scene.detected), "runs": executed}
@@ -188,6 +199,7 @@ def unloading_experiment(
     progress: Callable[[int, int], None] | None = None,
     checkpoints: str | os.PathLike[str] | None = None,
     closed_loop: bool = False,
+    cost: str = DEFAULT_COST,
     n_jobs: int = 1,
     client: Any = None,
 ) -> dict[str, Any]:
@@ -200,6 +212,7 @@ def unloading_experiment(
     that is stopped and started again with the same scenes, model, budget and seed reuses
     them (resumable). Results do not depend on resuming: each pile has its own seed.
     ``closed_loop``: also run the :data:`CLOSED_LOOP_MAKERS` (about three times slower).
+    ``cost``: the cost of unstack's decisions (:data:`unstack.reasoner.costs.COSTS`).
     ``n_jobs``: piles run in parallel processes; ``client``: on the workers of a
     ``distributed.Client`` instead (the results do not depend on either).
     """
@@ -217,12 +230,12 @@ def unloading_experiment(
     folder = None if checkpoints is None else Path(checkpoints)
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
-    keys = [_pile_key(path, model, budget, seed + number, closed_loop) for number, path in enumerate(files)]
+    keys = [_pile_key(path, model, budget, seed + number, closed_loop, cost) for number, path in enumerate(files)]
     piles: list[dict[str, Any] | None] = [_finished_pile(folder, key) for key in keys]
     todo = [number for number, pile in enumerate(piles) if pile is None]
     if progress is not None:
         progress(len(files) - len(todo), len(files))
-    arguments = [(files[number], number, model, budget, seed + number, closed_loop) for number in todo]
+    arguments = [(files[number], number, model, budget, seed + number, closed_loop, cost) for number in todo]
     if client is None:
         results = Parallel(n_jobs=n_jobs, return_as="generator_unordered")(
             delayed(_run_pile)(*task) for task in arguments
@@ -265,6 +278,7 @@ def unloading_experiment(
         "samples": samples,
         "time_limit": time_limit,
         "seed": seed,
+        "cost": cost,
         "makers": list(makers),
         "summary": summary,
         "against_reasoner": against_reasoner,
