@@ -18,15 +18,14 @@ pytestmark = pytest.mark.slow  # physics runs of every decision maker
 @pytest.fixture(scope="module")
 def result(small_dataset: Path) -> dict[str, object]:
     model = load_model(default_model_path())
-    return container_experiment(small_dataset, model, piles=1, max_picks=3, samples=64, seed=2)
+    return container_experiment(small_dataset, model, piles=1, max_picks=1, samples=64, seed=2)
 
 
-def test_every_maker_unloads_the_same_pile_within_the_pick_limit(result: dict[str, object]) -> None:
+def test_every_maker_picks_from_the_same_pile_up_to_the_pick_limit(result: dict[str, object]) -> None:
     assert result["makers"] == list(CONTAINER_MAKERS)
     runs = result["runs"][0]["runs"]  # type: ignore[index]
     for maker in CONTAINER_MAKERS:
-        assert 1 <= len(runs[maker]["order"]) <= 3
-        assert runs[maker]["stopped"] in ("pick limit", "container empty", "nothing detected and reachable")
+        assert len(runs[maker]["order"]) == 1 and runs[maker]["stopped"] == "pick limit"
         assert all("fallen" in step for step in runs[maker]["steps"])
     summary = result["summary"]  # type: ignore[index]
     assert set(summary["unstack"]) == {  # type: ignore[index]
@@ -48,12 +47,12 @@ def test_an_unknown_maker_is_refused_before_any_work(small_dataset: Path) -> Non
 
 def test_the_cli_writes_the_results_and_resumes(small_dataset: Path, tmp_path: Path) -> None:
     arguments = ["experiment", "container", str(small_dataset), "--out", str(tmp_path), "--piles", "1",
-                 "--makers", "unstack,highest,nearest_door", "--max-picks", "2", "--samples", "64"]  # fmt: skip
+                 "--makers", "unstack,highest", "--max-picks", "1", "--samples", "64"]  # fmt: skip
     first = unstack(*arguments)
     assert first.returncode == 0, first.stderr
     assert "highest" in first.stdout and "container.json" in first.stdout
     document = json.loads((tmp_path / "container.json").read_text())
-    assert document["makers"] == ["unstack", "highest", "nearest_door"] and document["piles"] == 1
+    assert document["makers"] == ["unstack", "highest"] and document["piles"] == 1
     again = unstack(*arguments)
     assert again.returncode == 0, again.stderr
     assert json.loads((tmp_path / "container.json").read_text())["runs"] == document["runs"]
