@@ -156,19 +156,13 @@ def execute_policy(scene: Scene, policy: Callable[[Scene], str], boxes: Sequence
     boxes : sequence of str
         The boxes to unload (typically the scene's detected boxes).
     """
-    from unstack.scene import Box
     from unstack.sim.sensor import scan_pile
 
     settings = _scene_settings(scene)
     remaining = list(boxes)
 
     def sense_and_pick(number: int, world: Any, in_place: list[str]) -> str:
-        positions, orientations = world.poses([world.boxes[scene.box_ids.index(box_id)] for box_id in in_place])
-        current_boxes = [
-            Box(box_id, scene.box(box_id).size, position, orientation, mass=scene.box(box_id).mass)
-            for box_id, position, orientation in zip(in_place, positions, orientations / np.linalg.norm(
-                orientations, axis=1, keepdims=True), strict=True)
-        ]  # fmt: skip
+        current_boxes = _boxes_in_place(scene, world, in_place)
         scan = scan_pile(world, settings.sensor, seed=number)
         current = Scene(current_boxes, scan.points, remaining, metadata=scene.metadata, source=scene.source)
         choice = policy(current)
@@ -272,7 +266,6 @@ def unload_container(
     UnloadRun
     """
     from unstack.detector import detector_poses
-    from unstack.scene import Box
     from unstack.sim.sensor import scan_pile
 
     if reach not in REACH_RULES:
@@ -288,12 +281,7 @@ def unload_container(
     def sense_and_pick(number: int, world: Any, in_place: list[str]) -> str | None:
         if number >= limit or not in_place:
             return None
-        positions, orientations = world.poses([world.boxes[scene.box_ids.index(box_id)] for box_id in in_place])
-        true_boxes = [
-            Box(box_id, scene.box(box_id).size, position, orientation, mass=scene.box(box_id).mass)
-            for box_id, position, orientation in zip(in_place, positions, orientations / np.linalg.norm(
-                orientations, axis=1, keepdims=True), strict=True)
-        ]  # fmt: skip
+        true_boxes = _boxes_in_place(scene, world, in_place)
         step_seed = np.random.SeedSequence(seed, spawn_key=(number,))
         scan = scan_pile(world, settings.sensor, seed=step_seed)
         seen = {scene.box_ids[k] for k in np.flatnonzero(scan.pixel_counts >= settings.sensor.min_pixels)}
@@ -315,6 +303,18 @@ def unload_container(
 
     run = _execute(scene, sense_and_pick)
     return UnloadRun(run.order, run.steps, run.resettle_drift_m, stopped[0])
+
+
+def _boxes_in_place(scene: Scene, world: Any, in_place: list[str]) -> list[Any]:
+    """The scene's boxes still in place, at their poses in ``world`` now."""
+    from unstack.scene import Box
+
+    positions, orientations = world.poses([world.boxes[scene.box_ids.index(box_id)] for box_id in in_place])
+    unit = orientations / np.linalg.norm(orientations, axis=1, keepdims=True)
+    return [
+        Box(box_id, scene.box(box_id).size, position, orientation, mass=scene.box(box_id).mass)
+        for box_id, position, orientation in zip(in_place, positions, unit, strict=True)
+    ]
 
 
 def _execute(scene: Scene, next_box: Callable[[int, Any, list[str]], str | None]) -> UnloadRun:
