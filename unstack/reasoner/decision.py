@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from unstack.errors import InvalidArgument, NoConsistentWorld, UnstackError
+from unstack.errors import InvalidArgument, NoConsistentWorld
 from unstack.reasoner.arguments import check_budget, check_choice, check_count, check_seed
 from unstack.reasoner.components import support_components
 from unstack.reasoner.confidence import choice_probability
@@ -36,7 +36,7 @@ from unstack.reasoner.costs import COSTS, DEFAULT_COST, cost_weights, expected_c
 from unstack.reasoner.marginals import EXACT_MAX_BOXES
 from unstack.reasoner.pruning import Evidence, propagate_evidence
 from unstack.reasoner.reuse import WARM_BURN_IN, WorkCache
-from unstack.reasoner.sampling import SAMPLING_MAX_BOXES, SampledMarginals
+from unstack.reasoner.sampling import SampledMarginals
 from unstack.supports import Supports
 
 __all__ = [
@@ -248,34 +248,14 @@ def choose(objects: tuple[str, ...], costs: np.ndarray) -> tuple[str, tuple[str,
     return tied[0], tied
 
 
-def _group_methods(
-    method: str, sizes: list[int], n: int, time_limit: float | None, max_boxes: int | None = None
-) -> list[str]:
-    """The method of each group of linked boxes (``sizes``: boxes per group, of ``n``)."""
+def _group_methods(method: str, sizes: list[int], time_limit: float | None, max_boxes: int | None = None) -> list[str]:
+    """The method of each group of linked boxes (``sizes``: boxes per group)."""
     if method != "auto":
         return [method] * len(sizes)
     exact_limit = EXACT_MAX_BOXES if max_boxes is None else max_boxes
     if time_limit is not None and time_limit < AUTO_EXACT8_SECONDS:
         exact_limit = min(exact_limit, 7)
-    methods = []
-    for size in sizes:
-        if size <= exact_limit:
-            methods.append("exact")
-        elif size <= SAMPLING_MAX_BOXES:
-            methods.append("approx")
-        else:
-            raise _too_large_to_sample(size, n)
-    return methods
-
-
-def _too_large_to_sample(largest: int, n: int) -> UnstackError:
-    from unstack.errors import TooLarge
-
-    where = f"{largest} linked boxes" if largest == n else f"a group of {largest} linked boxes (of {n})"
-    return TooLarge(
-        f"{where}: the sampler holds at most {SAMPLING_MAX_BOXES} boxes per group of boxes linked by "
-        "non-zero support probabilities; decide on a subset of the detected boxes"
-    )
+    return ["exact" if size <= exact_limit else "approx" for size in sizes]
 
 
 @dataclass
@@ -430,7 +410,7 @@ def decide(
         ``exact``: weighted counting of preorders (no world list; a table of every preorder
         up to 5 boxes, a compiled walk up to 8 by default); ``sat``: list the consistent
         worlds with CaDiCaL (up to 6 boxes); ``approx``: Markov chain Monte Carlo over
-        consistent worlds, with standard errors (up to 63 boxes per group); ``auto``: per
+        consistent worlds, with standard errors (any number of boxes); ``auto``: per
         group of linked boxes, exact up to 8 boxes (7 when ``time_limit`` is under 10 s),
         sampling above.
     cost : {"load", "count", "mass"}
@@ -494,7 +474,7 @@ def decide(
     weights = cost_weights(supports, cost)
     evidence = _propagate(supports)
     groups = support_components(evidence.probabilities)
-    methods = _group_methods(method, [len(group) for group in groups], n, time_limit, max_boxes)
+    methods = _group_methods(method, [len(group) for group in groups], time_limit, max_boxes)
     seeds = _group_seeds(len(groups), seed)
     deadline = None if time_limit is None else start + time_limit
     waiting = sum(len(group) for group, method in zip(groups, methods, strict=True) if method == "approx")

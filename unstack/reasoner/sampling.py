@@ -51,23 +51,21 @@ from typing import Any
 
 import numpy as np
 
-from unstack.errors import InvalidArgument, TooLarge
+from unstack.errors import InvalidArgument
 from unstack.reasoner.arguments import check_budget, check_count, check_matrix, check_seed
+from unstack.reasoner.world_masks import mask_words, pack, unpack
 from unstack.threads import PARALLEL_KERNELS
 
 __all__ = [
     "DEFAULT_CHAINS",
     "DEFAULT_SAMPLES",
     "DEFAULT_TRIES",
-    "SAMPLING_MAX_BOXES",
     "SampledMarginals",
     "restrict_worlds",
     "sample_worlds",
     "sampled_marginals",
 ]
 
-#: Bit masks of 64-bit integers hold a state: at most 63 boxes per group.
-SAMPLING_MAX_BOXES = 63
 #: Independent chains (they run on all cores).
 DEFAULT_CHAINS = 8
 #: Recorded sweeps (over all chains) when neither ``samples`` nor ``time_limit`` is given:
@@ -113,9 +111,9 @@ class SampledMarginals:
     seed : int or None
     seconds : float
         Wall time.
-    final_worlds : numpy.ndarray, shape (chains, n), int64, optional
-        Last state of every chain (bit masks of the boxes each box supports): a warm start
-        for a related scene (see ``start`` of :func:`sampled_marginals`).
+    final_worlds : numpy.ndarray, shape (chains, n) or (chains, n, words), int64, optional
+        Last state of every chain (bit masks of the boxes each box supports, in the layout
+        of :mod:`unstack.reasoner.world_masks`): a warm start for a related scene.
     """
 
     marginals: np.ndarray
@@ -169,37 +167,33 @@ class SampledMarginals:
         return result
 
 
-def _start_state(probabilities: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _start_state(probabilities: np.ndarray, *, wide: bool) -> tuple[np.ndarray, np.ndarray]:
     """Bit masks of the transitive closure of the relations forced by probability 1."""
     n = probabilities.shape[0]
     reach = probabilities >= 1.0
     np.fill_diagonal(reach, False)
-    for k in range(n):  # Warshall: small n, runs once
+    for k in range(n):  # Warshall: runs once
         reach |= reach[:, k : k + 1] & reach[k : k + 1, :]
     np.fill_diagonal(reach, False)
     if np.any(reach & (probabilities <= 0.0)):
         raise InvalidArgument(
             "the relations forced by probability 1 imply one of probability 0; propagate evidence first"
         )
-    bits = np.left_shift(np.int64(1), np.arange(n, dtype=np.int64))
-    successors = (reach * bits[None, :]).sum(axis=1).astype(np.int64)
-    predecessors = (reach * bits[:, None]).sum(axis=0).astype(np.int64)
-    return successors, predecessors
+    return pack(reach, wide=wide), pack(reach.T, wide=wide)
 
 
-def _transposed(successors: np.ndarray, n: int) -> np.ndarray:
-    """Predecessor masks from successor masks (``(..., n)`` int64 arrays)."""
-    bits = np.left_shift(np.int64(1), np.arange(n, dtype=np.int64))
-    member = (successors[..., :, None] & bits) != 0  # [..., i, j]: i supports j
-    result: np.ndarray = (member * bits[:, None]).sum(axis=-2).astype(np.int64)
-    return result
+def _transposed(successors: np.ndarray, n: int, *, wide: bool) -> np.ndarray:
+    """Predecessor masks from successor masks (``(chains, n)`` or ``(chains, n, words)``)."""
+    return pack(np.swapaxes(unpack(successors, n, wide=wide), -1, -2), wide=wide)
 
 
 def restrict_worlds(worlds: np.ndarray, keep: np.ndarray) -> np.ndarray:
     """Chain states on the boxes ``keep`` (indices, in order) from states on more boxes.
 
     A preorder restricted to a subset of the boxes is a preorder of the subset, so the
-    result is a consistent start for :func:`sampled_marginals` on those boxes.
+    result is a consistent start for :func:`sampled_marginals` on those boxes. ``worlds``:
+    ``(chains, n)`` masks, or ``(chains, n, words)`` for more than 63 boxes
+    (:mod:`unstack.reasoner.world_masks`); the result has the layout of ``len(keep)`` boxes.
 
     Examples
     --------
@@ -207,10 +201,10 @@ def restrict_worlds(worlds: np.ndarray, keep: np.ndarray) -> np.ndarray:
     [[2, 0]]
     """
     keep = np.asarray(keep, dtype=np.int64)
-    member = (worlds[..., keep, None] >> keep) & 1  # [..., a, b]: keep[a] supports keep[b]
-    bits = np.left_shift(np.int64(1), np.arange(len(keep), dtype=np.int64))
-    result: np.ndarray = (member * bits).sum(axis=-1).astype(np.int64)
-    return result
+    wide = worlds.ndim == 3
+    n = worlds.shape[1]
+    relation = unpack(worlds, n, wide=wide)[:, keep][:, :, keep]
+    return pack(relation)
 
 
 def _log_tables(probabilities: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -230,7 +224,9 @@ class _Chains:
     """The state of ``chains`` chains on one probability matrix, started and burnt in.
 
     Each chain starts from the closure of the hard evidence, takes one sweep of every first
-    proposal (scattered starts), then ``burn_in`` ordinary sweeps.
+    proposal (scattered starts), then ``burn_in`` ordinary sweeps. Groups of up to 63 boxes
+    run the one-word kernels (:mod:`unstack.reasoner._sampler_kernels`), larger ones the
+    word-array kernels (:mod:`unstack.reasoner._wide_kernels`); ``wide=True`` forces the latter.
     """
 
     def __init__(
@@ -243,19 +239,22 @@ class _Chains:
         tries: int,
         blocks: bool = True,
         start: np.ndarray | None = None,
+        wide: bool | None = None,
     ) -> None:
-        from unstack.reasoner._sampler_kernels import run_chains
         from unstack.reasoner.block_gibbs import block_tables, strong_blocks
 
         n = probabilities.shape[0]
-        if n > SAMPLING_MAX_BOXES:
-            raise TooLarge(f"{n} linked boxes: the sampler holds at most {SAMPLING_MAX_BOXES} boxes per group")
+        self.wide = mask_words(n) > 0 if wide is None else wide
+        if self.wide:
+            from unstack.reasoner._wide_kernels import run_chains
+        else:
+            from unstack.reasoner._sampler_kernels import run_chains
         self._run = run_chains
         self.probabilities = probabilities
         self.log_tables = _log_tables(probabilities)
-        successors, predecessors = _start_state(probabilities)
-        self.successors = np.repeat(successors[None, :], chains, axis=0)
-        self.predecessors = np.repeat(predecessors[None, :], chains, axis=0)
+        successors, predecessors = _start_state(probabilities, wide=self.wide)
+        self.successors = np.repeat(successors[None], chains, axis=0)
+        self.predecessors = np.repeat(predecessors[None], chains, axis=0)
         self.rng = _chain_seeds(seed, chains)
         self.tries = tries
         self.accepted = np.zeros(chains, dtype=np.int64)
@@ -265,7 +264,7 @@ class _Chains:
             self.advance(1, scatter=True)
         else:
             self.successors[:] = start
-            self.predecessors[:] = _transposed(start, n)
+            self.predecessors[:] = _transposed(start, n, wide=self.wide)
         self.advance(burn_in)
 
     def advance(self, sweeps: int, *, record: bool = False, scatter: bool = False) -> None:
@@ -305,6 +304,7 @@ def sampled_marginals(
     burn_in: int = DEFAULT_BURN_IN,
     tries: int = DEFAULT_TRIES,
     blocks: bool = True,
+    wide: bool | None = None,
 ) -> SampledMarginals:
     """Estimate the conditional marginals of the consistent worlds by MCMC.
 
@@ -331,6 +331,10 @@ def sampled_marginals(
         Redraw blocks of strongly linked boxes exactly after every sweep and record their
         exact conditional marginals (:mod:`unstack.reasoner.block_gibbs`); ``False`` runs
         the single-box moves alone.
+    wide : bool, optional
+        Run the word-array kernels (any number of boxes) even for 63 boxes or fewer, where
+        they give the same numbers as the default one-word kernels, only more slowly; by
+        default they run for groups of 64 boxes and more.
 
     Returns
     -------
@@ -340,8 +344,6 @@ def sampled_marginals(
     ------
     InvalidArgument
         Not a square probability matrix, or a budget, seed or count out of its domain.
-    TooLarge
-        More than :data:`SAMPLING_MAX_BOXES` boxes.
     """
     start = time.perf_counter()  # loading the compiled kernels counts against the time limit
     p = check_matrix(probabilities)
@@ -356,6 +358,7 @@ def sampled_marginals(
         tries=tries,
         start=start,
         blocks=blocks,
+        wide=wide,
     )
 
 
@@ -385,16 +388,17 @@ def _sampled_marginals(
     start: float | None = None,
     blocks: bool = True,
     warm: np.ndarray | None = None,
+    wide: bool | None = None,
 ) -> SampledMarginals:
-    """:func:`sampled_marginals` on checked arguments; ``warm``: ``(chains, n)`` consistent
-    starting worlds (skips the scattering sweep)."""
+    """:func:`sampled_marginals` on checked arguments; ``warm``: consistent starting worlds,
+    one per chain (skips the scattering sweep)."""
     start = time.perf_counter() if start is None else start
     n = p.shape[0]
     if samples is None and time_limit is None:
         samples = DEFAULT_SAMPLES
     deadline = None if time_limit is None else start + time_limit
     per_chain = None if samples is None else -(-samples // chains)
-    state = _Chains(p, chains=chains, seed=seed, burn_in=burn_in, tries=tries, blocks=blocks, start=warm)
+    state = _Chains(p, chains=chains, seed=seed, burn_in=burn_in, tries=tries, blocks=blocks, start=warm, wide=wide)
 
     batches = np.zeros((chains, _MAX_BATCHES, n, n))
     batch_length = _ROUND_SWEEPS  # sweeps per chain in one batch
@@ -487,9 +491,8 @@ def sample_worlds(
     _check_sampling(None, None, seed, burn_in=burn_in, tries=tries)
     n = p.shape[0]
     state = _Chains(p, chains=1, seed=seed, burn_in=burn_in, tries=tries)
-    bits = np.left_shift(np.int64(1), np.arange(n, dtype=np.int64))
     draws = np.zeros((worlds, n, n), dtype=bool)
     for k in range(worlds):
         state.advance(thin)
-        draws[k] = (state.successors[0][:, None] & bits[None, :]) != 0
+        draws[k] = unpack(state.successors[0], n, wide=state.wide)
     return draws

@@ -1,0 +1,68 @@
+"""The word-array sampler kernels (groups of 64 boxes and more) against the one-word ones."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from unstack.reasoner.consistency import is_transitive
+from unstack.reasoner.sampling import restrict_worlds, sample_worlds, sampled_marginals
+from unstack.reasoner.world_masks import pack, unpack
+
+
+def weak_groups(rng: np.random.Generator, groups: int, size: int, link: float) -> np.ndarray:
+    """Dense groups of ``size`` boxes, every pair across ``link``."""
+    n = groups * size
+    p = np.full((n, n), link)
+    for g in range(groups):
+        block = slice(g * size, (g + 1) * size)
+        p[block, block] = rng.uniform(0.05, 0.95, (size, size))
+    np.fill_diagonal(p, 0.0)
+    return p
+
+
+@pytest.mark.parametrize("shape", [(1, 7), (3, 4), (4, 5)])
+def test_both_kernels_give_the_same_numbers(rng: np.random.Generator, shape: tuple[int, int]) -> None:
+    """Same seed, same moves, same random numbers: identical estimates and final states
+    (one dense group; groups with blocks drawn exactly)."""
+    p = weak_groups(rng, *shape, 1e-3)
+    seed = int(rng.integers(2**31))
+    one_word = sampled_marginals(p, samples=64, seed=seed)
+    words = sampled_marginals(p, samples=64, seed=seed, wide=True)
+    assert np.array_equal(one_word.marginals, words.marginals)
+    assert np.array_equal(one_word.standard_errors, words.standard_errors)
+    assert one_word.acceptance == words.acceptance
+    assert words.final_worlds is not None and words.final_worlds.shape == (8, len(p), 1)
+    assert np.array_equal(one_word.final_worlds, words.final_worlds[..., 0])
+
+
+def test_more_than_63_boxes_sample_transitive_worlds(rng: np.random.Generator) -> None:
+    """A 70-box group (two words per set): every drawn world is transitive, relations reach
+    across the word boundary, and a restriction to few boxes is a world in the one-word layout."""
+    p = rng.uniform(0.0, 0.05, (70, 70))
+    p[60:68, 60:68] = rng.uniform(0.3, 0.9, (8, 8))  # a dense group across bit 63 / 64
+    np.fill_diagonal(p, 0.0)
+    worlds = sample_worlds(p, 4, seed=int(rng.integers(2**31)), burn_in=4)
+    assert all(is_transitive(world) for world in worlds)
+    assert worlds[:, 60:64, 64:68].any() or worlds[:, 64:68, 60:64].any()
+    masks = pack(worlds)
+    assert masks.shape == (4, 70, 2)
+    keep = np.array([1, 62, 63, 64, 65, 69])
+    restricted = restrict_worlds(masks, keep)
+    assert restricted.shape == (4, 6)
+    assert np.array_equal(unpack(restricted, 6), worlds[:, keep][:, :, keep])
+
+
+def test_more_than_63_boxes_agree_with_the_groups_alone(rng: np.random.Generator) -> None:
+    """14 groups of 5 with links of 1e-6: the marginals inside each group are the group's
+    exact ones to within the links' effect, and every relation across stays near 1e-6."""
+    from unstack.reasoner.marginals import exact_marginals
+
+    p = weak_groups(rng, 14, 5, 1e-6)
+    result = sampled_marginals(p, samples=64, seed=int(rng.integers(2**31)))
+    for g in range(14):
+        block = slice(5 * g, 5 * g + 5)
+        exact = exact_marginals(p[block, block]).marginals
+        assert np.abs(result.marginals[block, block] - exact).max() < 1e-3
+    across = np.kron(1 - np.eye(14), np.ones((5, 5))).astype(bool)
+    assert result.marginals[across].max() < 1e-3
