@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -15,6 +16,11 @@ REPO = Path(__file__).resolve().parents[1]
 EXAMPLES = REPO / "examples"
 #: The five-box example supports file, relative to the repository (the CLI runs there).
 PILE5 = "examples/pile5.supports.json"
+
+# The suite runs on every core (pytest-xdist, ``-n auto``): one OpenMP thread per worker and per
+# CLI subprocess, or scikit-learn's boosting oversubscribes the cores and a 6 s fit takes a minute.
+if "PYTEST_XDIST_WORKER" in os.environ:
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 
 def unstack(*args: str, stdin: str | None = None, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
