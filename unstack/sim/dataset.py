@@ -130,8 +130,13 @@ def _save_configuration(folder: Path, result: SimulatedConfiguration) -> None:
     stem = config_name(result.index)
     atomic_save_array(folder / f"{stem}.point_boxes.npy", result.point_boxes.astype(np.int32))
     result.scene.save(folder / f"{stem}.json", points_file=f"{stem}.points.npy")
-    with open(folder / TIMINGS, "a", encoding="utf-8") as handle:
-        handle.write(json.dumps({"index": result.index, **{k: round(v, 4) for k, v in result.timings.items()}}) + "\n")
+    _append_timings(folder / TIMINGS, {"index": result.index, **{k: round(v, 4) for k, v in result.timings.items()}})
+
+
+def _append_timings(path: Path, record: dict[str, Any]) -> None:
+    """Add one line to the timings log by rewriting it whole (atomically: never a half line)."""
+    previous = path.read_text(encoding="utf-8") if path.exists() else ""
+    atomic_write_text(path, previous + json.dumps(record) + "\n")
 
 
 def _statistics(folder: Path) -> dict[str, Any]:
