@@ -53,8 +53,10 @@ def test_evaluate_prints_the_confusion_matrix_and_a_reliability_diagram(
     assert result.returncode == 0, result.stderr
     assert "balanced error rate (Eq. 16)" in result.stdout and "average entropy (Eq. 15)" in result.stdout
     assert (tmp_path / "r.png").read_bytes()[:4] == b"\x89PNG"
+    assert "at the paper's SUPP recall (78.4 %) the best not-SUPP recall is" in result.stdout
     report = json.loads(unstack("evaluate", str(model), str(small_dataset), "--r", "4", "--json").stdout)
     assert report["relations"] == report["supp"] + report["not_supp"]
+    assert 0.0 <= report["fig5a"]["not_supp_recall"] <= 1.0 and report["fig5a"]["paper_not_supp_recall"] == 0.875
 
 
 def test_probabilities_of_a_scene(model: Path, small_dataset: Path, tmp_path: Path) -> None:

@@ -13,6 +13,7 @@ from unstack.learning.metrics import (
     balanced_error_rate,
     classification_report,
     confusion_counts,
+    not_supp_recall_at,
     save_reliability_diagram,
 )
 
@@ -54,3 +55,19 @@ def test_reliability_diagram_png(tmp_path: Path, rng: np.random.Generator) -> No
     target = tmp_path / "reliability.png"
     save_reliability_diagram(report, target)
     assert target.read_bytes()[:4] == b"\x89PNG" and [p.name for p in tmp_path.iterdir()] == ["reliability.png"]
+
+
+def test_not_supp_recall_at_matches_a_threshold_sweep(rng: np.random.Generator) -> None:
+    truth = rng.random(300) < 0.3
+    probability = np.clip(truth * 0.3 + rng.random(300) * 0.7, 0.0, 1.0)
+    target = 0.784
+    best = max(
+        float(np.mean(probability[~truth] < threshold))
+        for threshold in np.unique(probability)
+        if np.mean(probability[truth] >= threshold) >= target
+    )
+    assert not_supp_recall_at(truth, probability, target) == pytest.approx(best)
+
+
+def test_not_supp_recall_at_is_nan_without_both_classes() -> None:
+    assert np.isnan(not_supp_recall_at([1, 1], [0.2, 0.9], 0.5))

@@ -211,19 +211,29 @@ def evaluate(
 ) -> None:
     """Score a model (a file or a shipped model's name) on a data set: confusion matrix,
     success rate, BER, entropy, calibration."""
+    from unstack.experiments.fig5a import paper_point
     from unstack.learning.metrics import classification_report, save_reliability_diagram
 
     if r < 2 or isets < 1 or jobs < 1:
         raise UnstackError("expected --r >= 2, --isets >= 1 and --jobs >= 1")
     model, _ = load_support_model(model_file)
     examples = _examples(data_dir, r, isets, seed, jobs, model.features, draw, pose_noise=pose_noise)
-    report = classification_report(examples.labels, model.support_probability(examples.features))
+    probability = model.support_probability(examples.features)
+    report = classification_report(examples.labels, probability)
+    report["fig5a"] = paper_point(examples.labels, probability)
     if reliability:
         save_reliability_diagram(report, reliability, title=f"{model_file} on {data_dir}")
     if as_json:
         click.echo(json.dumps({"model": model_file, "data": data_dir, **report}, indent=2))
         return
-    Console().print(metrics_view(report, f"{model_file} on {data_dir}: confusion matrix (Fig. 5 layout)"))
+    console = Console()
+    console.print(metrics_view(report, f"{model_file} on {data_dir}: confusion matrix (Fig. 5 layout)"))
+    point = report["fig5a"]
+    console.print(
+        f"ROC AUC {point['auc']:.3f}; at the paper's SUPP recall ({100 * point['supp_recall']:.1f} %) "
+        f"the best not-SUPP recall is {100 * point['not_supp_recall']:.1f} % "
+        f"(paper: {100 * point['paper_not_supp_recall']:.1f} %)"
+    )
 
 
 @click.command()

@@ -22,7 +22,15 @@ from typing import Any, cast
 
 import numpy as np
 
-__all__ = ["PAPER_FIG_5A", "balanced_threshold", "fig5a", "plot_fig5a", "recall_threshold", "validation_roc"]
+__all__ = [
+    "PAPER_FIG_5A",
+    "balanced_threshold",
+    "fig5a",
+    "paper_point",
+    "plot_fig5a",
+    "recall_threshold",
+    "validation_roc",
+]
 
 #: The paper's Fig. 5a: 145 of 185 SUPP and 351 of 401 not-SUPP validation relations right.
 PAPER_FIG_5A: dict[str, Any] = {
@@ -75,15 +83,39 @@ def validation_roc(truth: np.ndarray, probability: np.ndarray, *, points: int = 
     """
     from sklearn.metrics import roc_auc_score, roc_curve
 
+    from unstack.learning.metrics import not_supp_recall_at
+
     false_positive, true_positive, _ = roc_curve(truth, probability)
     grid = np.linspace(0.0, 1.0, points)
-    # the best not-SUPP recall among thresholds whose SUPP recall reaches the paper's
-    reaching = true_positive >= PAPER_FIG_5A["supp_recall"]
     return {
         "auc": float(roc_auc_score(truth, probability)),
         "not_supp_recall": grid.tolist(),
         "supp_recall": [float(true_positive[false_positive <= 1.0 - level].max()) for level in grid],
-        "not_supp_recall_at_paper_supp_recall": float(1.0 - false_positive[reaching].min()),
+        "not_supp_recall_at_paper_supp_recall": not_supp_recall_at(truth, probability, PAPER_FIG_5A["supp_recall"]),
+    }
+
+
+def paper_point(truth: np.ndarray, probability: np.ndarray) -> dict[str, float]:
+    """Where a model's ROC curve passes the paper's Fig. 5a point: the AUC, and the best
+    not-SUPP recall at the paper's SUPP recall beside the paper's own.
+
+    Examples
+    --------
+    >>> point = paper_point(np.array([0, 0, 1, 1]), np.array([0.1, 0.6, 0.4, 0.9]))
+    >>> point["auc"], point["not_supp_recall"], point["paper_not_supp_recall"]
+    (0.75, 0.5, 0.875)
+    """
+    from sklearn.metrics import roc_auc_score
+
+    from unstack.learning.metrics import not_supp_recall_at
+
+    truth = np.asarray(truth).astype(bool)
+    both = bool(truth.any() and not truth.all())
+    return {
+        "auc": float(roc_auc_score(truth, probability)) if both else float("nan"),
+        "supp_recall": PAPER_FIG_5A["supp_recall"],
+        "not_supp_recall": not_supp_recall_at(truth, probability, PAPER_FIG_5A["supp_recall"]),
+        "paper_not_supp_recall": PAPER_FIG_5A["not_supp_recall"],
     }
 
 

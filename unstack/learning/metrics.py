@@ -25,6 +25,7 @@ __all__ = [
     "classification_report",
     "confusion_counts",
     "expected_calibration_error",
+    "not_supp_recall_at",
     "reliability_curve",
     "save_reliability_diagram",
 ]
@@ -105,6 +106,36 @@ def expected_calibration_error(truth: Any, probability: Any, bins: int = 10) -> 
         if count:
             total += count * abs(observed - predicted)
     return round(total / actual.size, 12)
+
+
+def not_supp_recall_at(truth: Any, probability: Any, supp_recall: float) -> float:
+    """One point of the ROC curve: the best not-SUPP recall of any threshold whose SUPP recall
+    reaches ``supp_recall`` (how Fig. 5a's point is compared with a curve).
+
+    Parameters
+    ----------
+    truth : array_like of {0, 1}
+    probability : array_like of float
+    supp_recall : float
+        The SUPP recall to reach, in [0, 1].
+
+    Returns
+    -------
+    float
+        NaN when one class is missing.
+
+    Examples
+    --------
+    >>> not_supp_recall_at([0, 0, 1, 1], [0.1, 0.6, 0.4, 0.9], 1.0)
+    0.5
+    """
+    from sklearn.metrics import roc_curve
+
+    actual = np.asarray(truth).astype(bool)
+    if actual.all() or not actual.any():
+        return float("nan")
+    false_positive, true_positive, _ = roc_curve(actual, np.asarray(probability, dtype=np.float64))
+    return float(1.0 - false_positive[true_positive >= supp_recall].min())
 
 
 def classification_report(truth: Any, probability: Any) -> dict[str, Any]:
