@@ -59,6 +59,19 @@ def metrics_view(report: dict[str, Any], title: str) -> Group:
     return Group(confusion, summary)
 
 
+def data_sets_view(reports: dict[str, dict[str, Any]]) -> Table:
+    """The hold-out figures of each pooled data set: relations, the two recalls at 0.5, ECE."""
+    table = Table(title="hold-out figures by data set", title_justify="left")
+    for column in ("data set", "relations", "SUPP", "SUPP recall", "not-SUPP recall", "ECE"):
+        table.add_column(column, justify="left" if column == "data set" else "right")
+    for name, report in reports.items():
+        table.add_row(
+            name, str(report["relations"]), str(report["supp"]), f"{100 * report['supp_recall']:.1f} %",
+            f"{100 * report['not_supp_recall']:.1f} %", f"{report['expected_calibration_error']:.3f}",
+        )  # fmt: skip
+    return table
+
+
 ISETS_FROM_HELP = "How ISets are drawn: random detected boxes, or a detected box and its nearest neighbours."
 FEATURES_HELP = (
     "paper: the 19 numbers of Eq. 6; extended: those and 17 contact features (gaps, overlaps, cloud); "
@@ -180,6 +193,8 @@ def train(
     console.print(Text.assemble(("chosen: ", "bold"), params, f"  (cross-validated score {score:.3f})"))
     if validation:
         console.print(metrics_view(validation, "hold-out confusion matrix (Fig. 5 layout)"))
+        if "by_data_set" in validation:
+            console.print(data_sets_view(validation["by_data_set"]))
         console.print("(of a model fitted on the rest; the saved model is fitted on all relations)")
     console.print(f"model written to {output}")
 

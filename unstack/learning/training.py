@@ -30,6 +30,7 @@ __all__ = [
     "CONFIGURATION_OFFSET",
     "SPLITS",
     "TrainingRun",
+    "holdout_by_data_set",
     "pooled_examples",
     "train_support_model",
     "training_provenance",
@@ -176,11 +177,55 @@ def train_support_model(
     )
     classifier = clone(template).fit(examples.features, examples.labels, groups=groups)
     training = {**(provenance or {}), "split_by": split_by, "validation_size": validation_size, "fitted_on": "all"}
+    validation = None
+    if holdout is not None:
+        data = (provenance or {}).get("data")
+        names = data if isinstance(data, list) else None
+        validation = {**holdout.validation_metrics, **holdout_by_data_set(examples, holdout, names)}
     model = SupportModel.from_classifier(
         classifier,
         settings,
         training=training,
         training_features=examples.features,
-        validation=None if holdout is None else holdout.validation_metrics,
+        validation=validation,
     )
     return TrainingRun(model, holdout)
+
+
+def holdout_by_data_set(
+    examples: SupportExamples, holdout: HoldoutResult, names: Sequence[str] | None = None
+) -> dict[str, Any]:
+    """The hold-out figures of each pooled data set apart (``{"by_data_set": {name: report}}``).
+
+    Rows belong to the data set their configuration number says (:data:`CONFIGURATION_OFFSET`);
+    ``names`` are the folders in pooling order (default ``"0"``, ``"1"``...). A run on one
+    data set gives ``{}``. Each report is
+    :func:`~unstack.learning.metrics.classification_report` without its reliability bins.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from unstack.learning.training_data import SupportExamples
+    >>> from unstack.learning.holdout import HoldoutResult
+    >>> examples = SupportExamples(
+    ...     np.zeros((4, 1)), np.array([1, 0, 1, 0]), np.array([0, 0, 100000, 100000]), np.zeros(4, int), []
+    ... )
+    >>> holdout = HoldoutResult(None, np.array([], int), np.arange(4), True, np.array([0.9, 0.2, 0.3, 0.1]), {}, None)
+    >>> figures = holdout_by_data_set(examples, holdout, ["wall", "stacked"])["by_data_set"]
+    >>> figures["wall"]["supp_recall"], figures["stacked"]["supp_recall"]
+    (1.0, 0.0)
+    """
+    from unstack.learning.metrics import classification_report
+
+    folder = examples.configuration[holdout.validation_indices] // CONFIGURATION_OFFSET
+    numbers = sorted(set(folder.tolist()))
+    if len(numbers) < 2:
+        return {}
+    labels = examples.labels[holdout.validation_indices]
+    reports = {}
+    for number in numbers:
+        rows = folder == number
+        report = classification_report(labels[rows], holdout.validation_probabilities[rows])
+        report.pop("reliability")
+        reports[names[number] if names is not None else str(number)] = report
+    return {"by_data_set": reports}
