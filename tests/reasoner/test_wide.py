@@ -24,16 +24,20 @@ def weak_groups(rng: np.random.Generator, groups: int, size: int, link: float) -
 @pytest.mark.parametrize("shape", [(1, 7), (3, 4), (4, 5)])
 def test_both_kernels_give_the_same_numbers(rng: np.random.Generator, shape: tuple[int, int]) -> None:
     """Same seed, same moves, same random numbers: identical estimates and final states
-    (one dense group; groups with blocks drawn exactly)."""
+    without blocks; with blocks (linked ones sum precomputed weights in the word-array
+    kernels) the same to rounding."""
     p = weak_groups(rng, *shape, 1e-3)
     seed = int(rng.integers(2**31))
-    one_word = sampled_marginals(p, samples=64, seed=seed)
-    words = sampled_marginals(p, samples=64, seed=seed, wide=True)
+    one_word = sampled_marginals(p, samples=64, seed=seed, blocks=False)
+    words = sampled_marginals(p, samples=64, seed=seed, blocks=False, wide=True)
     assert np.array_equal(one_word.marginals, words.marginals)
     assert np.array_equal(one_word.standard_errors, words.standard_errors)
     assert one_word.acceptance == words.acceptance
     assert words.final_worlds is not None and words.final_worlds.shape == (8, len(p), 1)
     assert np.array_equal(one_word.final_worlds, words.final_worlds[..., 0])
+    with_blocks = sampled_marginals(p, samples=64, seed=seed)
+    wide_blocks = sampled_marginals(p, samples=64, seed=seed, wide=True)
+    np.testing.assert_allclose(wide_blocks.marginals, with_blocks.marginals, rtol=0.0, atol=1e-12)
 
 
 def test_more_than_63_boxes_sample_transitive_worlds(rng: np.random.Generator) -> None:
@@ -66,3 +70,19 @@ def test_more_than_63_boxes_agree_with_the_groups_alone(rng: np.random.Generator
         assert np.abs(result.marginals[block, block] - exact).max() < 1e-3
     across = np.kron(1 - np.eye(14), np.ones((5, 5))).astype(bool)
     assert result.marginals[across].max() < 1e-3
+
+
+def test_rare_sweeps_across_weak_links_widen_the_errors(rng: np.random.Generator) -> None:
+    """Two groups of 4 joined by 1e-4: the blocks' exact marginals hide the rare sweeps with a
+    relation across, so the batch means alone gave standard errors far below the true error
+    (53 % coverage); with the rare-event floor every EC lies within 3 standard errors."""
+    from unstack.reasoner.marginals import exact_marginals
+
+    p = weak_groups(rng, 2, 4, 1e-4)
+    result = sampled_marginals(p, samples=4096, seed=int(rng.integers(2**31)))
+    costs, covariance = result.errors_of(np.ones(8))
+    errors = np.sqrt(np.diag(covariance))
+    floor = result.rare_event_floor(np.ones(8))
+    assert result.link_rates is not None and np.all(result.link_rates * result.samples < 30)
+    assert np.all(floor > 0) and np.all(errors >= floor)
+    assert np.all(np.abs(costs - exact_marginals(p).marginals.sum(axis=1)) <= 3 * errors)

@@ -19,6 +19,9 @@ from numba import njit, prange
 
 from unstack.reasoner._sampler_kernels import _STRIDE, _uniform
 
+#: Below this a linked block's sum of table weights is redone in scaled log space.
+_SMALLEST_TOTAL = 1e-250
+
 
 @njit(cache=True, nogil=True, inline="always")
 def _has(mask: np.ndarray, k: int) -> bool:
@@ -65,35 +68,51 @@ def _decide_side(
     """:func:`unstack.reasoner._sampler_kernels._decide_side` on word arrays; the decided set
     is written to ``inside`` (``outside``: scratch). Returns ``(log proposal, log forced)``."""
     words = inside.shape[0]
-    inside[:] = 0
-    outside[:] = 0
+    constrained = False  # the other side is decided and not empty
+    for w in range(words):
+        inside[w] = 0
+        outside[w] = 0
+        if other_side[w] != 0:
+            constrained = True
     log_proposal = 0.0
     log_forced = 0.0
     for k in order:
         word = k >> 6
         bit = np.int64(1) << (k & 63)
-        allowed = True
-        for w in range(words):
-            rest = other_side[w] & ~backward[k, w]
-            if w == word:
-                rest &= ~bit
-            if rest != 0:
-                allowed = False
+        forced_in = False
+        for w in range(words):  # direct indexing: no array views in the innermost loop
+            if backward[k, w] & inside[w]:
+                forced_in = True
                 break
-        if _meets(backward[k], inside):
+        if forced_in:
             inside[word] |= bit
             log_forced += log_present[x, k]
-        elif (not allowed) or _meets(forward[k], outside):
+            continue
+        excluded = False
+        if constrained:
+            for w in range(words):
+                rest = other_side[w] & ~backward[k, w]
+                if w == word:
+                    rest &= ~bit
+                if rest != 0:
+                    excluded = True
+                    break
+        if not excluded:
+            for w in range(words):
+                if forward[k, w] & outside[w]:
+                    excluded = True
+                    break
+        if excluded:
             outside[word] |= bit
             log_forced += log_absent[x, k]
+            continue
+        member = (replay[word] & bit) != 0 if replaying else _uniform(rng, chain) < probabilities[x, k]
+        if member:
+            inside[word] |= bit
+            log_proposal += log_present[x, k]
         else:
-            member = (replay[word] & bit) != 0 if replaying else _uniform(rng, chain) < probabilities[x, k]
-            if member:
-                inside[word] |= bit
-                log_proposal += log_present[x, k]
-            else:
-                outside[word] |= bit
-                log_proposal += log_absent[x, k]
+            outside[word] |= bit
+            log_proposal += log_absent[x, k]
     return log_proposal, log_forced
 
 
@@ -315,6 +334,7 @@ def _block_update(
     count: int,
     masks: np.ndarray,
     log_weights: np.ndarray,
+    linear_weights: np.ndarray,
     cumulative: np.ndarray,
     clean_marginals: np.ndarray,
     pair_table: np.ndarray,
@@ -328,7 +348,14 @@ def _block_update(
     inside: np.ndarray,
 ) -> None:
     """:func:`unstack.reasoner._sampler_kernels._block_update` on word arrays (``inside``:
-    scratch for the block's set of boxes). The block's table masks stay one word."""
+    scratch for the block's set of boxes). The block's table masks stay one word.
+
+    One difference: a block linked across sums the table's ``linear_weights``
+    (``exp(log_weights)``, computed once) instead of calling ``exp`` for every preorder of the
+    table at every update -- 5 to 10 times faster on 150 boxes linked by 1e-2, where most
+    blocks are linked -- unless those allowed all underflow. The draws can then differ from
+    the one-word kernels' in the last bits of a cumulative sum.
+    """
     words = successors.shape[1]
     inside[:] = 0
     for a in range(size):
@@ -378,24 +405,32 @@ def _block_update(
                     forced |= bit
                 elif excluded:
                     forbidden |= bit
-        top = -np.inf
-        for t in range(count):
-            m = masks[t]
-            if (m & forbidden) == 0 and (m & forced) == forced and log_weights[t] > top:
-                top = log_weights[t]
-        if top == -np.inf:
-            return  # cannot happen from a consistent state of non-zero weight
-        total = 0.0
-        pair_sums[:] = 0.0
-        for t in range(count):
-            m = masks[t]
-            if (m & forbidden) == 0 and (m & forced) == forced:
-                weight = np.exp(log_weights[t] - top)
-                total += weight
-                if record:
-                    row = pair_table[t]
-                    for k in range(_STRIDE * _STRIDE):
-                        pair_sums[k] += weight * row[k]
+        # the table's own weights (largest 1) first; exp(log weight - top) only if those
+        # allowed here all underflow (extreme probabilities)
+        top = 0.0
+        scaled = False
+        while True:
+            total = 0.0
+            pair_sums[:] = 0.0
+            for t in range(count):
+                m = masks[t]
+                if (m & forbidden) == 0 and (m & forced) == forced:
+                    weight = np.exp(log_weights[t] - top) if scaled else linear_weights[t]
+                    total += weight
+                    if record:
+                        row = pair_table[t]
+                        for k in range(_STRIDE * _STRIDE):
+                            pair_sums[k] += weight * row[k]
+            if total > _SMALLEST_TOTAL or scaled:
+                break
+            scaled = True
+            top = -np.inf
+            for t in range(count):
+                m = masks[t]
+                if (m & forbidden) == 0 and (m & forced) == forced and log_weights[t] > top:
+                    top = log_weights[t]
+            if top == -np.inf:
+                return  # cannot happen from a consistent state of non-zero weight
         if record:
             for a in range(size):
                 for b in range(size):
@@ -407,7 +442,7 @@ def _block_update(
             m = masks[t]
             if (m & forbidden) == 0 and (m & forced) == forced:
                 pick = m
-                target -= np.exp(log_weights[t] - top)
+                target -= np.exp(log_weights[t] - top) if scaled else linear_weights[t]
                 if target < 0.0:
                     break
     for a in range(size):
@@ -457,12 +492,18 @@ def _run_chain(
     block_counts: np.ndarray,
     block_masks: np.ndarray,
     block_log_weights: np.ndarray,
+    block_linear_weights: np.ndarray,
     block_cumulative: np.ndarray,
     block_marginals: np.ndarray,
     block_pairs: np.ndarray,
     block_of: np.ndarray,
+    moves: int,
+    cursors: np.ndarray,
 ) -> int:
-    """Run ``sweeps`` sweeps of one chain; add the estimates when ``record``."""
+    """Run ``sweeps`` sweeps of one chain; add the estimates when ``record``.
+
+    A sweep re-inserts ``moves`` boxes, the next ones in turn from ``cursors[chain]`` (all
+    boxes, in order, when ``moves == n``: the sweep of the one-word kernels)."""
     n = probabilities.shape[0]
     words = successors.shape[1]
     pair_sums = np.zeros(_STRIDE * _STRIDE)
@@ -475,7 +516,9 @@ def _run_chain(
     accepted = 0
     for _ in range(sweeps):
         _flip_pairs(probabilities, successors, predecessors, rng, chain)
-        for x in range(n):
+        for _ in range(moves):
+            x = cursors[chain]
+            cursors[chain] = (x + 1) % n
             if _reinsert(
                 x, probabilities, log_present, log_absent, successors, predecessors, order, rng, chain, tries,
                 candidates_supported, candidates_supporters, log_ratios, scatter, scratch,
@@ -484,8 +527,8 @@ def _run_chain(
         for k in range(block_sizes.shape[0]):
             _block_update(
                 block_members[k], block_sizes[k], block_counts[k], block_masks[k], block_log_weights[k],
-                block_cumulative[k], block_marginals[k], block_pairs[k], successors, predecessors, rng, chain,
-                record, sums, pair_sums, inside,
+                block_linear_weights[k], block_cumulative[k], block_marginals[k], block_pairs[k], successors,
+                predecessors, rng, chain, record, sums, pair_sums, inside,
             )  # fmt: skip
         if record:
             _add_conditionals(probabilities, successors, predecessors, sums, block_of)
@@ -511,15 +554,19 @@ def run_chains(
     block_counts: np.ndarray,
     block_masks: np.ndarray,
     block_log_weights: np.ndarray,
+    block_linear_weights: np.ndarray,
     block_cumulative: np.ndarray,
     block_marginals: np.ndarray,
     block_pairs: np.ndarray,
     block_of: np.ndarray,
+    moves: int,
+    cursors: np.ndarray,
 ) -> None:
-    """:func:`unstack.reasoner._sampler_kernels.run_chains` with ``(chains, n, words)`` states."""
+    """:func:`unstack.reasoner._sampler_kernels.run_chains` with ``(chains, n, words)`` states;
+    a sweep re-inserts ``moves`` boxes, in turn from ``cursors`` (``(chains,)``, updated)."""
     for c in prange(successors.shape[0]):
         accepted[c] += _run_chain(
             c, probabilities, log_present, log_absent, successors[c], predecessors[c], rng, sweeps, tries, record,
             sums[c], scatter, block_members, block_sizes, block_counts, block_masks, block_log_weights,
-            block_cumulative, block_marginals, block_pairs, block_of,
+            block_linear_weights, block_cumulative, block_marginals, block_pairs, block_of, moves, cursors,
         )  # fmt: skip

@@ -46,6 +46,7 @@ True
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -53,13 +54,16 @@ import numpy as np
 
 from unstack.errors import InvalidArgument
 from unstack.reasoner.arguments import check_budget, check_count, check_matrix, check_seed
-from unstack.reasoner.world_masks import mask_words, pack, unpack
+from unstack.reasoner.world_masks import ONE_WORD_BOXES, mask_words, pack, unpack
 from unstack.threads import PARALLEL_KERNELS
 
 __all__ = [
     "DEFAULT_CHAINS",
     "DEFAULT_SAMPLES",
     "DEFAULT_TRIES",
+    "RARE_SWEEPS",
+    "WIDE_MOVES",
+    "WIDE_SAMPLES",
     "SampledMarginals",
     "restrict_worlds",
     "sample_worlds",
@@ -73,11 +77,24 @@ DEFAULT_CHAINS = 8
 #: ``benchmarks/data`` (2 cores, both busy with other work): 0.98-1.07 s per group; 1024 and
 #: 2048 sweeps took 0.34-0.37 s and 0.53-0.62 s (worst summed EC error 0.11 and 0.08 vs 0.06).
 DEFAULT_SAMPLES = 4096
+#: The default budget of a group of more than 63 boxes: its sweeps cost more (about 1 ms
+#: for 150 boxes on one core against 0.06 ms for 40). On 150 boxes in 30 groups of 5 linked
+#: by 1e-3 the worst EC error was 0.016-0.025 with 1024 sweeps and 0.013-0.017 with 2048
+#: (benchmarks page, "Hundreds of boxes").
+WIDE_SAMPLES = 2048
 #: Proposals per move. Measured on the classifier matrices of two 39-40-box piles (1 s,
 #: 4 seeds each, 2 free cores, against 100 s reference runs): mean worst EC error 0.0198 /
 #: 0.0216 / 0.0275 with 1 / 2 / 3 proposals (worst 0.025 / 0.039 / 0.040); a second pass
 #: over the pairs per sweep made it worse (0.023).
 DEFAULT_TRIES = 1
+#: Re-insertions per sweep in a group of more than 63 boxes (the boxes in turn; a smaller
+#: group re-inserts every box every sweep). The pair pass, the block updates and the record
+#: still cover every pair each sweep: on weakly linked groups they do most of the mixing,
+#: and a sweep of 150 boxes costs about 4 times less than with every box re-inserted.
+WIDE_MOVES = 16
+#: Below this expected number of sweeps with a relation across a block, its ECs' standard
+#: errors get the rare-event floor (:meth:`SampledMarginals.rare_event_floor`).
+RARE_SWEEPS = 30
 #: Sweeps per chain discarded before recording.
 DEFAULT_BURN_IN = 64
 #: Sweeps per chain in one round of the anytime loop (one call of the compiled kernel).
@@ -95,7 +112,8 @@ class SampledMarginals:
     marginals : numpy.ndarray, shape (n, n)
         Estimated ``P(S_xy = 1 | consistent)``.
     standard_errors : numpy.ndarray, shape (n, n)
-        Batch-means standard error of each estimate.
+        Batch-means standard error of each estimate; inside a block at weak links at least
+        the rare-event floor ``sqrt(link_rate / samples)`` (see :meth:`rare_event_floor`).
     batch_marginals : numpy.ndarray, shape (batches, n, n)
         The equal-length batch means the errors come from (every chain's batches).
     error_scale : float
@@ -111,6 +129,12 @@ class SampledMarginals:
     seed : int or None
     seconds : float
         Wall time.
+    block_of : numpy.ndarray, shape (n,), int64, optional
+        Block of each box (``-1``: in none; :mod:`unstack.reasoner.block_gibbs`).
+    link_rates : numpy.ndarray, shape (blocks,), optional
+        Estimated relations across each block per sweep (the sum of the marginals of the pairs
+        joining it to other boxes): the rate of the rare sweeps in which its exact
+        marginals do not apply.
     final_worlds : numpy.ndarray, shape (chains, n) or (chains, n, words), int64, optional
         Last state of every chain (bit masks of the boxes each box supports, in the layout
         of :mod:`unstack.reasoner.world_masks`): a warm start for a related scene.
@@ -127,6 +151,8 @@ class SampledMarginals:
     seed: int | None
     seconds: float
     final_worlds: np.ndarray | None = None
+    block_of: np.ndarray | None = None
+    link_rates: np.ndarray | None = None
 
     def errors_of(self, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Estimate and covariance of ``marginals @ weights`` (the expected costs).
@@ -135,14 +161,39 @@ class SampledMarginals:
         -------
         values : numpy.ndarray, shape (n,)
         covariance : numpy.ndarray, shape (n, n)
-            Covariance of the estimate (from the batch means).
+            Covariance of the estimate: from the batch means, with every variance raised to
+            at least the rare-event floor (:meth:`rare_event_floor`).
         """
         values = self.marginals @ weights
         batch_values = self.batch_marginals @ weights
-        if len(batch_values) < 2:
-            return values, np.zeros((len(values), len(values)))
-        covariance = np.atleast_2d(np.cov(batch_values, rowvar=False)) * self.error_scale**2
+        n = len(values)
+        covariance = np.zeros((n, n))
+        if len(batch_values) >= 2:
+            covariance = np.atleast_2d(np.cov(batch_values, rowvar=False)) * self.error_scale**2
+        floor = self.rare_event_floor(weights) ** 2
+        covariance[np.diag_indices(n)] = np.maximum(np.diag(covariance), floor)
         return values, covariance
+
+    def rare_event_floor(self, weights: np.ndarray) -> np.ndarray:
+        """Smallest honest standard error of each ``marginals @ weights`` from rare sweeps.
+
+        A block records its exact marginals in every sweep with no relation across it; the
+        sweeps with one are rare at weak links (expected ``link_rate * samples`` of them), and a
+        run may see none or a few, while its batch means see only those. Each such sweep can
+        move a box's row by up to the largest weight in its block, so the count of such sweeps
+        (Poisson, with the *expected* count, not the observed one) gives the floor
+        ``max weight * sqrt(link_rate / samples)``. Applied only where fewer than
+        :data:`RARE_SWEEPS` such sweeps are expected; with more the batch means see them.
+        """
+        floor = np.zeros(self.marginals.shape[0])
+        if self.block_of is None or self.link_rates is None:
+            return floor
+        for k, rate in enumerate(self.link_rates):
+            if rate * self.samples >= RARE_SWEEPS:
+                continue
+            inside = self.block_of == k
+            floor[inside] = np.max(np.abs(weights[inside])) * np.sqrt(rate / self.samples)
+        return floor
 
     def convergence_of(self, weights: np.ndarray) -> np.ndarray:
         """Gelman-Rubin potential scale reduction (R-hat) of each ``marginals @ weights``.
@@ -245,11 +296,15 @@ class _Chains:
 
         n = probabilities.shape[0]
         self.wide = mask_words(n) > 0 if wide is None else wide
+        self._run: Callable[..., None]
         if self.wide:
-            from unstack.reasoner._wide_kernels import run_chains
+            from unstack.reasoner._wide_kernels import run_chains as run_wide
+
+            self._run = run_wide
         else:
             from unstack.reasoner._sampler_kernels import run_chains
-        self._run = run_chains
+
+            self._run = run_chains
         self.probabilities = probabilities
         self.log_tables = _log_tables(probabilities)
         successors, predecessors = _start_state(probabilities, wide=self.wide)
@@ -260,6 +315,10 @@ class _Chains:
         self.accepted = np.zeros(chains, dtype=np.int64)
         self.sums = np.zeros((chains, n, n))
         self.blocks = block_tables(probabilities, strong_blocks(probabilities) if blocks else [])
+        self.linear_weights = np.exp(self.blocks.log_weights)
+        self.moves = min(n, WIDE_MOVES) if n > ONE_WORD_BOXES else n
+        self.cursors = np.zeros(chains, dtype=np.int64)
+        self.moves_done = 0
         if start is None:
             self.advance(1, scatter=True)
         else:
@@ -268,7 +327,19 @@ class _Chains:
         self.advance(burn_in)
 
     def advance(self, sweeps: int, *, record: bool = False, scatter: bool = False) -> None:
-        """Run every chain ``sweeps`` sweeps; with ``record`` the conditionals go to ``sums``."""
+        """Run every chain ``sweeps`` sweeps; with ``record`` the conditionals go to ``sums``.
+
+        A sweep re-inserts every box, or :data:`WIDE_MOVES` of them in turn in a group of more
+        than 63 boxes (the scattering sweep re-inserts every box).
+        """
+        moves = self.probabilities.shape[0] if scatter else self.moves
+        self.moves_done += len(self.rng) * sweeps * moves
+        blocks = self.blocks
+        weights: tuple[np.ndarray, ...] = (blocks.log_weights,)
+        extra: tuple[Any, ...] = ()
+        if self.wide:
+            weights = (blocks.log_weights, self.linear_weights)
+            extra = (moves, self.cursors)
         with PARALLEL_KERNELS:
             self._run(
                 self.probabilities,
@@ -282,15 +353,16 @@ class _Chains:
                 self.sums,
                 self.accepted,
                 scatter,
-                self.blocks.members,
-                self.blocks.sizes,
-                self.blocks.counts,
-                self.blocks.masks,
-                self.blocks.log_weights,
-                self.blocks.cumulative,
-                self.blocks.marginals,
-                self.blocks.pairs,
-                self.blocks.block_of,
+                blocks.members,
+                blocks.sizes,
+                blocks.counts,
+                blocks.masks,
+                *weights,
+                blocks.cumulative,
+                blocks.marginals,
+                blocks.pairs,
+                blocks.block_of,
+                *extra,
             )
 
 
@@ -315,7 +387,8 @@ def sampled_marginals(
         first with :func:`~unstack.reasoner.pruning.propagate_evidence`).
     samples : int, optional
         Recorded sweeps over all chains; the run is reproducible for a given ``seed``.
-        Neither this nor ``time_limit``: :data:`DEFAULT_SAMPLES`.
+        Neither this nor ``time_limit``: :data:`DEFAULT_SAMPLES` (:data:`WIDE_SAMPLES` for more
+        than 63 boxes).
     time_limit : float, optional
         Seconds of sampling (burn-in included); not reproducible. With ``samples`` too,
         whichever comes first.
@@ -395,7 +468,7 @@ def _sampled_marginals(
     start = time.perf_counter() if start is None else start
     n = p.shape[0]
     if samples is None and time_limit is None:
-        samples = DEFAULT_SAMPLES
+        samples = DEFAULT_SAMPLES if n <= ONE_WORD_BOXES else WIDE_SAMPLES
     deadline = None if time_limit is None else start + time_limit
     per_chain = None if samples is None else -(-samples // chains)
     state = _Chains(p, chains=chains, seed=seed, burn_in=burn_in, tries=tries, blocks=blocks, start=warm, wide=wide)
@@ -434,10 +507,23 @@ def _sampled_marginals(
     error_scale = float(np.sqrt(full_share / (chains * filled)))
     spread = batch_marginals.std(axis=0, ddof=1) if len(batch_marginals) > 1 else np.zeros((n, n))
     np.fill_diagonal(marginals, 0.0)
-    moves = chains * (1 + burn_in + recorded) * n  # the scattering sweep, burn-in and recorded sweeps
+    block_of = state.blocks.block_of
+    link_rates = np.array(
+        [
+            marginals[block_of == k][:, block_of != k].sum() + marginals[block_of != k][:, block_of == k].sum()
+            for k in range(len(state.blocks.sizes))
+        ]
+    )
+    standard_errors = spread * error_scale
+    for k, rate in enumerate(link_rates):  # the rare-event floor of the pairs inside each block
+        if rate * chains * recorded < RARE_SWEEPS:
+            inside = np.ix_(block_of == k, block_of == k)
+            standard_errors[inside] = np.maximum(standard_errors[inside], np.sqrt(rate / (chains * recorded)))
+    np.fill_diagonal(standard_errors, 0.0)
+    moves = state.moves_done  # the scattering sweep, burn-in and recorded sweeps
     return SampledMarginals(
         marginals=marginals,
-        standard_errors=spread * error_scale,
+        standard_errors=standard_errors,
         batch_marginals=batch_marginals,
         error_scale=error_scale,
         chains=chains,
@@ -447,6 +533,8 @@ def _sampled_marginals(
         seed=seed,
         seconds=time.perf_counter() - start,
         final_worlds=state.successors.copy(),
+        block_of=block_of,
+        link_rates=link_rates,
     )
 
 
