@@ -90,7 +90,7 @@ DEFAULT_TRIES = 1
 #: Re-insertions per sweep in a group of more than 63 boxes (the boxes in turn; a smaller
 #: group re-inserts every box every sweep). The pair pass, the block updates and the record
 #: still cover every pair each sweep: on weakly linked groups they do most of the mixing,
-#: and a sweep of 150 boxes costs about 4 times less than with every box re-inserted.
+#: and 150 boxes sampled about 3 times faster for about the same error (benchmarks/wide_moves.py).
 WIDE_MOVES = 16
 #: Below this expected number of sweeps with a relation across a block, its ECs' standard
 #: errors get the rare-event floor (:meth:`SampledMarginals.rare_event_floor`).
