@@ -73,16 +73,37 @@ def test_more_than_63_boxes_agree_with_the_groups_alone(rng: np.random.Generator
 
 
 def test_rare_sweeps_across_weak_links_widen_the_errors(rng: np.random.Generator) -> None:
-    """Two groups of 4 joined by 1e-4: the blocks' exact marginals hide the rare sweeps with a
+    """Two groups of 3 joined by 1e-4: the blocks' exact marginals hide the rare sweeps with a
     relation across, so the batch means alone gave standard errors far below the true error
-    (53 % coverage); with the rare-event floor every EC lies within 3 standard errors."""
+    (53 % coverage on two groups of 4); with the rare-event floor every EC lies within 3
+    standard errors."""
     from unstack.reasoner.marginals import exact_marginals
 
-    p = weak_groups(rng, 2, 4, 1e-4)
+    p = weak_groups(rng, 2, 3, 1e-4)
     result = sampled_marginals(p, samples=4096, seed=int(rng.integers(2**31)))
-    costs, covariance = result.errors_of(np.ones(8))
+    costs, covariance = result.errors_of(np.ones(6))
     errors = np.sqrt(np.diag(covariance))
-    floor = result.rare_event_floor(np.ones(8))
+    floor = result.rare_event_floor(np.ones(6))
     assert result.link_rates is not None and np.all(result.link_rates * result.samples < 30)
     assert np.all(floor > 0) and np.all(errors >= floor)
     assert np.all(np.abs(costs - exact_marginals(p).marginals.sum(axis=1)) <= 3 * errors)
+
+
+def test_a_plan_step_starts_warm_across_the_63_box_boundary(rng: np.random.Generator) -> None:
+    """Chains of a 66-box group (word arrays) warm-start the 65- and 63-box groups left after
+    picks (word arrays, then one word): the restricted worlds are consistent starts."""
+    from unstack.reasoner.decision import decide
+    from unstack.reasoner.reuse import WorkCache
+    from unstack.supports import Supports
+
+    p = rng.uniform(0.001, 0.01, (66, 66))
+    p[60:66, 60:66] = rng.uniform(0.2, 0.9, (6, 6))
+    np.fill_diagonal(p, 0.0)
+    supports = Supports([f"b{i:02d}" for i in range(66)], p)
+    work = WorkCache()
+    decide(supports, samples=32, seed=0, cache=work)
+    for left in (65, 63):
+        step = decide(supports.subset(supports.objects[66 - left :]), samples=32, seed=0, cache=work)
+        assert np.all(np.isfinite(step.expected_costs)) and len(step.expected_costs) == left
+    assert work.warm_starts == 2
+    assert work.chains[tuple(supports.objects[3:])].shape == (8, 63)
