@@ -438,6 +438,8 @@ def _block_update(
     record: bool,
     sums: np.ndarray,
     pair_sums: np.ndarray,
+    cache_key: np.ndarray,
+    cache_sums: np.ndarray,
 ) -> None:
     """Redraw the relations inside one block from their exact conditional (block Gibbs).
 
@@ -446,7 +448,10 @@ def _block_update(
     by ``log_weights`` and one is drawn. With ``record`` the conditional marginal of every
     pair inside the block is added to ``sums``. A block with no relation across draws from
     ``cumulative`` and records ``clean_marginals`` (no pass over its table). ``pair_table``:
-    the table's masks as 0/1 floats, one row per preorder.
+    the table's masks as 0/1 floats, one row per preorder. ``cache_key`` /
+    ``cache_sums``: the chain's last sums of a linked block (``(state, forbidden, forced)``,
+    state 0 none, 1 the total, 2 also the pair sums; the 25 pair sums, the total, ``top``),
+    reused while the relations across impose the same constraints.
     """
     inside = np.int64(0)
     for a in range(size):
@@ -489,24 +494,39 @@ def _block_update(
                     forced |= bit
                 elif (in_u & ~in_v) or (out_v & ~out_u):
                     forbidden |= bit
-        top = -np.inf
-        for t in range(count):
-            m = masks[t]
-            if (m & forbidden) == 0 and (m & forced) == forced and log_weights[t] > top:
-                top = log_weights[t]
-        if top == -np.inf:
-            return  # cannot happen from a consistent state of non-zero weight
-        total = 0.0
-        pair_sums[:] = 0.0
-        for t in range(count):
-            m = masks[t]
-            if (m & forbidden) == 0 and (m & forced) == forced:
-                w = np.exp(log_weights[t] - top)
-                total += w
-                if record:
-                    row = pair_table[t]
-                    for k in range(_STRIDE * _STRIDE):  # vectorised: no branch on the bits
-                        pair_sums[k] += w * row[k]
+        # the sums depend only on (forbidden, forced), which change only when a relation
+        # across the block does: the chain's last sums for the same constraints are reused
+        # (the very same numbers, so the results do not change)
+        known = cache_key[1] == forbidden and cache_key[2] == forced and cache_key[0] >= (2 if record else 1)
+        if known:
+            top = cache_sums[_STRIDE * _STRIDE + 1]
+            total = cache_sums[_STRIDE * _STRIDE]
+            pair_sums[:] = cache_sums[: _STRIDE * _STRIDE]
+        else:
+            top = -np.inf
+            for t in range(count):
+                m = masks[t]
+                if (m & forbidden) == 0 and (m & forced) == forced and log_weights[t] > top:
+                    top = log_weights[t]
+            if top == -np.inf:
+                return  # cannot happen from a consistent state of non-zero weight
+            total = 0.0
+            pair_sums[:] = 0.0
+            for t in range(count):
+                m = masks[t]
+                if (m & forbidden) == 0 and (m & forced) == forced:
+                    w = np.exp(log_weights[t] - top)
+                    total += w
+                    if record:
+                        row = pair_table[t]
+                        for k in range(_STRIDE * _STRIDE):  # vectorised: no branch on the bits
+                            pair_sums[k] += w * row[k]
+            cache_key[0] = 2 if record else 1
+            cache_key[1] = forbidden
+            cache_key[2] = forced
+            cache_sums[: _STRIDE * _STRIDE] = pair_sums
+            cache_sums[_STRIDE * _STRIDE] = total
+            cache_sums[_STRIDE * _STRIDE + 1] = top
         if record:
             for a in range(size):
                 for b in range(size):
@@ -584,6 +604,8 @@ def _run_chain(
     candidates_supported = np.empty(tries + 1, dtype=np.int64)
     candidates_supporters = np.empty(tries + 1, dtype=np.int64)
     log_ratios = np.empty(tries + 1)
+    cache_keys = np.zeros((block_sizes.shape[0], 3), dtype=np.int64)
+    cache_sums = np.zeros((block_sizes.shape[0], _STRIDE * _STRIDE + 2))
     accepted = 0
     for _ in range(sweeps):
         _flip_pairs(probabilities, successors, predecessors, rng, chain)
@@ -622,6 +644,8 @@ def _run_chain(
                 record,
                 sums,
                 pair_sums,
+                cache_keys[k],
+                cache_sums[k],
             )
         if record:
             _add_conditionals(probabilities, successors, predecessors, sums, block_of)
