@@ -1,8 +1,8 @@
 """Compile (or load from numba's cache) every compiled kernel before the first real call.
 
 After a fresh install the first decision on a group of six or more boxes, the first
-sampled group and the first scene's features each pay for numba's compilation (seconds
-each; the README states what was measured). ``unstack warm-up`` -- or :func:`warm_up` at a
+sampled group, the first group of 64 boxes or more and the first scene's features each pay
+for numba's compilation (seconds to a minute each; the README states what was measured). ``unstack warm-up`` -- or :func:`warm_up` at a
 robot's start-up -- pays it once, and numba caches the result on disk for later processes.
 
 Examples
@@ -38,6 +38,14 @@ def _sampler() -> None:
     sample_worlds(probabilities, 1, seed=0, burn_in=1)
 
 
+def _wide_sampler() -> None:
+    from unstack.reasoner.sampling import sampled_marginals
+
+    probabilities = np.full((70, 70), 0.02)  # more boxes than one 64-bit word holds
+    np.fill_diagonal(probabilities, 0.0)
+    sampled_marginals(probabilities, samples=4, seed=0, burn_in=1)
+
+
 def _features() -> None:
     from unstack.learning._contact_kernel import column_index, counts_in_boxes
     from unstack.learning._dbaf_kernel import gaussian_sums
@@ -52,6 +60,7 @@ def _features() -> None:
 KERNELS: tuple[tuple[str, Callable[[], None]], ...] = (
     ("exact engine", _exact),
     ("sampler", _sampler),
+    ("wide sampler", _wide_sampler),
     ("feature kernels", _features),
 )
 
@@ -72,7 +81,7 @@ def warm_up(progress: Callable[[str, float], None] | None = None) -> dict[str, f
     Examples
     --------
     >>> sorted(warm_up())
-    ['exact engine', 'feature kernels', 'sampler']
+    ['exact engine', 'feature kernels', 'sampler', 'wide sampler']
     """
     seconds = {}
     for name, compile_kernel in KERNELS:

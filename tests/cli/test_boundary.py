@@ -177,10 +177,11 @@ def test_warm_up_reports_each_kernel() -> None:
     result = unstack("warm-up")
     assert result.returncode == 0, result.stderr
     lines = result.stderr.splitlines()
-    assert lines[0].startswith("warm-up: compiling 3 groups of kernels")
+    assert lines[0].startswith("warm-up: compiling 4 groups of kernels")
     assert [line.split("] ")[1].split(" ready")[0] for line in lines[1:]] == [
         "exact engine",
         "sampler",
+        "wide sampler",
         "feature kernels",
     ]
     assert result.stdout.startswith("warm-up: done in ")

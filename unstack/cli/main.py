@@ -137,7 +137,7 @@ def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
             default="auto",
             show_default=True,
             help="exact: weighted preorder counting (<= 8 boxes per group); sat: list worlds with CaDiCaL "
-            "(<= 6); approx: sampling with standard errors (<= 63); auto: per group, exact up to 8, else approx.",
+            "(<= 6); approx: sampling with standard errors (any size); auto: per group, exact up to 8, else approx.",
         ),
         click.option(
             "--cost",
@@ -311,7 +311,7 @@ def warm_up() -> None:
 
     total = len(KERNELS)
     done = [0]
-    click.echo(f"warm-up: compiling {total} groups of kernels (about 10 s after a fresh install) ...", err=True)
+    click.echo(f"warm-up: compiling {total} groups of kernels (a minute or more after a fresh install) ...", err=True)
 
     def report(name: str, seconds: float) -> None:
         done[0] += 1
