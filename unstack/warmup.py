@@ -2,8 +2,9 @@
 
 After a fresh install the first decision on a group of six or more boxes, the first
 sampled group, the first group of 64 boxes or more and the first scene's features each pay
-for numba's compilation (seconds to a minute each; the README states what was measured). ``unstack warm-up`` -- or :func:`warm_up` at a
-robot's start-up -- pays it once, and numba caches the result on disk for later processes.
+for numba's compilation (seconds to a minute each; the README states what was measured).
+``unstack warm-up`` -- or :func:`warm_up` at a robot's start-up -- pays it once, and numba
+caches the result on disk for later processes.
 
 Examples
 --------
