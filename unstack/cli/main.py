@@ -151,7 +151,7 @@ def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
             "--samples",
             type=click.IntRange(min=1),
             default=None,
-            help="Recorded sweeps per sampled group (default 4096; reproducible with --seed).",
+            help="Recorded sweeps per sampled group (default 4096, 2048 for 64+ boxes; reproducible with --seed).",
         ),
         click.option(
             "--time-limit",

@@ -81,17 +81,16 @@ def validation_roc(truth: np.ndarray, probability: np.ndarray, *, points: int = 
     >>> roc["auc"], roc["not_supp_recall_at_paper_supp_recall"]
     (0.75, 0.5)
     """
-    from sklearn.metrics import roc_auc_score, roc_curve
-
-    from unstack.learning.metrics import not_supp_recall_at
+    from sklearn.metrics import roc_curve
 
     false_positive, true_positive, _ = roc_curve(truth, probability)
     grid = np.linspace(0.0, 1.0, points)
+    point = paper_point(truth, probability)
     return {
-        "auc": float(roc_auc_score(truth, probability)),
+        "auc": point["auc"],
         "not_supp_recall": grid.tolist(),
         "supp_recall": [float(true_positive[false_positive <= 1.0 - level].max()) for level in grid],
-        "not_supp_recall_at_paper_supp_recall": not_supp_recall_at(truth, probability, PAPER_FIG_5A["supp_recall"]),
+        "not_supp_recall_at_paper_supp_recall": point["not_supp_recall"],
     }
 
 

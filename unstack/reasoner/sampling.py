@@ -188,11 +188,8 @@ class SampledMarginals:
         floor = np.zeros(self.marginals.shape[0])
         if self.block_of is None or self.link_rates is None:
             return floor
-        for k, rate in enumerate(self.link_rates):
-            if rate * self.samples >= RARE_SWEEPS:
-                continue
-            inside = self.block_of == k
-            floor[inside] = np.max(np.abs(weights[inside])) * np.sqrt(rate / self.samples)
+        for inside, scale in _rare_blocks(self.block_of, self.link_rates, self.samples):
+            floor[inside] = np.max(np.abs(weights[inside])) * scale
         return floor
 
     def convergence_of(self, weights: np.ndarray) -> np.ndarray:
@@ -216,6 +213,16 @@ class SampledMarginals:
             ratio = np.where(within > tiny, pooled / within, np.where(between > tiny, np.inf, 1.0))
         result: np.ndarray = np.sqrt(ratio)
         return result
+
+
+def _rare_blocks(block_of: np.ndarray, link_rates: np.ndarray, samples: int) -> list[tuple[np.ndarray, float]]:
+    """``(members, sqrt(link_rate / samples))`` of each block expecting fewer than
+    :data:`RARE_SWEEPS` recorded sweeps with a relation across it (the rare-event floor's blocks)."""
+    return [
+        (block_of == k, float(np.sqrt(rate / samples)))
+        for k, rate in enumerate(link_rates)
+        if rate * samples < RARE_SWEEPS
+    ]
 
 
 def _start_state(probabilities: np.ndarray, *, wide: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -515,10 +522,9 @@ def _sampled_marginals(
         ]
     )
     standard_errors = spread * error_scale
-    for k, rate in enumerate(link_rates):  # the rare-event floor of the pairs inside each block
-        if rate * chains * recorded < RARE_SWEEPS:
-            inside = np.ix_(block_of == k, block_of == k)
-            standard_errors[inside] = np.maximum(standard_errors[inside], np.sqrt(rate / (chains * recorded)))
+    for inside, scale in _rare_blocks(block_of, link_rates, chains * recorded):  # the floor of the pairs inside
+        pairs = np.ix_(inside, inside)
+        standard_errors[pairs] = np.maximum(standard_errors[pairs], scale)
     np.fill_diagonal(standard_errors, 0.0)
     moves = state.moves_done  # the scattering sweep, burn-in and recorded sweeps
     return SampledMarginals(
