@@ -30,6 +30,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from weak_links import weak_groups
 
+from unstack.atomic import atomic_write_text
 from unstack.reasoner.decision import decide
 from unstack.supports import Supports
 
@@ -95,7 +96,7 @@ def main() -> None:
                 print(json.dumps(row), flush=True)
     print(f"load average after {os.getloadavg()}")
     if args.json:
-        args.json.write_text(json.dumps({"argv": sys.argv, "rows": rows}, indent=1))
+        atomic_write_text(args.json, json.dumps({"argv": sys.argv, "rows": rows}, indent=1))
 
 
 if __name__ == "__main__":

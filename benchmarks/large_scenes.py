@@ -41,6 +41,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from instances import instance
 
+from unstack.atomic import atomic_write_text
 from unstack.reasoner.decision import decide
 from unstack.reasoner.marginals import exact_marginals
 from unstack.reasoner.sampling import sampled_marginals
@@ -236,7 +237,7 @@ def main(argv: list[str] | None = None) -> int:
         print(line)
     print(f"total {time.perf_counter() - start:.0f} s")
     if args.json is not None:
-        args.json.write_text(json.dumps({"argv": sys.argv[1:], "rows": rows, "totals": totals(rows)}, indent=1))
+        atomic_write_text(args.json, json.dumps({"argv": sys.argv[1:], "rows": rows, "totals": totals(rows)}, indent=1))
     return 0
 
 

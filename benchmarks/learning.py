@@ -26,6 +26,7 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
+from unstack.atomic import atomic_write_text
 from unstack.learning.contact_features import contact_features
 from unstack.learning.features import FeatureSettings, interest_points, pair_features
 from unstack.learning.model_file import bundled_model_path, default_model_path, load_model
@@ -100,7 +101,8 @@ def main() -> None:
         table.add_row(name, f"{seconds:.4f}", ratio)
     Console().print(table)
     if arguments.json:
-        arguments.json.write_text(json.dumps({"seconds": timings, "points": len(cloud), "pairs": len(pairs)}, indent=2))
+        report = {"seconds": timings, "points": len(cloud), "pairs": len(pairs)}
+        atomic_write_text(arguments.json, json.dumps(report, indent=2))
 
 
 if __name__ == "__main__":

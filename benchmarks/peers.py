@@ -95,6 +95,8 @@ if str(HERE) not in sys.path:
 
 from instances import ALL_FAMILIES, box_ids, instance  # noqa: E402
 
+from unstack.atomic import atomic_write_text  # noqa: E402
+
 METHODS: tuple[str, ...] = ("exact", "exact-1t", "sat", "approx", "problog", "pysdd", "pyganak")
 LABELS: dict[str, str] = {
     "exact": "exact",
@@ -155,10 +157,11 @@ CallResult = tuple[np.ndarray, dict[str, float], dict[str, Any]]
 
 
 def run_unstack(method: str, probabilities: np.ndarray, max_boxes: int | None) -> CallResult:
-    import unstack
+    from unstack.reasoner.decision import decide
+    from unstack.supports import Supports
 
-    supports = unstack.Supports(box_ids(len(probabilities)), probabilities)
-    decision = unstack.decide(supports, method=method, max_boxes=max_boxes)
+    supports = Supports(box_ids(len(probabilities)), probabilities)
+    decision = decide(supports, method=method, max_boxes=max_boxes)
     return decision.marginals, {}, {"consistent_worlds": decision.consistent_worlds, "choice": decision.choice}
 
 
@@ -392,7 +395,7 @@ def worker_main(argv: list[str]) -> int:
         outcome = Outcome(
             args.worker, args.family, args.n, args.seed, status="error", reason=f"{type(error).__name__}: {error}"
         )
-    args.out.write_text(json.dumps(asdict(outcome)))
+    atomic_write_text(args.out, json.dumps(asdict(outcome)))
     return 0
 
 
@@ -758,9 +761,9 @@ def main(argv: list[str] | None = None) -> int:
         report["machine"] = machine()
         report["largest_n_within_timeout"] = summary
         report["outcomes"] = [asdict(o) for o in outcomes]
-        args.json.write_text(json.dumps(report, indent=1))
+        atomic_write_text(args.json, json.dumps(report, indent=1))
     if args.markdown is not None:
-        args.markdown.write_text(markdown(outcomes) + "\n" + "\n".join(f"- {line}" for line in lines) + "\n")
+        atomic_write_text(args.markdown, markdown(outcomes) + "\n" + "\n".join(f"- {line}" for line in lines) + "\n")
     return 1 if disagreeing else 0
 
 

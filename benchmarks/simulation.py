@@ -23,6 +23,7 @@ from pathlib import Path
 from rich.console import Console
 from rich.table import Table
 
+from unstack.atomic import atomic_write_text
 from unstack.sim.dataset import simulate_dataset
 from unstack.sim.settings import SimulationSettings
 
@@ -67,8 +68,8 @@ def main() -> None:
     speedup = float(results[1]["per_minute"]) / float(results[0]["per_minute"])  # type: ignore[arg-type]
     console.print(f"2 workers / 1 worker: {speedup:.2f}x (target >= 1.8x on a quiet machine)")
     if arguments.json:
-        arguments.json.write_text(
-            json.dumps({"results": results, "speedup": speedup, "reference": REFERENCE}, indent=2)
+        atomic_write_text(
+            arguments.json, json.dumps({"results": results, "speedup": speedup, "reference": REFERENCE}, indent=2)
         )
 
 

@@ -34,6 +34,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+from unstack.atomic import atomic_write_text
 from unstack.reasoner.marginals import exact_marginals
 from unstack.reasoner.sampling import DEFAULT_SAMPLES, sampled_marginals
 from unstack.reasoner.small import small_marginals
@@ -185,7 +186,7 @@ def main() -> None:
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(f"peak RSS {peak:.0f} MiB; load average before/after {os.getloadavg()}")
     if args.json:
-        args.json.write_text(json.dumps({"argv": sys.argv, "peak_rss_mib": peak, "rows": rows}, indent=1))
+        atomic_write_text(args.json, json.dumps({"argv": sys.argv, "peak_rss_mib": peak, "rows": rows}, indent=1))
 
 
 if __name__ == "__main__":
