@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from unstack.clouds import surface_cloud, vary_cloud
-from unstack.hidden_load import hidden_load
+from unstack.hidden_load import container_planes, hidden_load
 from unstack.scene import Box, Scene
 
 
@@ -48,3 +48,58 @@ def test_a_sparser_noisier_cloud_still_shows_the_load() -> None:
 def test_without_a_cloud_nothing_is_hidden() -> None:
     boxes = _loaded_and_free(np.random.default_rng(0))
     assert hidden_load(Scene(boxes, np.zeros((0, 3)), ["loaded"])).tolist() == [0.0]
+
+
+def _container_walls(
+    rng: np.random.Generator, depth: float = 2.0, width: float = 2.35, height: float = 2.39
+) -> np.ndarray:
+    """Points on a container's back wall, side walls and ceiling, with a few millimetres of noise."""
+    count = 3000
+    back = np.column_stack(
+        [np.full(count, depth), rng.uniform(-width / 2, width / 2, count), rng.uniform(0, height, count)]
+    )
+    left = np.column_stack([rng.uniform(0, depth, count), np.full(count, -width / 2), rng.uniform(0, height, count)])
+    right = np.column_stack([rng.uniform(0, depth, count), np.full(count, width / 2), rng.uniform(0, height, count)])
+    ceiling = np.column_stack(
+        [rng.uniform(0, depth, count), rng.uniform(-width / 2, width / 2, count), np.full(count, height)]
+    )
+    walls = np.vstack([back, left, right, ceiling])
+    return walls + rng.normal(0.0, 0.004, walls.shape)
+
+
+def _inside_container(cloud: np.ndarray, depth: float = 2.0, width: float = 2.35) -> np.ndarray:
+    """The cloud without the floor beyond the walls (a sensor inside a container sees none)."""
+    return cloud[(cloud[:, 0] <= depth) & (np.abs(cloud[:, 1]) <= width / 2)]
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_container_walls_behind_and_beside_a_box_are_not_load(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    size = rng.uniform([0.3, 0.3, 0.2], [0.6, 0.45, 0.4])
+    against_back = Box("against_back", size, [2.0 - size[0] / 2, 0.2, size[2] / 2])
+    in_corner = Box("in_corner", size, [2.0 - size[0] / 2, -2.35 / 2 + size[1] / 2, size[2] / 2])
+    boxes = [against_back, in_corner]
+    cloud = np.vstack(
+        [_inside_container(surface_cloud(boxes, viewpoint=[-2.0, 0.0, 1.5], seed=seed)), _container_walls(rng)]
+    )
+    assert hidden_load(Scene(boxes, cloud, ["against_back", "in_corner"])).tolist() == [0.0, 0.0]
+
+
+def test_an_undetected_box_against_the_back_wall_still_counts() -> None:
+    rng = np.random.default_rng(5)
+    under = Box("under", [0.5, 0.4, 0.3], [1.75, 0.2, 0.15])
+    unseen = Box("unseen", [0.4, 0.4, 0.3], [1.8, 0.2, 0.451])
+    cloud = surface_cloud([under, unseen], viewpoint=[-2.0, 0.0, 1.5], seed=5)
+    cloud = np.vstack([_inside_container(cloud), _container_walls(rng)])
+    assert hidden_load(Scene([under, unseen], cloud, ["under"]))[0] == pytest.approx(1.0, abs=0.45)
+
+
+def test_container_planes_finds_walls_and_ceiling_but_not_a_carton() -> None:
+    rng = np.random.default_rng(0)
+    walls = _container_walls(rng)
+    carton = surface_cloud([Box("c", [0.5, 0.4, 0.3], [1.0, 0.0, 0.15])], viewpoint=[-2.0, 0.0, 1.5], seed=0)
+    inside = _inside_container(carton)
+    planes = container_planes(np.vstack([walls, inside]))
+    assert planes[: len(walls)].mean() > 0.95
+    assert not planes[len(walls) :][inside[:, 2] > 0.01].any()  # the carton's faces (the floor meets the walls)
+    assert not container_planes(carton).any()  # in the open: nothing is dropped

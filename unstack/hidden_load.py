@@ -4,8 +4,8 @@ Eq. 11 counts only detected boxes, so a detected box carrying an undetected one 
 little as a free box -- although the cloud shows the load. For each detected box X this
 module estimates the expected number of undetected boxes resting on it, from the points
 over X's footprint that no detected box explains (points inside a detected box grown by
-:data:`EXPLAINED_MARGIN` are explained; a ceiling -- the highest points, spread wide -- is
-dropped first):
+:data:`EXPLAINED_MARGIN` are explained; the container's walls and ceiling -- planes no box is -- are dropped first,
+:func:`container_planes`):
 
 * the points over X's footprint swept :data:`FRONT_REACH` towards the door (a box resting
   on X that is deeper than X shows its front face in front of X's footprint);
@@ -44,7 +44,7 @@ import numpy as np
 from unstack.geometry import bounding_boxes, box_corners, convex_hull_2d, footprint, points_in_box
 from unstack.scene import Scene
 
-__all__ = ["EXPLAINED_MARGIN", "STACK_GAP", "hidden_load"]
+__all__ = ["EXPLAINED_MARGIN", "STACK_GAP", "container_planes", "hidden_load"]
 
 #: Points within this distance of a detected box belong to it (metres).
 EXPLAINED_MARGIN = 0.02
@@ -58,10 +58,14 @@ MAX_RISE = 1.5
 COVERAGE_BIN = 0.04
 #: The footprint is swept this far towards the door (-x) before looking for load (metres).
 FRONT_REACH = 0.08
-#: The highest points of the cloud are a ceiling when they spread over more than this (metres) ...
-CEILING_SPREAD = 1.0
-#: ... within this height (metres).
-CEILING_THICKNESS = 0.05
+#: The cloud's extreme points on one side (top, back, left, right) are a container plane when
+#: they spread over more than this (metres) in both directions of the plane ...
+PLANE_SPREAD = 1.0
+#: ... within this distance of the extreme (metres).
+PLANE_THICKNESS = 0.05
+#: The sides a container plane can stand on: (axis, +1 for the highest coordinate, -1 for the
+#: lowest). The door side (-x) is open and the floor lies under every box.
+PLANE_SIDES = ((2, 1), (0, 1), (1, -1), (1, 1))
 
 
 def _over(polygon: np.ndarray, points: np.ndarray) -> np.ndarray:
@@ -73,17 +77,41 @@ def _over(polygon: np.ndarray, points: np.ndarray) -> np.ndarray:
     return inside
 
 
-def _without_ceiling(points: np.ndarray) -> np.ndarray:
-    """Drop a ceiling: the highest points, when they spread over more than
-    :data:`CEILING_SPREAD` in both x and y (a plane no box is)."""
-    if len(points) == 0:
-        return points
-    highest = float(points[:, 2].max())
-    near_top = points[:, 2] > highest - CEILING_THICKNESS
-    spread = np.ptp(points[near_top, :2], axis=0)
-    if np.all(spread > CEILING_SPREAD):
-        return points[~near_top]
-    return points
+def container_planes(points: np.ndarray) -> np.ndarray:
+    """Which points belong to a container's ceiling, back wall or side walls.
+
+    On each side of :data:`PLANE_SIDES`, the points within :data:`PLANE_THICKNESS` of the
+    cloud's extreme coordinate are a plane when they spread over more than
+    :data:`PLANE_SPREAD` in both other directions -- a plane no carton is. A box standing
+    against the back wall otherwise carries the wall as load.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (m, 3)
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (m,)
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> back_wall = np.column_stack([np.full(200, 2.0), rng.uniform(-1.2, 1.2, 200), rng.uniform(0, 2.4, 200)])
+    >>> carton_top = np.column_stack([rng.uniform(0.8, 1.2, 50), rng.uniform(-0.2, 0.2, 50), np.full(50, 0.4)])
+    >>> container_planes(np.vstack([back_wall, carton_top])).sum()
+    np.int64(200)
+    """
+    planes = np.zeros(len(points), dtype=bool)
+    for axis, direction in PLANE_SIDES:
+        rest = points[~planes]
+        if len(rest) == 0:
+            break
+        coordinate = direction * rest[:, axis]
+        near = coordinate > coordinate.max() - PLANE_THICKNESS
+        others = [other for other in range(3) if other != axis]
+        if np.all(np.ptp(rest[near][:, others], axis=0) > PLANE_SPREAD):
+            planes[np.flatnonzero(~planes)[near]] = True
+    return planes
 
 
 def _load_on(column: np.ndarray, top: float, low_y: float, high_y: float, typical_height: float) -> float:
@@ -125,7 +153,7 @@ def hidden_load(scene: Scene, detected: Sequence[str] | None = None) -> np.ndarr
     explained = np.zeros(len(points), dtype=bool)
     for box in boxes:
         explained |= points_in_box(points, box, margin=EXPLAINED_MARGIN)
-    free_points = _without_ceiling(points[~explained])
+    free_points = points[~explained & ~container_planes(points)]
     typical_height = float(np.median([np.ptp(box_corners(box)[:, 2]) for box in boxes]))
     bounds = bounding_boxes(boxes)
     for k, box in enumerate(boxes):

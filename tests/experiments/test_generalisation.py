@@ -46,6 +46,15 @@ def test_a_box_under_undetected_load_costs_at_least_half_a_box_more_than_a_free_
         assert loaded and all(costs[box] >= costs["free"] + 0.5 for box in loaded), costs
 
 
+@pytest.mark.parametrize("seed", SEEDS)
+def test_the_container_walls_are_not_load_on_the_boxes_against_them(seed: int) -> None:
+    from unstack.hidden_load import hidden_load
+
+    case = build_case("against_the_walls", seed=seed, in_container=True)
+    scene = canonical_scene(case, cloud="sensor", seed=seed)
+    assert hidden_load(scene).max() < 0.05
+
+
 def test_eq_11_alone_does_not_see_the_hidden_load(default_model) -> None:  # type: ignore[no-untyped-def]
     case = build_case("hidden_load", seed=7)
     supports = scene_support_probabilities(canonical_scene(case, cloud="sensor", seed=7), default_model)

@@ -1,7 +1,8 @@
 """Hand-made canonical scenes: the generalisation suite's kinds, drawn at random.
 
 Each kind builds a small scene a robot engineer might meet on the first day -- a tower, a
-bridge, a wall, a staircase, a box leaning on another, load nobody detected -- with random
+bridge, a wall, a staircase, a box leaning on another, load nobody detected, boxes against
+the container's walls -- with random
 box sizes, gaps, positions and yaw from a seed, so that a test or a check draws as many
 variants of a kind as it likes. A scene says which detected boxes may be picked (those that
 hold up nothing, detected or not) and which carry load, with how many boxes each holds up.
@@ -290,6 +291,25 @@ def _mixed_sizes(builder: _Builder, in_container: bool) -> CanonicalCase:
     return builder.case("mixed_sizes", in_container=in_container)
 
 
+def _against_the_walls(builder: _Builder, in_container: bool) -> CanonicalCase:
+    from unstack.sim.settings import Container
+
+    container = Container()
+
+    def touching(name: str, size: np.ndarray, y: float, on: list[str] | None = None) -> str:
+        """Place a box turned a little about z with its deepest corner on the back wall."""
+        yaw = float(builder.rng.uniform(-builder.max_yaw, builder.max_yaw))
+        turn = np.radians(yaw)
+        half_depth = (size[0] * np.cos(turn) + size[1] * abs(np.sin(turn))) / 2.0
+        return builder.place(name, size, container.depth - half_depth, y, on, yaw=yaw)
+
+    bottom = touching("back0", builder.size(), 0.3)
+    touching("back1", builder.size((0.3, 0.25, 0.2), (0.45, 0.4, 0.35)), 0.3, [bottom])
+    free = builder.size()
+    touching("corner", free, -container.width / 2 + free[1] / 2 + 0.02)  # near the side wall too
+    return builder.case("against_the_walls", in_container=in_container)
+
+
 #: The kinds of the suite: name -> builder (takes a seeded builder and where the scene stands).
 CANONICAL_KINDS: dict[str, Callable[[_Builder, bool], CanonicalCase]] = {
     "plain_stack": _plain_stack,
@@ -308,6 +328,7 @@ CANONICAL_KINDS: dict[str, Callable[[_Builder, bool], CanonicalCase]] = {
     "hidden_middle": _hidden_middle,
     "across_two": _across_two,
     "mixed_sizes": _mixed_sizes,
+    "against_the_walls": _against_the_walls,
 }
 
 
