@@ -8,6 +8,9 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     the default model's probabilities and the default cost (hidden load counted).
 ``unstack_count``
     the same probabilities with Eq. 11's cost (detected boxes supported).
+``hybrid``
+    unstack's default, near ties broken by height: the highest candidate whose expected
+    cost is within :data:`HYBRID_MARGIN` boxes of the lowest.
 ``highest``
     the highest candidate first.
 ``footprint``
@@ -43,11 +46,14 @@ import numpy as np
 
 from unstack.scene import Scene
 
-__all__ = ["CONTAINER_MAKERS", "CONTAINER_SAMPLES", "container_experiment", "container_policies"]
+__all__ = ["CONTAINER_MAKERS", "CONTAINER_SAMPLES", "HYBRID_MARGIN", "container_experiment", "container_policies"]
 
-CONTAINER_MAKERS = ("unstack", "unstack_count", "highest", "footprint", "nearest_door", "random", "lookahead")
+CONTAINER_MAKERS = ("unstack", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random", "lookahead")
 #: Recorded sweeps per sampled group in each decision.
 CONTAINER_SAMPLES = 512
+#: The ``hybrid`` maker takes the highest candidate whose expected cost is within this many
+#: boxes of the lowest.
+HYBRID_MARGIN = 0.1
 
 
 def _free(scene: Scene, candidates: Sequence[str]) -> list[str]:
@@ -67,18 +73,27 @@ def container_policies(
 
     rng = np.random.default_rng(seed)
 
+    def decision(scene: Scene, cost: str) -> Any:
+        from unstack.learning.probabilities import scene_support_probabilities
+        from unstack.reasoner.decision import decide
+
+        return decide(scene_support_probabilities(scene, model), cost=cost, samples=samples, seed=seed)
+
     def deciding(cost: str) -> Callable[[Scene], str]:
         def policy(scene: Scene) -> str:
-            from unstack.learning.probabilities import scene_support_probabilities
-            from unstack.reasoner.decision import decide
-
-            supports = scene_support_probabilities(scene, model)
-            return str(decide(supports, cost=cost, samples=samples, seed=seed).choice)
+            return str(decision(scene, cost).choice)
 
         return policy
 
     def height(scene: Scene, box_id: str) -> float:
         return float(scene.box(box_id).position[2])
+
+    def hybrid(scene: Scene) -> str:
+        made = decision(scene, "load")
+        costs = dict(zip(made.objects, np.asarray(made.expected_costs, dtype=float), strict=True))
+        lowest = min(costs.values())
+        near = [box_id for box_id in scene.detected if costs[box_id] <= lowest + HYBRID_MARGIN]
+        return max(near, key=lambda box_id: (height(scene, box_id), box_id))
 
     def highest(scene: Scene) -> str:
         return max(scene.detected, key=lambda box_id: (height(scene, box_id), box_id))
@@ -103,6 +118,7 @@ def container_policies(
     every = {
         "unstack": deciding("load"),
         "unstack_count": deciding("count"),
+        "hybrid": hybrid,
         "highest": highest,
         "footprint": footprint,
         "nearest_door": nearest_door,
