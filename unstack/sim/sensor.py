@@ -113,10 +113,12 @@ def scan_pile(world: PhysicsWorld, sensor: SensorSettings, *, seed: int | np.ran
     )
     depth_buffer = np.asarray(depth, dtype=np.float64).reshape(sensor.height, sensor.width)
     bodies = np.asarray(segmentation, dtype=np.int64).reshape(sensor.height, sensor.width)
-    box_index = {body: index for index, body in enumerate(world.boxes)}
+    body_ids = np.asarray(world.boxes, dtype=np.int64)
+    box_of_body = np.full(max(int(bodies.max(initial=-1)), int(body_ids.max(initial=-1))) + 1, -1, dtype=np.int64)
+    box_of_body[body_ids] = np.arange(len(body_ids))  # any other body (the container) is -1
     box_image = np.full(bodies.shape, -2, dtype=np.int64)
     hit = bodies >= 0
-    box_image[hit] = [box_index.get(int(body), -1) for body in bodies[hit]]
+    box_image[hit] = box_of_body[bodies[hit]]
     points = _unproject(depth_buffer, view, projection)
     near, far = sensor.near, sensor.far
     linear_depth = far * near / (far - (far - near) * depth_buffer)
