@@ -15,8 +15,16 @@ A node of the tree keeps three lists, all as bit masks over the boxes already pl
 its admissible down-sets, ``A(D)`` for each of them, and its admissible up-sets. A child's
 lists are filtered from the parent's instead of recomputing closures. Each call returns
 its subtree's weight sum; times the path weight, that sum is added to per-level tables
-indexed by ``D`` and by ``U``, so the marginal bookkeeping costs O(1) per node. The last
-box is never expanded into leaves: the admissible ``(D, U)`` pairs are summed directly.
+indexed by ``D`` and by ``U``, so the marginal bookkeeping costs O(1) per node.
+
+The last levels are summed without building their nodes (``collapse``):
+
+* ``collapse=1``: the last box's admissible ``(D, U)`` pairs are summed directly
+  (:func:`_last_level`, O(#D x #U) per node of level ``n - 1``);
+* ``collapse=2`` (the default): the last *two* boxes are summed at each node of level
+  ``n - 2`` with subset-sum (zeta) and superset-sum (Moebius-side) transforms over the bit
+  masks of the ``n - 2`` boxes already placed (:func:`_last_two_levels`), so the
+  ``A000798(n - 1)`` nodes of the last level are never built.
 
 Everything here is plain numeric code compiled with numba; the public wrapper lives in
 :mod:`unstack.reasoner.marginals`.
@@ -128,6 +136,205 @@ def _last_level(
     return total
 
 
+@njit(inline="always")
+def _subset_sums(values: np.ndarray, bits: int) -> None:
+    """In place: ``values[M]`` becomes the sum of ``values[S]`` over ``S ⊆ M``."""
+    size = 1 << bits
+    step = 1
+    while step < size:
+        for base in range(0, size, 2 * step):
+            for k in range(base, base + step):
+                values[k + step] += values[k]
+        step *= 2
+
+
+@njit(inline="always")
+def _superset_sums(values: np.ndarray, bits: int) -> None:
+    """In place: ``values[M]`` becomes the sum of ``values[S]`` over ``S ⊇ M``."""
+    size = 1 << bits
+    step = 1
+    while step < size:
+        for base in range(0, size, 2 * step):
+            for k in range(base, base + step):
+                values[k] += values[k + step]
+        step *= 2
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def _last_two_levels(
+    m: int,
+    path_weight: float,
+    downs: np.ndarray,
+    above: np.ndarray,
+    n_downs: int,
+    ups: np.ndarray,
+    n_ups: int,
+    down_weights: np.ndarray,
+    up_weights: np.ndarray,
+    down_table: np.ndarray,
+    up_table: np.ndarray,
+    tables: bool,
+    scratch: np.ndarray,
+    index_scratch: np.ndarray,
+) -> float:
+    """Weight sum of the completions of a node at level ``m = n - 2`` (the last two boxes).
+
+    Box ``a = m`` joins with ``(D_a, U_a)`` and box ``b = m + 1`` with ``(D_b, U_b)``
+    (``D_b``, ``U_b`` the sets of earlier boxes, without ``a``), in one of four ways:
+
+    * **unrelated**: ``U_a`` and ``D_b`` disjoint, ``U_b`` and ``D_a`` disjoint. For fixed
+      ``D_a`` and ``D_b`` the up-sets are independent: ``U_a`` ranges over the up-sets inside
+      ``A(D_a) \\ D_b``, ``U_b`` over those inside ``A(D_b) \\ D_a``, so the sum is
+      ``f_a(D_a) f_b(D_b) G_a(A(D_a) \\ D_b) G_b(A(D_b) \\ D_a)`` with ``G`` the subset sums
+      (zeta transform) of ``g`` over the up-sets -- O(#D^2) per node;
+    * **a under b** (``a`` supports ``b``): ``D_b`` contains ``D_a``, ``U_b`` lies in
+      ``A(D_b)``, in ``U_a`` and outside ``D_a``: for each admissible ``(D_a, U_a)`` and each
+      ``D_b`` containing ``D_a``, ``f_b(D_b + a) G_b(A(D_b) & U_a \\ D_a)``;
+    * **b under a**, the mirror image: ``U_b`` contains ``U_a``, ``D_b`` lies under every
+      member of ``U_b``, in ``D_a`` and outside ``U_a``: ``g_b(U_b + a) F_b(B(U_b) & D_a \\ U_a)``
+      with ``B(U)`` the largest down-set ``D`` with ``U`` inside ``A(D)`` and ``F`` the
+      subset sums of ``f`` over the down-sets;
+    * **a and b mutual**: ``D_b = D_a``, ``U_b = U_a``.
+
+    The per-level tables of ``a`` and ``b`` come from the same loops; where a term is summed
+    over a transform, its marginal contribution is scattered at the transform's argument and
+    gathered back by the opposite transform (superset sums): O(n 2^n) per node.
+
+    With ``tables`` false only the sum is returned (the world count uses 0/1 weights).
+    """
+    a_bit = np.int64(1) << m
+    b = m + 1
+    size = 1 << m
+    g2_sub = scratch[0]
+    g1_sub = scratch[1]
+    f2_sub = scratch[2]
+    x_acc = scratch[3]
+    y_acc = scratch[4]
+    z_acc = scratch[5]
+    f1 = scratch[6]
+    f2 = scratch[7]
+    f2a = scratch[8]
+    g1 = scratch[9]
+    g2 = scratch[10]
+    g2a = scratch[11]
+    down_m = scratch[12]
+    up_m = scratch[13]
+    down_b = scratch[14]
+    down_ba = scratch[15]
+    up_ba = scratch[16]
+    below = index_scratch[0]
+    supersets = index_scratch[1]
+    for k in range(size):
+        g2_sub[k] = 0.0
+        g1_sub[k] = 0.0
+        f2_sub[k] = 0.0
+        x_acc[k] = 0.0
+        y_acc[k] = 0.0
+        z_acc[k] = 0.0
+    for t in range(n_ups):
+        u = ups[t]
+        g1[t] = up_weights[m, u]
+        g2[t] = up_weights[b, u]
+        g2a[t] = up_weights[b, u | a_bit]
+        g1_sub[u] = g1[t]
+        g2_sub[u] = g2[t]
+        up_m[t] = 0.0
+        up_ba[t] = 0.0
+    for s in range(n_downs):
+        d = downs[s]
+        f1[s] = down_weights[m, d]
+        f2[s] = down_weights[b, d]
+        f2a[s] = down_weights[b, d | a_bit]
+        f2_sub[d] = f2[s]
+        down_m[s] = 0.0
+        down_b[s] = 0.0
+        down_ba[s] = 0.0
+    _subset_sums(g2_sub, m)
+    _subset_sums(g1_sub, m)
+    _subset_sums(f2_sub, m)
+    for t in range(n_ups):
+        u = ups[t]
+        union = np.int64(0)
+        for s in range(n_downs):
+            union |= downs[s] * np.int64(u & ~above[s] == 0)
+        below[t] = union
+    total = 0.0
+    # a and b unrelated: any two down-sets; each box's up-sets summed by a transform
+    for i in range(n_downs):
+        d1 = downs[i]
+        a1 = above[i]
+        w1 = f1[i]
+        row = 0.0
+        for s in range(n_downs):
+            mask_a = a1 & ~downs[s]
+            mask_b = above[s] & ~d1
+            ga = g1_sub[mask_a]
+            gb = g2_sub[mask_b]
+            wf = w1 * f2[s]
+            v = wf * ga * gb
+            row += v
+            down_b[s] += v
+            z_acc[mask_a] += wf * gb
+            x_acc[mask_b] += wf * ga
+        down_m[i] += row
+        total += row
+    # the admissible (D_a, U_a) pairs: a and b mutual, a under b, b under a
+    for i in range(n_downs):
+        d1 = downs[i]
+        if f1[i] == 0.0:
+            continue
+        a1 = above[i]
+        n_sup = np.int64(0)
+        for s in range(n_downs):
+            supersets[n_sup] = s
+            n_sup += np.int64(d1 & ~downs[s] == 0)
+        for k in range(n_ups):
+            u1 = ups[k]
+            if u1 & ~a1 != 0 or g1[k] == 0.0:
+                continue
+            w1 = f1[i] * g1[k]
+            same = down_weights[b, d1 | a_bit] * up_weights[b, u1 | a_bit]
+            sub = same
+            if tables:
+                down_table[b, d1 | a_bit] += path_weight * w1 * same
+                up_table[b, u1 | a_bit] += path_weight * w1 * same
+            outside = u1 & ~d1
+            for q in range(n_sup):
+                s = supersets[q]
+                mask = above[s] & outside
+                va = f2a[s] * g2_sub[mask]
+                sub += va
+                down_ba[s] += w1 * va
+                x_acc[mask] += w1 * f2a[s]
+            inside = d1 & ~u1
+            for t in range(n_ups):
+                ga = np.float64(u1 & ~ups[t] == 0) * g2a[t]
+                mask = below[t] & inside
+                v = ga * f2_sub[mask]
+                sub += v
+                up_ba[t] += w1 * v
+                y_acc[mask] += w1 * ga
+            down_m[i] += w1 * sub
+            up_m[k] += w1 * sub
+            total += w1 * sub
+    if not tables:
+        return total
+    _superset_sums(x_acc, m)
+    _superset_sums(y_acc, m)
+    _superset_sums(z_acc, m)
+    for t in range(n_ups):
+        u = ups[t]
+        up_table[m, u] += path_weight * (up_m[t] + g1[t] * z_acc[u])
+        up_table[b, u] += path_weight * g2[t] * x_acc[u]
+        up_table[b, u | a_bit] += path_weight * up_ba[t]
+    for s in range(n_downs):
+        d = downs[s]
+        down_table[m, d] += path_weight * down_m[s]
+        down_table[b, d] += path_weight * (down_b[s] + f2[s] * y_acc[d])
+        down_table[b, d | a_bit] += path_weight * down_ba[s]
+    return total
+
+
 @njit(cache=True, nogil=True)
 def _next_pair(
     j: int,
@@ -161,51 +368,136 @@ def _next_pair(
 
 
 @njit(cache=True, nogil=True)
-def _subtree(
-    start: int,
+def _finish(
+    j: int,
     n: int,
-    start_weight: float,
+    path_weight: float,
     downs: np.ndarray,
     above: np.ndarray,
+    n_downs: int,
     ups: np.ndarray,
-    n_downs: np.ndarray,
-    n_ups: np.ndarray,
-    down_weights: np.ndarray,
-    up_weights: np.ndarray,
-    down_allowed: np.ndarray,
-    up_allowed: np.ndarray,
+    n_ups: int,
+    weights: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    down_ones: np.ndarray,
+    up_ones: np.ndarray,
     down_table: np.ndarray,
     up_table: np.ndarray,
-    scratch_ups: np.ndarray,
-    scratch_weights: np.ndarray,
-    scratch_sums: np.ndarray,
+    scratch: np.ndarray,
+    index_scratch: np.ndarray,
     world_count: np.ndarray,
+    counting: bool,
 ) -> float:
-    """Weight sum of all completions of the node at level ``start`` (lists in its row).
+    """Weight sum of the completions of the node at level ``j``, one of the last two levels.
 
-    An explicit depth-first walk (numba's on-disk cache mishandles recursive functions):
-    row ``j`` of ``downs``/``above``/``ups`` holds the lists of the current node at level
-    ``j`` and ``n_downs[j]``/``n_ups[j]`` their lengths.
+    Level ``n - 1``: the last box's pairs directly; level ``n - 2``: the last two boxes
+    by transforms, and (``counting``) their worlds again with 0/1 weights.
     """
-    if start == n - 1:
+    down_weights, up_weights, down_allowed, up_allowed = weights
+    if j == n - 1:
         return _last_level(
-            start,
-            start_weight,
-            downs[start],
-            above[start],
-            n_downs[start],
-            ups[start],
-            n_ups[start],
+            j,
+            path_weight,
+            downs,
+            above,
+            n_downs,
+            ups,
+            n_ups,
             down_weights,
             up_weights,
             down_allowed,
             up_allowed,
             down_table,
             up_table,
-            scratch_ups,
-            scratch_weights,
-            scratch_sums,
+            index_scratch[0],
+            scratch[0],
+            scratch[1],
             world_count,
+        )
+    if counting:
+        worlds = _last_two_levels(
+            j,
+            1.0,
+            downs,
+            above,
+            n_downs,
+            ups,
+            n_ups,
+            down_ones,
+            up_ones,
+            down_table,
+            up_table,
+            False,
+            scratch,
+            index_scratch,
+        )
+        world_count[0] += np.int64(worlds + 0.5)
+    return _last_two_levels(
+        j,
+        path_weight,
+        downs,
+        above,
+        n_downs,
+        ups,
+        n_ups,
+        down_weights,
+        up_weights,
+        down_table,
+        up_table,
+        True,
+        scratch,
+        index_scratch,
+    )
+
+
+@njit(cache=True, nogil=True)
+def _subtree(
+    start: int,
+    n: int,
+    collapse: int,
+    start_weight: float,
+    downs: np.ndarray,
+    above: np.ndarray,
+    ups: np.ndarray,
+    n_downs: np.ndarray,
+    n_ups: np.ndarray,
+    weights: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    down_ones: np.ndarray,
+    up_ones: np.ndarray,
+    down_table: np.ndarray,
+    up_table: np.ndarray,
+    scratch: np.ndarray,
+    index_scratch: np.ndarray,
+    world_count: np.ndarray,
+    counting: bool,
+) -> float:
+    """Weight sum of all completions of the node at level ``start`` (lists in its row).
+
+    An explicit depth-first walk (numba's on-disk cache mishandles recursive functions):
+    row ``j`` of ``downs``/``above``/``ups`` holds the lists of the current node at level
+    ``j`` and ``n_downs[j]``/``n_ups[j]`` their lengths. Nodes of level ``n - collapse``
+    are not expanded (:func:`_finish`); ``start`` must not be deeper.
+    """
+    down_weights, up_weights, down_allowed, up_allowed = weights
+    last = n - collapse
+    if start == last:
+        return _finish(
+            start,
+            n,
+            start_weight,
+            downs[start],
+            above[start],
+            n_downs[start],
+            ups[start],
+            n_ups[start],
+            weights,
+            down_ones,
+            up_ones,
+            down_table,
+            up_table,
+            scratch,
+            index_scratch,
+            world_count,
+            counting,
         )
     cursor_down = np.zeros(n, dtype=np.int64)
     cursor_up = np.zeros(n, dtype=np.int64)
@@ -250,31 +542,31 @@ def _subtree(
                 above[j + 1],
                 ups[j + 1],
             )
-            if j + 1 < n - 1:
+            if j + 1 < last:
                 level = j + 1
                 cursor_down[level] = 0
                 cursor_up[level] = 0
                 path_weight[level] = path_weight[j] * w
                 subtotal[level] = 0.0
                 continue
-            sub = _last_level(
+            sub = _finish(
                 j + 1,
+                n,
                 path_weight[j] * w,
                 downs[j + 1],
                 above[j + 1],
                 n_downs[j + 1],
                 ups[j + 1],
                 n_ups[j + 1],
-                down_weights,
-                up_weights,
-                down_allowed,
-                up_allowed,
+                weights,
+                down_ones,
+                up_ones,
                 down_table,
                 up_table,
-                scratch_ups,
-                scratch_weights,
-                scratch_sums,
+                scratch,
+                index_scratch,
                 world_count,
+                counting,
             )
         else:
             if j == start:
@@ -400,6 +692,8 @@ def collect_tasks(
 def run_tasks(
     n: int,
     depth: int,
+    collapse: int,
+    counting: bool,
     task_weight: np.ndarray,
     task_downs: np.ndarray,
     task_above: np.ndarray,
@@ -412,11 +706,17 @@ def run_tasks(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
     """Expand every task's subtree in parallel.
 
-    Returns each task's subtree weight sum, the per-level ``D`` and ``U`` tables (summed
-    over the tasks) and the number of worlds of non-zero weight.
+    ``collapse`` (1 or 2) last levels are summed without building their nodes, and
+    ``depth`` must be at most ``n - collapse``. Returns each task's subtree weight sum, the
+    per-level ``D`` and ``U`` tables (summed over the tasks) and the number of worlds whose
+    relations are all allowed -- counted only if ``counting`` with ``collapse=2`` (when every
+    relation is allowed, the count is the number of preorders and the caller knows it).
     """
     n_tasks = task_weight.shape[0]
     width = 1 << max(n - 1, 0)
+    weights = (down_weights, up_weights, down_allowed, up_allowed)
+    down_ones = down_allowed.astype(np.float64)
+    up_ones = up_allowed.astype(np.float64)
     # One table per task (numba's thread id would keep this function out of the cache);
     # callers keep the task count in the hundreds, so this stays a few megabytes.
     down_tables = np.zeros((n_tasks, n, width))
@@ -427,9 +727,8 @@ def run_tasks(
         downs = np.zeros((n + 1, width + 1), dtype=np.int64)
         above = np.zeros((n + 1, width + 1), dtype=np.int64)
         ups = np.zeros((n + 1, width + 1), dtype=np.int64)
-        scratch_ups = np.zeros(width + 1, dtype=np.int64)
-        scratch_weights = np.zeros(width + 1)
-        scratch_sums = np.zeros(width + 1)
+        scratch = np.zeros((17, width + 1))
+        index_scratch = np.zeros((2, width + 1), dtype=np.int64)
         n_downs = np.zeros(n + 1, dtype=np.int64)
         n_ups = np.zeros(n + 1, dtype=np.int64)
         n_downs[depth] = task_sizes[t, 0]
@@ -442,21 +741,21 @@ def run_tasks(
         subtree_sums[t] = _subtree(
             depth,
             n,
+            collapse,
             task_weight[t],
             downs,
             above,
             ups,
             n_downs,
             n_ups,
-            down_weights,
-            up_weights,
-            down_allowed,
-            up_allowed,
+            weights,
+            down_ones,
+            up_ones,
             down_tables[t],
             up_tables[t],
-            scratch_ups,
-            scratch_weights,
-            scratch_sums,
+            scratch,
+            index_scratch,
             world_counts[t],
+            counting,
         )
     return subtree_sums, down_tables.sum(axis=0), up_tables.sum(axis=0), world_counts.sum()

@@ -149,26 +149,44 @@ def _exact_marginals(probabilities: np.ndarray, max_boxes: int = EXACT_MAX_BOXES
     :data:`~unstack.reasoner.small.SMALL_MAX_BOXES` boxes, the compiled walk above."""
     n = probabilities.shape[0]
     if n > max_boxes:
+        next_count = f"{PREORDER_COUNTS[max_boxes + 1]:.2g}" if max_boxes + 1 < len(PREORDER_COUNTS) else "over 1e13"
         raise TooLarge(
             f"{n} boxes: the exact engine is limited to {max_boxes} boxes "
-            f"(n = {max_boxes + 1} has {PREORDER_COUNTS[max_boxes + 1]:.2g} consistent worlds; "
+            f"(n = {max_boxes + 1} has {next_count} consistent worlds; "
             f"n = 8 takes seconds, each further box about 100 times longer)"
         )
     if n <= SMALL_MAX_BOXES:
         marginals, worlds, log_partition = small_marginals(probabilities)
         return ExactMarginals(marginals, worlds, log_partition)
+    return _compiled_marginals(probabilities)
+
+
+def _compiled_marginals(probabilities: np.ndarray, collapse: int = 2) -> ExactMarginals:
+    """The compiled insertion walk on a checked matrix of ``n >= 2`` boxes (any size the
+    tables fit in memory; :func:`exact_marginals` takes it above the table path).
+
+    ``collapse`` is how many of the last levels are summed without building their nodes:
+    2 (transforms, the default) or 1 (the direct pair sum, kept as a cross-check).
+    """
     from numba import parallel_chunksize
 
     from unstack.reasoner import _insertion_kernels as kernels
 
+    n = probabilities.shape[0]
     tables = _level_weights(np.ascontiguousarray(probabilities, dtype=np.float64))
-    depth = min(_split_depth(n), n - 1)
+    depth = min(_split_depth(n), n - collapse)
+    off_diagonal = probabilities[~np.eye(n, dtype=bool)]
+    # Worlds are counted only when some relation is exactly 0 or 1; otherwise every
+    # preorder is allowed and the count is A000798(n).
+    counting = bool(np.any((off_diagonal == 0.0) | (off_diagonal == 1.0)))
     tasks = kernels.collect_tasks(n, depth, PREORDER_COUNTS[depth], *tables)
     task_weight, task_downs, task_above, task_ups, task_sizes, path_downs, path_ups = tasks
     with PARALLEL_KERNELS, parallel_chunksize(1):
         subtree_sums, down_table, up_table, world_count = kernels.run_tasks(
-            n, depth, task_weight, task_downs, task_above, task_ups, task_sizes, *tables
+            n, depth, collapse, counting, task_weight, task_downs, task_above, task_ups, task_sizes, *tables
         )
+    if not counting:
+        world_count = PREORDER_COUNTS[n] if n < len(PREORDER_COUNTS) else int(world_count)
     contributions = task_weight * subtree_sums
     for level in range(depth):
         np.add.at(down_table[level], path_downs[:, level], contributions)
