@@ -8,9 +8,11 @@ from pathlib import Path
 import pytest
 
 from tests.conftest import unstack
+from unstack.clouds import surface_cloud
 from unstack.errors import UnstackError
-from unstack.experiments.container import CONTAINER_MAKERS, container_experiment
+from unstack.experiments.container import CONTAINER_MAKERS, container_experiment, container_policies
 from unstack.learning.model_file import default_model_path, load_model
+from unstack.scene import Box, Scene
 
 pytestmark = pytest.mark.slow  # physics runs of every decision maker
 
@@ -58,3 +60,19 @@ def test_the_cli_writes_the_results_and_resumes(small_dataset: Path, tmp_path: P
     assert json.loads((tmp_path / "container.json").read_text())["runs"] == document["runs"]
     bad = unstack("experiment", "container", str(small_dataset), "--out", str(tmp_path), "--makers", "tallest")
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "unknown decision makers" in bad.stderr
+
+
+def _tall_loaded_and_short_free() -> Scene:
+    boxes = [
+        Box("loaded", [0.4, 0.4, 0.6], [1.2, -0.35, 0.301]),
+        Box("unseen", [0.4, 0.4, 0.3], [1.2, -0.35, 0.752]),
+        Box("free", [0.4, 0.4, 0.3], [1.2, 0.35, 0.151]),
+    ]
+    return Scene(boxes, surface_cloud(boxes, viewpoint=[-2.0, 0.0, 1.5], seed=0), ["loaded", "free"])
+
+
+def test_the_hybrid_takes_the_highest_box_the_model_does_not_believe_loaded() -> None:
+    policies = container_policies(load_model(default_model_path()), seed=0, makers=("hybrid", "highest"))
+    scene = _tall_loaded_and_short_free()
+    assert policies["highest"](scene) == "loaded"
+    assert policies["hybrid"](scene) == "free"
