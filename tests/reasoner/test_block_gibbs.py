@@ -56,6 +56,20 @@ def test_tables_hold_every_preorder_and_the_blocks_own_marginals(rng: np.random.
     assert tables.block_of.tolist() == [0] * 5 + [1] * 3 + [2] * 2
 
 
+def test_a_block_with_certain_relations_gives_the_small_engines_marginals(rng: np.random.Generator) -> None:
+    p = weak_groups(rng, [4, 3], 1e-3)
+    p[0, 1], p[2, 1], p[4, 5] = 1.0, 0.0, 1.0
+    tables = block_tables(p, strong_blocks(p))
+    for k, block in enumerate(strong_blocks(p)):
+        size = len(block)
+        expected = small_marginals(p[np.ix_(block, block)])[0]
+        got = tables.marginals[k].reshape(BLOCK_STRIDE, BLOCK_STRIDE)[:size, :size]
+        np.testing.assert_allclose(got, expected, atol=1e-12)
+        impossible = ~np.isfinite(tables.log_weights[k, : tables.counts[k]])
+        assert 0 < impossible.sum() < tables.counts[k]  # the preorders that break a certain relation
+    assert tables.counts[1] < tables.counts[0] and np.all(tables.pairs[1, tables.counts[1] :] == 0.0)  # padding
+
+
 @pytest.mark.parametrize("link", [1e-3, 0.02])
 def test_block_gibbs_agrees_with_the_exact_engine(rng: np.random.Generator, link: float) -> None:
     """Weak links (blocks mostly alone) and links at the threshold (relations across constrain the blocks)."""

@@ -34,6 +34,7 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -106,6 +107,27 @@ def strong_blocks(
     return [group for group in support_components(strong) if 2 <= len(group) <= max_size]
 
 
+@lru_cache(maxsize=SMALL_MAX_BOXES + 1)
+def _block_layout(size: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The preorders of a block of ``size`` boxes laid out for :func:`block_tables`
+    (computed once per size; read-only, so threads share them).
+
+    Returns the preorders' off-diagonal relations (preorders x pairs, 0/1 floats), their
+    masks (bits ``a * BLOCK_STRIDE + b``), the masks as 0/1 floats per bit (preorders x
+    ``BLOCK_STRIDE ** 2``), the bit of each off-diagonal pair and the off-diagonal selector.
+    """
+    table = preorders(size)
+    bits = (np.arange(size)[:, None] * BLOCK_STRIDE + np.arange(size)[None, :]).astype(np.int64)
+    masks = (table * (np.int64(1) << bits)[None]).sum(axis=(1, 2))
+    off = ~np.eye(size, dtype=bool)
+    relations = np.ascontiguousarray(table[:, off], dtype=np.float64)
+    mask_bits = ((masks[:, None] >> np.arange(BLOCK_STRIDE * BLOCK_STRIDE)) & 1).astype(np.float64)
+    layout = (relations, masks, mask_bits, bits[off], off)
+    for array in layout:
+        array.flags.writeable = False
+    return layout
+
+
 def block_tables(probabilities: np.ndarray, blocks: list[np.ndarray]) -> BlockTables:
     """The preorder tables of ``blocks`` with their log weights under ``probabilities``."""
     n = probabilities.shape[0]
@@ -118,26 +140,29 @@ def block_tables(probabilities: np.ndarray, blocks: list[np.ndarray]) -> BlockTa
     block_of = np.full(n, -1, dtype=np.int64)
     cumulative = np.zeros((len(blocks), most))
     marginals = np.zeros((len(blocks), BLOCK_STRIDE * BLOCK_STRIDE))
-    pairs = np.zeros((len(blocks), most, BLOCK_STRIDE * BLOCK_STRIDE))
+    pairs = np.empty((len(blocks), most, BLOCK_STRIDE * BLOCK_STRIDE))
     for k, block in enumerate(blocks):
         size = len(block)
-        table = preorders(size)
+        relations, table_masks, mask_bits, off_bits, off = _block_layout(size)
+        count = len(relations)
         members[k, :size] = block
         sizes[k] = size
-        counts[k] = len(table)
+        counts[k] = count
         block_of[block] = k
-        bits = (np.arange(size)[:, None] * BLOCK_STRIDE + np.arange(size)[None, :]).astype(np.int64)
-        masks[k, : len(table)] = (table * (np.int64(1) << bits)[None]).sum(axis=(1, 2))
-        p = probabilities[np.ix_(block, block)]
+        masks[k, :count] = table_masks
+        p = probabilities[np.ix_(block, block)][off]
         with np.errstate(divide="ignore"):
             present, absent = np.log(p), np.log1p(-p)
-        off = ~np.eye(size, dtype=bool)
-        weights = np.where(table, present[None], absent[None])[:, off].sum(axis=1)
+        if np.all(np.isfinite(present)) and np.all(np.isfinite(absent)):
+            weights = relations @ (present - absent) + absent.sum()
+        else:  # a probability of 0 or 1: a product would meet 0 * inf
+            weights = np.where(relations > 0, present[None], absent[None]).sum(axis=1)
         top = weights.max()
-        log_weights[k, : len(table)] = weights - (top if np.isfinite(top) else 0.0)
-        linear = np.exp(log_weights[k, : len(table)])
-        cumulative[k, : len(table)] = np.cumsum(linear)
-        cumulative[k, len(table) :] = np.inf
-        marginals[k, bits[off]] = linear @ table[:, off] / linear.sum()
-        pairs[k] = (masks[k][:, None] >> np.arange(BLOCK_STRIDE * BLOCK_STRIDE)) & 1
+        log_weights[k, :count] = weights - (top if np.isfinite(top) else 0.0)
+        linear = np.exp(log_weights[k, :count])
+        cumulative[k, :count] = np.cumsum(linear)
+        cumulative[k, count:] = np.inf
+        marginals[k, off_bits] = linear @ relations / linear.sum()
+        pairs[k, :count] = mask_bits
+        pairs[k, count:] = 0.0
     return BlockTables(members, sizes, counts, masks, log_weights, block_of, cumulative, marginals, pairs)
