@@ -59,10 +59,17 @@ COVERAGE_BIN = 0.04
 #: The footprint is swept this far towards the door (-x) before looking for load (metres).
 FRONT_REACH = 0.08
 #: The cloud's extreme points on one side (top, back, left, right) are a container plane when
-#: they spread over more than this (metres) in both directions of the plane ...
-PLANE_SPREAD = 1.0
+#: they spread over more than this (metres) in both directions of the plane (a 1 m deep
+#: section's side walls, not the face of a carton of up to 0.7 m) ...
+PLANE_SPREAD = 0.8
 #: ... within this distance of the extreme (metres).
 PLANE_THICKNESS = 0.05
+#: A wall is looked for this far inside the cloud's extreme on its side (metres): a door
+#: frame or the floor outside can reach beyond the walls.
+PLANE_SEARCH_DEPTH = 0.3
+#: Points this close to the cloud's lowest point are floor: no wall is looked for among them
+#: (the floor in front of the door can reach wider than the walls).
+FLOOR_BAND = 0.05
 #: The sides a container plane can stand on: (axis, +1 for the highest coordinate, -1 for the
 #: lowest). The door side (-x) is open and the floor lies under every box.
 PLANE_SIDES = ((2, 1), (0, 1), (1, -1), (1, 1))
@@ -80,10 +87,12 @@ def _over(polygon: np.ndarray, points: np.ndarray) -> np.ndarray:
 def container_planes(points: np.ndarray) -> np.ndarray:
     """Which points belong to a container's ceiling, back wall or side walls.
 
-    On each side of :data:`PLANE_SIDES`, the points within :data:`PLANE_THICKNESS` of the
-    cloud's extreme coordinate are a plane when they spread over more than
-    :data:`PLANE_SPREAD` in both other directions -- a plane no carton is. A box standing
-    against the back wall otherwise carries the wall as load.
+    On each side of :data:`PLANE_SIDES`, the cloud above the floor (:data:`FLOOR_BAND`) is cut
+    into slabs :data:`PLANE_THICKNESS` thick from its extreme coordinate inwards, down to
+    :data:`PLANE_SEARCH_DEPTH`; the first slab whose points spread over more than
+    :data:`PLANE_SPREAD` in both other directions -- a plane no carton is -- is a wall, and it
+    and every point beyond it are dropped. A box standing against a wall otherwise carries
+    the wall as load.
 
     Parameters
     ----------
@@ -96,21 +105,28 @@ def container_planes(points: np.ndarray) -> np.ndarray:
     Examples
     --------
     >>> rng = np.random.default_rng(0)
-    >>> back_wall = np.column_stack([np.full(200, 2.0), rng.uniform(-1.2, 1.2, 200), rng.uniform(0, 2.4, 200)])
+    >>> back_wall = np.column_stack([np.full(200, 2.0), rng.uniform(-1.2, 1.2, 200), rng.uniform(0.1, 2.4, 200)])
     >>> carton_top = np.column_stack([rng.uniform(0.8, 1.2, 50), rng.uniform(-0.2, 0.2, 50), np.full(50, 0.4)])
-    >>> container_planes(np.vstack([back_wall, carton_top])).sum()
+    >>> floor = np.column_stack([rng.uniform(-0.5, 2.0, 300), rng.uniform(-1.5, 1.5, 300), np.zeros(300)])
+    >>> container_planes(np.vstack([back_wall, carton_top, floor])).sum()  # the wall only
     np.int64(200)
     """
     planes = np.zeros(len(points), dtype=bool)
+    if len(points) == 0:
+        return planes
+    floor = points[:, 2] <= points[:, 2].min() + FLOOR_BAND
     for axis, direction in PLANE_SIDES:
-        rest = points[~planes]
-        if len(rest) == 0:
+        candidates = np.flatnonzero(~planes & ~floor)
+        if len(candidates) == 0:
             break
-        coordinate = direction * rest[:, axis]
-        near = coordinate > coordinate.max() - PLANE_THICKNESS
+        coordinate = direction * points[candidates, axis]
         others = [other for other in range(3) if other != axis]
-        if np.all(np.ptp(rest[near][:, others], axis=0) > PLANE_SPREAD):
-            planes[np.flatnonzero(~planes)[near]] = True
+        extreme = coordinate.max()
+        for inside in np.arange(0.0, PLANE_SEARCH_DEPTH, PLANE_THICKNESS):
+            slab = (coordinate > extreme - inside - PLANE_THICKNESS) & (coordinate <= extreme - inside)
+            if slab.any() and np.all(np.ptp(points[candidates[slab]][:, others], axis=0) > PLANE_SPREAD):
+                planes[candidates[coordinate > extreme - inside - PLANE_THICKNESS]] = True  # the wall and beyond
+                break
     return planes
 
 
