@@ -103,3 +103,13 @@ def test_container_planes_finds_walls_and_ceiling_but_not_a_carton() -> None:
     assert planes[: len(walls)].mean() > 0.95
     assert not planes[len(walls) :][inside[:, 2] > 0.01].any()  # the carton's faces (the floor meets the walls)
     assert not container_planes(carton).any()  # in the open: nothing is dropped
+
+
+def test_the_walls_of_a_narrow_section_are_found_behind_a_wider_floor_and_door_frame() -> None:
+    rng = np.random.default_rng(3)
+    walls = _container_walls(rng, depth=1.0, width=1.2, height=2.3)
+    floor = np.column_stack([rng.uniform(-0.7, 1.0, 4000), rng.uniform(-0.7, 0.7, 4000), np.zeros(4000)])
+    door_frame = np.column_stack([np.zeros(400), rng.choice([-0.7, 0.7], 400), rng.uniform(0.0, 2.0, 400)])
+    planes = container_planes(np.vstack([walls, floor, door_frame]))
+    assert planes[: len(walls)].mean() > 0.95
+    assert not planes[len(walls) : len(walls) + len(floor)].any()

@@ -90,8 +90,8 @@ def container_planes(points: np.ndarray) -> np.ndarray:
     On each side of :data:`PLANE_SIDES`, the cloud above the floor (:data:`FLOOR_BAND`) is cut
     into slabs :data:`PLANE_THICKNESS` thick from its extreme coordinate inwards, down to
     :data:`PLANE_SEARCH_DEPTH`; the first slab whose points spread over more than
-    :data:`PLANE_SPREAD` in both other directions -- a plane no carton is -- is a wall, and it
-    and every point beyond it are dropped. A box standing against a wall otherwise carries
+    :data:`PLANE_SPREAD` in both other directions -- a plane no carton is -- holds a wall: the
+    points within half a slab of its median and every point beyond are dropped. A box standing against a wall otherwise carries
     the wall as load.
 
     Parameters
@@ -125,7 +125,8 @@ def container_planes(points: np.ndarray) -> np.ndarray:
         for inside in np.arange(0.0, PLANE_SEARCH_DEPTH, PLANE_THICKNESS):
             slab = (coordinate > extreme - inside - PLANE_THICKNESS) & (coordinate <= extreme - inside)
             if slab.any() and np.all(np.ptp(points[candidates[slab]][:, others], axis=0) > PLANE_SPREAD):
-                planes[candidates[coordinate > extreme - inside - PLANE_THICKNESS]] = True  # the wall and beyond
+                wall = float(np.median(coordinate[slab]))  # a noisy wall straddles two slabs
+                planes[candidates[coordinate > wall - PLANE_THICKNESS / 2]] = True  # the wall and beyond
                 break
     return planes
 
