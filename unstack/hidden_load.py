@@ -91,8 +91,8 @@ def container_planes(points: np.ndarray) -> np.ndarray:
     into slabs :data:`PLANE_THICKNESS` thick from its extreme coordinate inwards, down to
     :data:`PLANE_SEARCH_DEPTH`; the first slab whose points spread over more than
     :data:`PLANE_SPREAD` in both other directions -- a plane no carton is -- holds a wall: the
-    points within half a slab of its median and every point beyond are dropped. A box standing against a wall otherwise carries
-    the wall as load.
+    points within half a slab of its median and every point beyond are dropped. A box
+    standing against a wall otherwise carries the wall as load.
 
     Parameters
     ----------
