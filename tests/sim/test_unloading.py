@@ -142,10 +142,31 @@ def test_detector_noise_moves_the_reported_boxes_reproducibly(pile: Scene) -> No
     assert 0 < errors.max() < 0.1
 
 
+def test_a_detector_that_misses_boxes_offers_fewer_candidates_reproducibly(pile: Scene) -> None:
+    offered: dict[float, list[int]] = {}
+
+    def recording(share: float):  # type: ignore[no-untyped-def]
+        def policy(current: Scene) -> str:
+            offered.setdefault(share, []).append(len(current.detected))
+            return highest_first(current)
+
+        return policy
+
+    for share in (0.0, 0.6):
+        unload_container(pile, recording(share), detector_misses=share, max_picks=3, seed=4)
+    first = offered[0.6]
+    offered.pop(0.6)
+    unload_container(pile, recording(0.6), detector_misses=0.6, max_picks=3, seed=4)
+    assert offered[0.6] == first  # the same misses for the same seed
+    assert all(count >= 1 for count in first)  # at least one box is found at every scan
+    assert sum(first) < sum(offered[0.0])
+
+
 @pytest.mark.parametrize(
     ("arguments", "message"),
     [
         ({"reach": "roof"}, "unknown reach rule 'roof'; expected one of door, any"),
+        ({"detector_misses": 1.0}, r"detector_misses must be a share in \[0, 1\), got 1.0"),
         ({"detector_noise": -0.1}, "detector_noise must be a finite number of metres >= 0, got -0.1"),
         ({"max_picks": -1}, "max_picks must be at least 0, got -1"),
     ],

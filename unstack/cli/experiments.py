@@ -350,6 +350,8 @@ def unload(
               help="Comma-separated decision makers.")  # fmt: skip
 @click.option("--detector-noise", type=click.FloatRange(0.0, 0.1), default=0.0, show_default=True,
               help="Position error of the box detector (m); yaw errors follow.")  # fmt: skip
+@click.option("--detector-misses", type=click.FloatRange(0.0, 0.9), default=0.0, show_default=True,
+              help="Share of the seen boxes the detector misses at each scan.")  # fmt: skip
 @click.option(
     "--reach",
     type=click.Choice(list(REACH_RULES)),
@@ -369,6 +371,7 @@ def container(
     piles: int,
     makers: str,
     detector_noise: float,
+    detector_misses: float,
     reach: str,
     max_picks: int | None,
     samples: int,
@@ -392,7 +395,8 @@ def container(
     folder = _out(out)
     with progress_bar("piles") as report:
         result = container_experiment(
-            data_dir, model, piles=piles, makers=chosen, detector_noise=detector_noise, reach=reach,
+            data_dir, model, piles=piles, makers=chosen, detector_noise=detector_noise,
+            detector_misses=detector_misses, reach=reach,
             max_picks=max_picks, samples=samples, seed=seed, progress=report,
             checkpoints=folder / "container-piles", n_jobs=jobs,
         )  # fmt: skip

@@ -145,8 +145,8 @@ def _run_pile(
     policies = container_policies(model, seed=options["seed"], samples=options["samples"], makers=makers)
     for maker, policy in policies.items():
         run = unload_container(
-            scene, policy, detector_noise=options["detector_noise"], reach=options["reach"],
-            max_picks=options["max_picks"], seed=options["seed"],
+            scene, policy, detector_noise=options["detector_noise"], detector_misses=options["detector_misses"],
+            reach=options["reach"], max_picks=options["max_picks"], seed=options["seed"],
         )  # fmt: skip
         runs[maker] = run.to_dict()
     return number, {"scene": path.name, "boxes": len(scene.boxes), "runs": runs}
@@ -169,6 +169,7 @@ def container_experiment(
     piles: int = 2,
     makers: Sequence[str] = CONTAINER_MAKERS,
     detector_noise: float = 0.0,
+    detector_misses: float = 0.0,
     reach: str = "door",
     max_picks: int | None = None,
     samples: int = CONTAINER_SAMPLES,
@@ -200,12 +201,15 @@ def container_experiment(
     folder = None if checkpoints is None else Path(checkpoints)
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
-    settings = {"detector_noise": detector_noise, "reach": reach, "max_picks": max_picks, "samples": samples}
+    settings = {"detector_noise": detector_noise, "detector_misses": detector_misses, "reach": reach,
+                "max_picks": max_picks, "samples": samples}  # fmt: skip
 
     def key(number: int, path: Path) -> dict[str, Any]:
         digest = hashlib.sha256(path.read_bytes()).hexdigest()
+        # detector_misses joins the key only when set: runs made before it keep their checkpoints
+        kept = {name: value for name, value in settings.items() if name != "detector_misses" or value}
         return {"scene_sha256": digest, "model_sha256": model_digest, "makers": list(makers),
-                **settings, "seed": seed + number}  # fmt: skip
+                **kept, "seed": seed + number}  # fmt: skip
 
     def finished(number: int, path: Path) -> dict[str, Any] | None:
         if folder is None:

@@ -227,11 +227,21 @@ def reachable_boxes(boxes: Sequence[Any], candidates: Sequence[str], rule: str =
     return result
 
 
+def _detector_misses(candidates: list[str], share: float, seed: np.random.SeedSequence) -> list[str]:
+    """The candidates a detector that misses ``share`` of the boxes finds (at least one)."""
+    rng = np.random.default_rng(seed)
+    while True:
+        found = [box_id for box_id in candidates if rng.random() >= share]
+        if found:
+            return found
+
+
 def unload_container(
     scene: Scene,
     policy: Callable[[Scene], str],
     *,
     detector_noise: float = 0.0,
+    detector_misses: float = 0.0,
     reach: str = "door",
     max_picks: int | None = None,
     seed: int = 0,
@@ -256,6 +266,10 @@ def unload_container(
         ``policy(current_scene) -> box id`` among ``current_scene.detected``.
     detector_noise : float
         Position error of the detector (metres; yaw errors follow, see :mod:`unstack.detector`).
+    detector_misses : float
+        Share of the seen boxes the detector misses, drawn box by box at every scan (a real
+        detector's misses: only the cloud shows such a box). When every reachable box was
+        missed the draw is made again, as a robot would scan again.
     reach : {"door", "any"}
     max_picks : int, optional
     seed : int
@@ -272,6 +286,8 @@ def unload_container(
         raise UnstackError(f"unknown reach rule {reach!r}; expected one of {', '.join(REACH_RULES)}")
     if not (detector_noise >= 0 and np.isfinite(detector_noise)):
         raise UnstackError(f"detector_noise must be a finite number of metres >= 0, got {detector_noise}")
+    if not (0.0 <= detector_misses < 1.0):
+        raise UnstackError(f"detector_misses must be a share in [0, 1), got {detector_misses}")
     if max_picks is not None and max_picks < 0:
         raise UnstackError(f"max_picks must be at least 0, got {max_picks}")
     settings = _scene_settings(scene)
@@ -290,6 +306,9 @@ def unload_container(
         if not candidates:
             stopped[0] = "nothing detected and reachable"
             return None
+        if detector_misses:
+            misses_seed = np.random.SeedSequence(seed, spawn_key=(number, 1))
+            candidates = _detector_misses(candidates, detector_misses, misses_seed)
         reported = (
             detector_poses(true_boxes, detector_noise, np.random.default_rng(step_seed))
             if detector_noise
