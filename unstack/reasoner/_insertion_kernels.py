@@ -22,9 +22,9 @@ The last levels are summed without building their nodes (``collapse``):
 * ``collapse=1``: the last box's admissible ``(D, U)`` pairs are summed directly
   (:func:`_last_level`, O(#D x #U) per node of level ``n - 1``);
 * ``collapse=2`` (the default): the last *two* boxes are summed at each node of level
-  ``n - 2`` with subset-sum (zeta) and superset-sum (Moebius-side) transforms over the bit
-  masks of the ``n - 2`` boxes already placed (:func:`_last_two_levels`), so the
-  ``A000798(n - 1)`` nodes of the last level are never built.
+  ``n - 2`` with subset sums (zeta transforms) and superset sums over the lattices of that
+  node's up-sets and down-sets (:func:`_last_two_levels`), so the ``A000798(n - 1)`` nodes
+  of the last level are never built.
 
 Everything here is plain numeric code compiled with numba; the public wrapper lives in
 :mod:`unstack.reasoner.marginals`.
@@ -137,27 +137,44 @@ def _last_level(
 
 
 @njit(inline="always")
-def _subset_sums(values: np.ndarray, bits: int) -> None:
-    """In place: ``values[M]`` becomes the sum of ``values[S]`` over ``S ⊆ M``."""
-    size = 1 << bits
-    step = 1
-    while step < size:
-        for base in range(0, size, 2 * step):
-            for k in range(base, base + step):
-                values[k + step] += values[k]
-        step *= 2
+def _lattice_sums(masks: np.ndarray, n: int, values: np.ndarray, out: np.ndarray, upward: bool) -> None:
+    """``out[j]`` = sum of ``values[i]`` over ``masks[i] ⊆ masks[j]`` (``masks[i] ⊇ masks[j]`` if ``upward``).
+
+    The zeta transform of a lattice given as a list of masks, O(n^2) and branch-free.
+    """
+    for j in range(n):
+        mask_j = masks[j]
+        acc = 0.0
+        if upward:
+            for i in range(n):
+                acc += np.float64(mask_j & ~masks[i] == 0) * values[i]
+        else:
+            for i in range(n):
+                acc += np.float64(masks[i] & ~mask_j == 0) * values[i]
+        out[j] = acc
 
 
 @njit(inline="always")
-def _superset_sums(values: np.ndarray, bits: int) -> None:
-    """In place: ``values[M]`` becomes the sum of ``values[S]`` over ``S ⊇ M``."""
-    size = 1 << bits
-    step = 1
-    while step < size:
-        for base in range(0, size, 2 * step):
-            for k in range(base, base + step):
-                values[k] += values[k + step]
-        step *= 2
+def _lattice_sums2(
+    masks: np.ndarray, n: int, x: np.ndarray, y: np.ndarray, x_out: np.ndarray, y_out: np.ndarray, upward: bool
+) -> None:
+    """:func:`_lattice_sums` of two value lists at once."""
+    for j in range(n):
+        mask_j = masks[j]
+        acc_x = 0.0
+        acc_y = 0.0
+        if upward:
+            for i in range(n):
+                inside = np.float64(mask_j & ~masks[i] == 0)
+                acc_x += inside * x[i]
+                acc_y += inside * y[i]
+        else:
+            for i in range(n):
+                inside = np.float64(masks[i] & ~mask_j == 0)
+                acc_x += inside * x[i]
+                acc_y += inside * y[i]
+        x_out[j] = acc_x
+        y_out[j] = acc_y
 
 
 @njit(cache=True, nogil=True, fastmath=True)
@@ -186,108 +203,169 @@ def _last_two_levels(
       ``D_a`` and ``D_b`` the up-sets are independent: ``U_a`` ranges over the up-sets inside
       ``A(D_a) \\ D_b``, ``U_b`` over those inside ``A(D_b) \\ D_a``, so the sum is
       ``f_a(D_a) f_b(D_b) G_a(A(D_a) \\ D_b) G_b(A(D_b) \\ D_a)`` with ``G`` the subset sums
-      (zeta transform) of ``g`` over the up-sets -- O(#D^2) per node;
-    * **a under b** (``a`` supports ``b``): ``D_b`` contains ``D_a``, ``U_b`` lies in
-      ``A(D_b)``, in ``U_a`` and outside ``D_a``: for each admissible ``(D_a, U_a)`` and each
-      ``D_b`` containing ``D_a``, ``f_b(D_b + a) G_b(A(D_b) & U_a \\ D_a)``;
-    * **b under a**, the mirror image: ``U_b`` contains ``U_a``, ``D_b`` lies under every
-      member of ``U_b``, in ``D_a`` and outside ``U_a``: ``g_b(U_b + a) F_b(B(U_b) & D_a \\ U_a)``
-      with ``B(U)`` the largest down-set ``D`` with ``U`` inside ``A(D)`` and ``F`` the
-      subset sums of ``f`` over the down-sets;
+      (zeta transform) of ``g`` over the up-sets: O(#D^2) per node;
+    * **a under b** (``a`` supports ``b``): ``D_b`` contains ``D_a``; ``U_b`` lies in
+      ``A(D_b)``, in ``U_a`` and outside ``D_a``: per admissible ``(D_a, U_a)`` and ``D_b``,
+      ``f_b(D_b + a) G_b(A(D_b) & U_a \\ D_a)``. Where ``U_a`` lies inside ``D_a`` this is
+      ``g_b(empty)`` times the superset sum of ``f_b(. + a)`` at ``D_a``; where ``D_a`` is
+      empty it is a subset sum over ``U_a`` of ``g_b(U) psi(U)``, ``psi(U)`` the sum of
+      ``f_b(D + a)`` over the down-sets ``D`` with ``U`` inside ``A(D)``;
+    * **b under a**, the mirror image with ``B(U)``, the largest down-set ``D`` with ``U``
+      inside ``A(D)``: ``g_b(U_b + a) F_b(B(U_b) & D_a \\ U_a)`` for ``U_b`` containing ``U_a``;
     * **a and b mutual**: ``D_b = D_a``, ``U_b = U_a``.
 
-    The per-level tables of ``a`` and ``b`` come from the same loops; where a term is summed
-    over a transform, its marginal contribution is scattered at the transform's argument and
-    gathered back by the opposite transform (superset sums): O(n 2^n) per node.
+    Every argument of a subset or superset sum is an up-set (or a down-set) of the node, so
+    the sums run over the node's lists, O(#U^2) and branch-free, instead of over all
+    ``2^m`` masks; arrays indexed by mask are read and written at those masks only. The
+    per-level tables of ``a`` and ``b`` come from the same loops: where a term is a subset
+    sum, its marginal contribution is scattered at the sum's argument and gathered back by
+    the opposite (superset) sum.
 
     With ``tables`` false only the sum is returned (the world count uses 0/1 weights).
     """
     a_bit = np.int64(1) << m
     b = m + 1
-    size = 1 << m
-    g2_sub = scratch[0]
-    g1_sub = scratch[1]
-    f2_sub = scratch[2]
-    x_acc = scratch[3]
-    y_acc = scratch[4]
-    z_acc = scratch[5]
-    f1 = scratch[6]
-    f2 = scratch[7]
-    f2a = scratch[8]
-    g1 = scratch[9]
-    g2 = scratch[10]
-    g2a = scratch[11]
-    down_m = scratch[12]
-    up_m = scratch[13]
-    down_b = scratch[14]
-    down_ba = scratch[15]
-    up_ba = scratch[16]
+    # cube arrays, indexed by a mask of the m earlier boxes (only up-set or down-set masks used)
+    g1_at = scratch[0]
+    g2_at = scratch[1]
+    f2_at = scratch[2]
+    x_at = scratch[3]
+    y_at = scratch[4]
+    z_at = scratch[5]
+    # lists over the up-sets (t) and the down-sets (s) of the node
+    g1 = scratch[6]
+    g2 = scratch[7]
+    g2a = scratch[8]
+    f1 = scratch[9]
+    f2 = scratch[10]
+    f2a = scratch[11]
+    t_a = scratch[12]
+    t_b = scratch[13]
+    t_c = scratch[14]
+    t_d = scratch[15]
+    s_a = scratch[16]
+    s_c = scratch[18]
+    s_d = scratch[19]
+    up_m = scratch[20]
+    up_ba = scratch[21]
+    down_m = scratch[22]
+    down_b = scratch[23]
+    down_ba = scratch[24]
+    wc2 = scratch[25]
+    wc3 = scratch[26]
+    omega = scratch[27]
+    omega2 = scratch[28]
+    psi = scratch[29]
+    psi2 = scratch[30]
+    q = scratch[31]
+    q2 = scratch[32]
+    r_above = scratch[33]
+    r2_below = scratch[34]
+    g2a_sup = scratch[35]
+    f2a_sup = scratch[36]
     below = index_scratch[0]
-    supersets = index_scratch[1]
-    for k in range(size):
-        g2_sub[k] = 0.0
-        g1_sub[k] = 0.0
-        f2_sub[k] = 0.0
-        x_acc[k] = 0.0
-        y_acc[k] = 0.0
-        z_acc[k] = 0.0
     for t in range(n_ups):
         u = ups[t]
         g1[t] = up_weights[m, u]
         g2[t] = up_weights[b, u]
         g2a[t] = up_weights[b, u | a_bit]
-        g1_sub[u] = g1[t]
-        g2_sub[u] = g2[t]
+        x_at[u] = 0.0
+        z_at[u] = 0.0
         up_m[t] = 0.0
         up_ba[t] = 0.0
+        wc2[t] = 0.0
     for s in range(n_downs):
         d = downs[s]
         f1[s] = down_weights[m, d]
         f2[s] = down_weights[b, d]
         f2a[s] = down_weights[b, d | a_bit]
-        f2_sub[d] = f2[s]
+        y_at[d] = 0.0
         down_m[s] = 0.0
         down_b[s] = 0.0
         down_ba[s] = 0.0
-    _subset_sums(g2_sub, m)
-    _subset_sums(g1_sub, m)
-    _subset_sums(f2_sub, m)
+        wc3[s] = 0.0
+    # below[t]: the largest down-set D with ups[t] inside A(D); psi[t]: sum of f2a over the
+    # down-sets D with ups[t] inside A(D); psi2[s]: sum of g2a over the up-sets inside A(D_s)
     for t in range(n_ups):
         u = ups[t]
         union = np.int64(0)
+        acc = 0.0
         for s in range(n_downs):
-            union |= downs[s] * np.int64(u & ~above[s] == 0)
+            fits = u & ~above[s] == 0
+            union |= downs[s] * np.int64(fits)
+            acc += np.float64(fits) * f2a[s]
         below[t] = union
+        psi[t] = acc
+    for s in range(n_downs):
+        a_s = above[s]
+        acc = 0.0
+        for t in range(n_ups):
+            acc += np.float64(ups[t] & ~a_s == 0) * g2a[t]
+        psi2[s] = acc
+    # subset sums over the up-sets (g1, g2) and down-sets (f2), placed at their masks
+    _lattice_sums2(ups, n_ups, g1, g2, t_a, t_b, False)
+    for t in range(n_ups):
+        g1_at[ups[t]] = t_a[t]
+        g2_at[ups[t]] = t_b[t]
+    _lattice_sums(downs, n_downs, f2, s_a, False)
+    for s in range(n_downs):
+        f2_at[downs[s]] = s_a[s]
+    # superset sums: g2a and g1 over the up-sets, f2a and f1 over the down-sets
+    _lattice_sums2(ups, n_ups, g2a, g1, g2a_sup, omega, True)
+    _lattice_sums2(downs, n_downs, f2a, f1, f2a_sup, omega2, True)
+    f1_empty = f1[0]
+    g1_empty = g1[0]
+    for t in range(n_ups):
+        t_c[t] = g2[t] * psi[t]
+        t_d[t] = g2[t] * f1_empty * omega[t]
+    for s in range(n_downs):
+        s_c[s] = f2[s] * psi2[s]
+        s_d[s] = f2[s] * g1_empty * omega2[s]
+    _lattice_sums(ups, n_ups, t_c, q, False)
+    _lattice_sums(downs, n_downs, s_c, q2, False)
+    # r_above[s]: t_d summed over the up-sets inside A(D_s); r2_below[t]: s_d over D inside below[t]
+    for s in range(n_downs):
+        a_s = above[s]
+        acc = 0.0
+        for t in range(n_ups):
+            acc += np.float64(ups[t] & ~a_s == 0) * t_d[t]
+        r_above[s] = acc
+    for t in range(n_ups):
+        u = ups[t]
+        acc = 0.0
+        for s in range(n_downs):
+            acc += np.float64(u & ~above[s] == 0) * s_d[s]
+        r2_below[t] = acc
     total = 0.0
-    # a and b unrelated: any two down-sets; each box's up-sets summed by a transform
+    # a and b unrelated: any two down-sets; each box's up-sets summed by the subset sums
     for i in range(n_downs):
         d1 = downs[i]
         a1 = above[i]
         w1 = f1[i]
-        row = 0.0
+        row_sum = 0.0
         for s in range(n_downs):
             mask_a = a1 & ~downs[s]
             mask_b = above[s] & ~d1
-            ga = g1_sub[mask_a]
-            gb = g2_sub[mask_b]
+            ga = g1_at[mask_a]
+            gb = g2_at[mask_b]
             wf = w1 * f2[s]
             v = wf * ga * gb
-            row += v
+            row_sum += v
             down_b[s] += v
-            z_acc[mask_a] += wf * gb
-            x_acc[mask_b] += wf * ga
-        down_m[i] += row
-        total += row
+            z_at[mask_a] += wf * gb
+            x_at[mask_b] += wf * ga
+        down_m[i] += row_sum
+        total += row_sum
     # the admissible (D_a, U_a) pairs: a and b mutual, a under b, b under a
+    x_empty = 0.0
+    y_empty = 0.0
+    g2_empty = g2_at[0]
+    f2_empty = f2_at[0]
     for i in range(n_downs):
         d1 = downs[i]
         if f1[i] == 0.0:
             continue
         a1 = above[i]
-        n_sup = np.int64(0)
-        for s in range(n_downs):
-            supersets[n_sup] = s
-            n_sup += np.int64(d1 & ~downs[s] == 0)
         for k in range(n_ups):
             u1 = ups[k]
             if u1 & ~a1 != 0 or g1[k] == 0.0:
@@ -298,40 +376,64 @@ def _last_two_levels(
             if tables:
                 down_table[b, d1 | a_bit] += path_weight * w1 * same
                 up_table[b, u1 | a_bit] += path_weight * w1 * same
+            # a under b
             outside = u1 & ~d1
-            for q in range(n_sup):
-                s = supersets[q]
-                mask = above[s] & outside
-                va = f2a[s] * g2_sub[mask]
-                sub += va
-                down_ba[s] += w1 * va
-                x_acc[mask] += w1 * f2a[s]
+            if d1 == 0:
+                sub += q[k]
+            elif outside == 0:
+                sub += g2_empty * f2a_sup[i]
+                wc3[i] += w1
+                x_empty += w1 * f2a_sup[i]
+            else:
+                for s in range(n_downs):
+                    mask = above[s] & outside
+                    fa = np.float64(d1 & ~downs[s] == 0) * f2a[s]
+                    va = fa * g2_at[mask]
+                    sub += va
+                    down_ba[s] += w1 * va
+                    x_at[mask] += w1 * fa
+            # b under a
             inside = d1 & ~u1
-            for t in range(n_ups):
-                ga = np.float64(u1 & ~ups[t] == 0) * g2a[t]
-                mask = below[t] & inside
-                v = ga * f2_sub[mask]
-                sub += v
-                up_ba[t] += w1 * v
-                y_acc[mask] += w1 * ga
+            if u1 == 0:
+                sub += q2[i]
+            elif inside == 0:
+                sub += f2_empty * g2a_sup[k]
+                wc2[k] += w1
+                y_empty += w1 * g2a_sup[k]
+            else:
+                for t in range(n_ups):
+                    ga = np.float64(u1 & ~ups[t] == 0) * g2a[t]
+                    mask = below[t] & inside
+                    v = ga * f2_at[mask]
+                    sub += v
+                    up_ba[t] += w1 * v
+                    y_at[mask] += w1 * ga
             down_m[i] += w1 * sub
             up_m[k] += w1 * sub
             total += w1 * sub
     if not tables:
         return total
-    _superset_sums(x_acc, m)
-    _superset_sums(y_acc, m)
-    _superset_sums(z_acc, m)
+    x_at[0] += x_empty
+    y_at[0] += y_empty
+    for t in range(n_ups):
+        t_a[t] = x_at[ups[t]]
+        t_b[t] = z_at[ups[t]]
+    _lattice_sums2(ups, n_ups, t_a, t_b, t_c, t_d, True)  # t_c: x summed upward, t_d: z
+    _lattice_sums(ups, n_ups, wc2, t_a, False)
+    for s in range(n_downs):
+        s_a[s] = y_at[downs[s]]
+    _lattice_sums(downs, n_downs, s_a, s_c, True)  # s_c: y summed upward
+    _lattice_sums(downs, n_downs, wc3, s_d, False)
     for t in range(n_ups):
         u = ups[t]
-        up_table[m, u] += path_weight * (up_m[t] + g1[t] * z_acc[u])
-        up_table[b, u] += path_weight * g2[t] * x_acc[u]
-        up_table[b, u | a_bit] += path_weight * up_ba[t]
+        up_table[m, u] += path_weight * (up_m[t] + g1[t] * t_d[t])
+        up_table[b, u] += path_weight * g2[t] * (t_c[t] + psi[t] * f1_empty * omega[t])
+        up_table[b, u | a_bit] += path_weight * (up_ba[t] + g2a[t] * (r2_below[t] + f2_empty * t_a[t]))
     for s in range(n_downs):
         d = downs[s]
         down_table[m, d] += path_weight * down_m[s]
-        down_table[b, d] += path_weight * (down_b[s] + f2[s] * y_acc[d])
-        down_table[b, d | a_bit] += path_weight * down_ba[s]
+        down_table[b, d] += path_weight * (down_b[s] + f2[s] * (s_c[s] + psi2[s] * g1_empty * omega2[s]))
+        down_table[b, d | a_bit] += path_weight * (down_ba[s] + f2a[s] * (r_above[s] + g2_empty * s_d[s]))
     return total
 
 
@@ -727,8 +829,8 @@ def run_tasks(
         downs = np.zeros((n + 1, width + 1), dtype=np.int64)
         above = np.zeros((n + 1, width + 1), dtype=np.int64)
         ups = np.zeros((n + 1, width + 1), dtype=np.int64)
-        scratch = np.zeros((17, width + 1))
-        index_scratch = np.zeros((2, width + 1), dtype=np.int64)
+        scratch = np.zeros((37, width + 1))
+        index_scratch = np.zeros((1, width + 1), dtype=np.int64)
         n_downs = np.zeros(n + 1, dtype=np.int64)
         n_ups = np.zeros(n + 1, dtype=np.int64)
         n_downs[depth] = task_sizes[t, 0]
