@@ -7,7 +7,9 @@ preorders on the boxes, and every preorder is built exactly once by inserting th
 up-closed set U of boxes it supports (see :mod:`unstack.reasoner._insertion_kernels`).
 A world's weight is the product of one factor per level -- ``f_j(D) * g_j(U)`` -- so a
 depth-first walk of this insertion tree computes the partition function, and per-level
-tables indexed by D and U give every marginal at O(1) cost per node. The walk is compiled
+tables indexed by D and U give every marginal at O(1) cost per node. The last two boxes are
+summed at each node of level ``n - 2`` by subset and superset sums over that node's
+down-sets and up-sets, so the nodes of the last level are never built. The walk is compiled
 with numba and the subtrees below the first levels run on all cores.
 
 Each pair's factors are divided by ``max(p, 1 - p)`` so that every factor is at most 1:
@@ -40,8 +42,8 @@ from unstack.threads import PARALLEL_KERNELS
 
 __all__ = ["EXACT_MAX_BOXES", "ExactMarginals", "exact_marginals"]
 
-#: Largest scene the exact engine accepts by default. n = 8 dense takes seconds; n = 9
-#: has 6.3e10 worlds and takes minutes (pass ``max_boxes=9`` to run it anyway).
+#: Largest scene the exact engine accepts by default. n = 8 dense takes about a second;
+#: n = 9 has 6.3e10 worlds and takes a minute or two (pass ``max_boxes=9`` to run it anyway).
 EXACT_MAX_BOXES = 8
 #: The engine refuses results whose partition function falls below this.
 SMALLEST_PARTITION = 1e-280
@@ -153,7 +155,7 @@ def _exact_marginals(probabilities: np.ndarray, max_boxes: int = EXACT_MAX_BOXES
         raise TooLarge(
             f"{n} boxes: the exact engine is limited to {max_boxes} boxes "
             f"(n = {max_boxes + 1} has {next_count} consistent worlds; "
-            f"n = 8 takes seconds, each further box about 100 times longer)"
+            f"n = 8 takes about a second, each further box about 100 times longer)"
         )
     if n <= SMALL_MAX_BOXES:
         marginals, worlds, log_partition = small_marginals(probabilities)
