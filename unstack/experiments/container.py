@@ -9,9 +9,10 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
 ``unstack_count``
     the same probabilities with Eq. 11's cost (detected boxes supported).
 ``hybrid``
-    height vetoed by unstack: the highest candidate whose expected cost (the default model
-    and cost) is below :data:`HYBRID_MAX_COST` -- the highest box the model does not
-    believe holds anything up; when every candidate costs more, the lowest expected cost.
+    height vetoed by unstack (:func:`unstack.height_veto.highest_free_box`): the highest
+    candidate whose expected cost (the default model and cost) is below
+    :data:`~unstack.height_veto.HYBRID_MAX_COST` -- the highest box the model does not
+    believe holds anything up; when every candidate costs more, unstack's choice.
 ``highest``
     the highest candidate first.
 ``footprint``
@@ -47,14 +48,11 @@ import numpy as np
 
 from unstack.scene import Scene
 
-__all__ = ["CONTAINER_MAKERS", "CONTAINER_SAMPLES", "HYBRID_MAX_COST", "container_experiment", "container_policies"]
+__all__ = ["CONTAINER_MAKERS", "CONTAINER_SAMPLES", "container_experiment", "container_policies"]
 
 CONTAINER_MAKERS = ("unstack", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random", "lookahead")
 #: Recorded sweeps per sampled group in each decision.
 CONTAINER_SAMPLES = 512
-#: The ``hybrid`` maker takes the highest candidate whose expected cost is below this
-#: (the bound of a free box in the generalisation suite).
-HYBRID_MAX_COST = 0.5
 
 
 def _free(scene: Scene, candidates: Sequence[str]) -> list[str]:
@@ -90,10 +88,10 @@ def container_policies(
         return float(scene.box(box_id).position[2])
 
     def hybrid(scene: Scene) -> str:
+        from unstack.height_veto import highest_free_box
+
         made = decision(scene, "load")
-        costs = dict(zip(made.objects, np.asarray(made.expected_costs, dtype=float), strict=True))
-        free = [box_id for box_id in scene.detected if costs[box_id] < HYBRID_MAX_COST]
-        return max(free, key=lambda box_id: (height(scene, box_id), box_id)) if free else str(made.choice)
+        return highest_free_box(scene, dict(zip(made.objects, map(float, made.expected_costs), strict=True)))
 
     def highest(scene: Scene) -> str:
         return max(scene.detected, key=lambda box_id: (height(scene, box_id), box_id))

@@ -1,0 +1,66 @@
+"""The hybrid pick: the highest box that unstack does not believe holds anything up.
+
+Over whole containers the highest detected box is rarely wrong, and the expected cost knows
+what height cannot: load on a box that the detector missed but the cloud shows. The hybrid
+takes the highest candidate whose expected cost is below :data:`HYBRID_MAX_COST` (the bound
+of a free box in the generalisation suite); when every candidate costs more, the decision's
+own minimum-EC choice. The results page measures it against the decision and the heuristics
+(`unstack experiment container`, maker ``hybrid``).
+
+Examples
+--------
+>>> import numpy as np
+>>> from unstack.scene import Box, Scene
+>>> boxes = [Box("tall", [0.4, 0.4, 0.8], [1.0, 0.0, 0.4]), Box("low", [0.4, 0.4, 0.3], [1.0, 0.5, 0.15])]
+>>> scene = Scene(boxes, np.zeros((0, 3)), ["tall", "low"])
+>>> highest_free_box(scene, {"tall": 0.9, "low": 0.01})
+'low'
+>>> highest_free_box(scene, {"tall": 0.2, "low": 0.01})
+'tall'
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from unstack.errors import InvalidArgument
+from unstack.scene import Scene
+
+__all__ = ["HYBRID_MAX_COST", "highest_free_box"]
+
+#: A candidate whose expected cost is below this counts as holding nothing up.
+HYBRID_MAX_COST = 0.5
+
+
+def highest_free_box(scene: Scene, expected_costs: Mapping[str, float], *, max_cost: float = HYBRID_MAX_COST) -> str:
+    """The highest detected box whose expected cost is below ``max_cost``.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its ``detected`` boxes are the candidates; a box's height is its centre's z.
+    expected_costs : mapping of str to float
+        The expected cost of every detected box (``dict(zip(decision.objects,
+        decision.expected_costs))``).
+    max_cost : float
+        A box below it counts as free.
+
+    Returns
+    -------
+    str
+        Ties in height go to the larger id; when no box is below ``max_cost``, the box of
+        lowest expected cost (ties to the smaller id).
+
+    Raises
+    ------
+    InvalidArgument
+        A detected box without an expected cost, or no detected box.
+    """
+    candidates = list(scene.detected)
+    missing = [box_id for box_id in candidates if box_id not in expected_costs]
+    if missing or not candidates:
+        raise InvalidArgument(f"expected an expected cost for every detected box; missing {missing or 'boxes'}")
+    free = [box_id for box_id in candidates if expected_costs[box_id] < max_cost]
+    if not free:
+        return min(sorted(candidates), key=lambda box_id: expected_costs[box_id])
+    return max(free, key=lambda box_id: (float(scene.box(box_id).position[2]), box_id))
