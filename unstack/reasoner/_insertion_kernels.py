@@ -263,6 +263,8 @@ def _last_two_levels(
     r2_below = scratch[34]
     g2a_sup = scratch[35]
     f2a_sup = scratch[36]
+    same_down = scratch[37]
+    same_up = scratch[38]
     below = index_scratch[0]
     for t in range(n_ups):
         u = ups[t]
@@ -274,6 +276,7 @@ def _last_two_levels(
         up_m[t] = 0.0
         up_ba[t] = 0.0
         wc2[t] = 0.0
+        same_up[t] = 0.0
     for s in range(n_downs):
         d = downs[s]
         f1[s] = down_weights[m, d]
@@ -284,6 +287,7 @@ def _last_two_levels(
         down_b[s] = 0.0
         down_ba[s] = 0.0
         wc3[s] = 0.0
+        same_down[s] = 0.0
     # below[t]: the largest down-set D with ups[t] inside A(D); psi[t]: sum of f2a over the
     # down-sets D with ups[t] inside A(D); psi2[s]: sum of g2a over the up-sets inside A(D_s)
     for t in range(n_ups):
@@ -371,11 +375,10 @@ def _last_two_levels(
             if u1 & ~a1 != 0 or g1[k] == 0.0:
                 continue
             w1 = f1[i] * g1[k]
-            same = down_weights[b, d1 | a_bit] * up_weights[b, u1 | a_bit]
+            same = f2a[i] * g2a[k]
             sub = same
-            if tables:
-                down_table[b, d1 | a_bit] += path_weight * w1 * same
-                up_table[b, u1 | a_bit] += path_weight * w1 * same
+            same_down[i] += w1 * same
+            same_up[k] += w1 * same
             # a under b
             outside = u1 & ~d1
             if d1 == 0:
@@ -428,12 +431,14 @@ def _last_two_levels(
         u = ups[t]
         up_table[m, u] += path_weight * (up_m[t] + g1[t] * t_d[t])
         up_table[b, u] += path_weight * g2[t] * (t_c[t] + psi[t] * f1_empty * omega[t])
-        up_table[b, u | a_bit] += path_weight * (up_ba[t] + g2a[t] * (r2_below[t] + f2_empty * t_a[t]))
+        up_table[b, u | a_bit] += path_weight * (same_up[t] + up_ba[t] + g2a[t] * (r2_below[t] + f2_empty * t_a[t]))
     for s in range(n_downs):
         d = downs[s]
         down_table[m, d] += path_weight * down_m[s]
         down_table[b, d] += path_weight * (down_b[s] + f2[s] * (s_c[s] + psi2[s] * g1_empty * omega2[s]))
-        down_table[b, d | a_bit] += path_weight * (down_ba[s] + f2a[s] * (r_above[s] + g2_empty * s_d[s]))
+        down_table[b, d | a_bit] += path_weight * (
+            same_down[s] + down_ba[s] + f2a[s] * (r_above[s] + g2_empty * s_d[s])
+        )
     return total
 
 
@@ -829,7 +834,7 @@ def run_tasks(
         downs = np.zeros((n + 1, width + 1), dtype=np.int64)
         above = np.zeros((n + 1, width + 1), dtype=np.int64)
         ups = np.zeros((n + 1, width + 1), dtype=np.int64)
-        scratch = np.zeros((37, width + 1))
+        scratch = np.zeros((39, width + 1))
         index_scratch = np.zeros((1, width + 1), dtype=np.int64)
         n_downs = np.zeros(n + 1, dtype=np.int64)
         n_ups = np.zeros(n + 1, dtype=np.int64)
