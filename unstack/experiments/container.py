@@ -33,8 +33,8 @@ not time limits); resumable per pile; piles in parallel processes.
 
 Examples
 --------
->>> CONTAINER_MAKERS[:3]
-('unstack', 'unstack_count', 'highest')
+>>> CONTAINER_MAKERS[:4]
+('unstack', 'unstack_count', 'hybrid', 'highest')
 """
 
 from __future__ import annotations
