@@ -23,10 +23,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-import numpy as np
-
 from unstack.errors import InvalidArgument
-from unstack.reasoner.decision import choose
 from unstack.scene import Scene
 
 __all__ = ["HYBRID_MAX_COST", "highest_free_box"]
@@ -52,8 +49,7 @@ def highest_free_box(scene: Scene, expected_costs: Mapping[str, float], *, max_c
     -------
     str
         Ties in height go to the larger id; when no box is below ``max_cost``, the box of
-        lowest expected cost as the reasoner chooses it
-        (:func:`~unstack.reasoner.decision.choose`, ties to the smaller id).
+        lowest expected cost (ties to the smaller id).
 
     Raises
     ------
@@ -66,6 +62,5 @@ def highest_free_box(scene: Scene, expected_costs: Mapping[str, float], *, max_c
         raise InvalidArgument(f"expected an expected cost for every detected box; missing {missing or 'boxes'}")
     free = [box_id for box_id in candidates if expected_costs[box_id] < max_cost]
     if not free:
-        costs = np.array([expected_costs[box_id] for box_id in candidates], dtype=np.float64)
-        return choose(tuple(candidates), costs)[0]
+        return min(sorted(candidates), key=lambda box_id: expected_costs[box_id])
     return max(free, key=lambda box_id: (float(scene.box(box_id).position[2]), box_id))
