@@ -53,6 +53,23 @@ def test_the_parallel_split_at_seven_boxes_agrees_with_serial_sat_enumeration(rn
     assert result.consistent_worlds == len(worlds)
 
 
+def test_one_thread_gives_the_same_bits_as_all_threads(rng: np.random.Generator) -> None:
+    """The subtrees run on the engine's own threads and are summed in task order."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    import numba
+
+    probabilities = random_probabilities(7, rng)
+
+    def on_one_thread() -> np.ndarray:
+        numba.set_num_threads(1)  # local to this worker thread
+        return exact_marginals(probabilities).marginals
+
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        serial = pool.submit(on_one_thread).result()
+    assert np.array_equal(exact_marginals(probabilities).marginals, serial)
+
+
 def test_extreme_probabilities_do_not_overflow() -> None:
     probabilities = np.full((5, 5), 1 - 1e-15)
     np.fill_diagonal(probabilities, 0.0)

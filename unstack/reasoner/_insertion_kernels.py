@@ -33,7 +33,7 @@ Everything here is plain numeric code compiled with numba; the public wrapper li
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 
 @njit(cache=True, nogil=True)
@@ -136,7 +136,7 @@ def _last_level(
     return total
 
 
-@njit(inline="always")
+@njit(cache=True, nogil=True, fastmath=True)
 def _lattice_sums(masks: np.ndarray, n: int, values: np.ndarray, out: np.ndarray, upward: bool) -> None:
     """``out[j]`` = sum of ``values[i]`` over ``masks[i] ⊆ masks[j]`` (``masks[i] ⊇ masks[j]`` if ``upward``).
 
@@ -154,7 +154,7 @@ def _lattice_sums(masks: np.ndarray, n: int, values: np.ndarray, out: np.ndarray
         out[j] = acc
 
 
-@njit(inline="always")
+@njit(cache=True, nogil=True, fastmath=True)
 def _lattice_sums2(
     masks: np.ndarray, n: int, x: np.ndarray, y: np.ndarray, x_out: np.ndarray, y_out: np.ndarray, upward: bool
 ) -> None:
@@ -795,8 +795,9 @@ def collect_tasks(
     )
 
 
-@njit(cache=True, parallel=True)
-def run_tasks(
+@njit(cache=True, nogil=True)
+def run_task(
+    t: int,
     n: int,
     depth: int,
     collapse: int,
@@ -810,59 +811,58 @@ def run_tasks(
     up_weights: np.ndarray,
     down_allowed: np.ndarray,
     up_allowed: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
-    """Expand every task's subtree in parallel.
+) -> tuple[float, np.ndarray, np.ndarray, int]:
+    """Expand task ``t``'s subtree, without the GIL (the caller runs tasks on threads).
 
     ``collapse`` (1 or 2) last levels are summed without building their nodes, and
-    ``depth`` must be at most ``n - collapse``. Returns each task's subtree weight sum, the
-    per-level ``D`` and ``U`` tables (summed over the tasks) and the number of worlds whose
-    relations are all allowed -- counted only if ``counting`` with ``collapse=2`` (when every
-    relation is allowed, the count is the number of preorders and the caller knows it).
+    ``depth`` must be at most ``n - collapse``. Returns the subtree's weight sum, its
+    per-level ``D`` and ``U`` tables and the number of worlds whose relations are all
+    allowed -- counted only if ``counting`` with ``collapse=2`` (when every relation is
+    allowed, the count is the number of preorders and the caller knows it).
+
+    A plain serial kernel rather than a ``parallel=True`` loop: numba's parallel lowering
+    tripled the compile time of this walk (about 60 s in a fresh process), and threads the
+    caller owns need no threading layer and no process-wide lock.
     """
-    n_tasks = task_weight.shape[0]
     width = 1 << max(n - 1, 0)
     weights = (down_weights, up_weights, down_allowed, up_allowed)
     down_ones = down_allowed.astype(np.float64)
     up_ones = up_allowed.astype(np.float64)
-    # One table per task (numba's thread id would keep this function out of the cache);
-    # callers keep the task count in the hundreds, so this stays a few megabytes.
-    down_tables = np.zeros((n_tasks, n, width))
-    up_tables = np.zeros((n_tasks, n, width))
-    subtree_sums = np.zeros(n_tasks)
-    world_counts = np.zeros((n_tasks, 1), dtype=np.int64)
-    for t in prange(n_tasks):
-        downs = np.zeros((n + 1, width + 1), dtype=np.int64)
-        above = np.zeros((n + 1, width + 1), dtype=np.int64)
-        ups = np.zeros((n + 1, width + 1), dtype=np.int64)
-        scratch = np.zeros((39, width + 1))
-        index_scratch = np.zeros((1, width + 1), dtype=np.int64)
-        n_downs = np.zeros(n + 1, dtype=np.int64)
-        n_ups = np.zeros(n + 1, dtype=np.int64)
-        n_downs[depth] = task_sizes[t, 0]
-        n_ups[depth] = task_sizes[t, 1]
-        for a in range(n_downs[depth]):
-            downs[depth, a] = task_downs[t, a]
-            above[depth, a] = task_above[t, a]
-        for b in range(n_ups[depth]):
-            ups[depth, b] = task_ups[t, b]
-        subtree_sums[t] = _subtree(
-            depth,
-            n,
-            collapse,
-            task_weight[t],
-            downs,
-            above,
-            ups,
-            n_downs,
-            n_ups,
-            weights,
-            down_ones,
-            up_ones,
-            down_tables[t],
-            up_tables[t],
-            scratch,
-            index_scratch,
-            world_counts[t],
-            counting,
-        )
-    return subtree_sums, down_tables.sum(axis=0), up_tables.sum(axis=0), world_counts.sum()
+    down_table = np.zeros((n, width))
+    up_table = np.zeros((n, width))
+    world_count = np.zeros(1, dtype=np.int64)
+    downs = np.zeros((n + 1, width + 1), dtype=np.int64)
+    above = np.zeros((n + 1, width + 1), dtype=np.int64)
+    ups = np.zeros((n + 1, width + 1), dtype=np.int64)
+    scratch = np.zeros((39, width + 1))
+    index_scratch = np.zeros((1, width + 1), dtype=np.int64)
+    n_downs = np.zeros(n + 1, dtype=np.int64)
+    n_ups = np.zeros(n + 1, dtype=np.int64)
+    n_downs[depth] = task_sizes[t, 0]
+    n_ups[depth] = task_sizes[t, 1]
+    for a in range(n_downs[depth]):
+        downs[depth, a] = task_downs[t, a]
+        above[depth, a] = task_above[t, a]
+    for b in range(n_ups[depth]):
+        ups[depth, b] = task_ups[t, b]
+    subtree_sum = _subtree(
+        depth,
+        n,
+        collapse,
+        task_weight[t],
+        downs,
+        above,
+        ups,
+        n_downs,
+        n_ups,
+        weights,
+        down_ones,
+        up_ones,
+        down_table,
+        up_table,
+        scratch,
+        index_scratch,
+        world_count,
+        counting,
+    )
+    return subtree_sum, down_table, up_table, world_count[0]

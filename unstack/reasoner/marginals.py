@@ -10,7 +10,7 @@ depth-first walk of this insertion tree computes the partition function, and per
 tables indexed by D and U give every marginal at O(1) cost per node. The last two boxes are
 summed at each node of level ``n - 2`` by subset and superset sums over that node's
 down-sets and up-sets, so the nodes of the last level are never built. The walk is compiled
-with numba and the subtrees below the first levels run on all cores.
+with numba and the subtrees below the first levels run on one thread each, on all cores.
 
 Each pair's factors are divided by ``max(p, 1 - p)`` so that every factor is at most 1:
 no product can overflow and the all-zero or forced-closure world keeps the partition
@@ -38,7 +38,7 @@ from unstack.errors import NumericalRangeError, TooLarge
 from unstack.reasoner.arguments import check_count, check_matrix
 from unstack.reasoner.consistency import PREORDER_COUNTS
 from unstack.reasoner.small import SMALL_MAX_BOXES, small_marginals
-from unstack.threads import PARALLEL_KERNELS
+from unstack.threads import map_on_threads
 
 __all__ = ["EXACT_MAX_BOXES", "ExactMarginals", "exact_marginals"]
 
@@ -170,8 +170,6 @@ def _compiled_marginals(probabilities: np.ndarray, collapse: int = 2) -> ExactMa
     ``collapse`` is how many of the last levels are summed without building their nodes:
     2 (transforms, the default) or 1 (the direct pair sum, kept as a cross-check).
     """
-    from numba import parallel_chunksize
-
     from unstack.reasoner import _insertion_kernels as kernels
 
     n = probabilities.shape[0]
@@ -183,10 +181,17 @@ def _compiled_marginals(probabilities: np.ndarray, collapse: int = 2) -> ExactMa
     counting = bool(np.any((off_diagonal == 0.0) | (off_diagonal == 1.0)))
     tasks = kernels.collect_tasks(n, depth, PREORDER_COUNTS[depth], *tables)
     task_weight, task_downs, task_above, task_ups, task_sizes, path_downs, path_ups = tasks
-    with PARALLEL_KERNELS, parallel_chunksize(1):
-        subtree_sums, down_table, up_table, world_count = kernels.run_tasks(
-            n, depth, collapse, counting, task_weight, task_downs, task_above, task_ups, task_sizes, *tables
+
+    def run(task: int) -> tuple[float, np.ndarray, np.ndarray, int]:
+        return kernels.run_task(
+            task, n, depth, collapse, counting, task_weight, task_downs, task_above, task_ups, task_sizes, *tables
         )
+
+    results = map_on_threads(run, range(len(task_weight)))
+    subtree_sums = np.array([result[0] for result in results])
+    down_table = np.sum([result[1] for result in results], axis=0)
+    up_table = np.sum([result[2] for result in results], axis=0)
+    world_count = sum(int(result[3]) for result in results)
     if not counting:
         world_count = PREORDER_COUNTS[n] if n < len(PREORDER_COUNTS) else int(world_count)
     contributions = task_weight * subtree_sums
