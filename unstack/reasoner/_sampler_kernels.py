@@ -28,7 +28,7 @@ depend on how the chains are spread over threads.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 _MULTIPLIER = np.uint64(0x2545F4914F6CDD1D)
 _SHIFT_A = np.uint64(12)
@@ -574,7 +574,7 @@ def _add_conditionals(
 
 
 @njit(cache=True, nogil=True)
-def run_chain(
+def _run_chain(
     chain: int,
     probabilities: np.ndarray,
     log_present: np.ndarray,
@@ -650,3 +650,65 @@ def run_chain(
         if record:
             _add_conditionals(probabilities, successors, predecessors, sums, block_of)
     return accepted
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def run_chains(
+    probabilities: np.ndarray,
+    log_present: np.ndarray,
+    log_absent: np.ndarray,
+    successors: np.ndarray,
+    predecessors: np.ndarray,
+    rng: np.ndarray,
+    sweeps: int,
+    tries: int,
+    record: bool,
+    sums: np.ndarray,
+    accepted: np.ndarray,
+    scatter: bool,
+    block_members: np.ndarray,
+    block_sizes: np.ndarray,
+    block_counts: np.ndarray,
+    block_masks: np.ndarray,
+    block_log_weights: np.ndarray,
+    block_cumulative: np.ndarray,
+    block_marginals: np.ndarray,
+    block_pairs: np.ndarray,
+    block_of: np.ndarray,
+) -> None:
+    """Advance every chain by ``sweeps`` sweeps (chains run in parallel).
+
+    ``log_present``/``log_absent``: ``log p`` and ``log(1 - p)`` (``-inf`` at 0);
+
+    ``successors``/``predecessors``: ``(chains, n)`` bit masks, updated in place;
+    ``rng``: ``(chains,)`` uint64 states; ``sums``: ``(chains, n, n)``, the conditionals
+    of every recorded sweep are added; ``scatter``: take every first proposal (to spread
+    the starting worlds of the chains);
+    ``accepted``: ``(chains,)`` counts of moves that changed the state;
+    ``block_*``: the blocks redrawn exactly after every sweep
+    (:class:`~unstack.reasoner.block_gibbs.BlockTables`; no blocks: zero rows).
+    """
+    for c in prange(successors.shape[0]):
+        accepted[c] += _run_chain(
+            c,
+            probabilities,
+            log_present,
+            log_absent,
+            successors[c],
+            predecessors[c],
+            rng,
+            sweeps,
+            tries,
+            record,
+            sums[c],
+            scatter,
+            block_members,
+            block_sizes,
+            block_counts,
+            block_masks,
+            block_log_weights,
+            block_cumulative,
+            block_marginals,
+            block_pairs,
+            block_of,
+        )

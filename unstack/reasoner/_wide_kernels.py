@@ -15,7 +15,7 @@ word operations against ``n ** 2`` for the one-word kernels.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from unstack.reasoner._sampler_kernels import _STRIDE, _uniform
 
@@ -491,7 +491,7 @@ def _add_conditionals(
 
 
 @njit(cache=True, nogil=True)
-def run_chain(
+def _run_chain(
     chain: int,
     probabilities: np.ndarray,
     log_present: np.ndarray,
@@ -552,3 +552,40 @@ def run_chain(
         if record:
             _add_conditionals(probabilities, successors, predecessors, sums, block_of)
     return accepted
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def run_chains(
+    probabilities: np.ndarray,
+    log_present: np.ndarray,
+    log_absent: np.ndarray,
+    successors: np.ndarray,
+    predecessors: np.ndarray,
+    rng: np.ndarray,
+    sweeps: int,
+    tries: int,
+    record: bool,
+    sums: np.ndarray,
+    accepted: np.ndarray,
+    scatter: bool,
+    block_members: np.ndarray,
+    block_sizes: np.ndarray,
+    block_counts: np.ndarray,
+    block_masks: np.ndarray,
+    block_log_weights: np.ndarray,
+    block_linear_weights: np.ndarray,
+    block_cumulative: np.ndarray,
+    block_marginals: np.ndarray,
+    block_pairs: np.ndarray,
+    block_of: np.ndarray,
+    moves: int,
+    cursors: np.ndarray,
+) -> None:
+    """:func:`unstack.reasoner._sampler_kernels.run_chains` with ``(chains, n, words)`` states;
+    a sweep re-inserts ``moves`` boxes, in turn from ``cursors`` (``(chains,)``, updated)."""
+    for c in prange(successors.shape[0]):
+        accepted[c] += _run_chain(
+            c, probabilities, log_present, log_absent, successors[c], predecessors[c], rng, sweeps, tries, record,
+            sums[c], scatter, block_members, block_sizes, block_counts, block_masks, block_log_weights,
+            block_linear_weights, block_cumulative, block_marginals, block_pairs, block_of, moves, cursors,
+        )  # fmt: skip

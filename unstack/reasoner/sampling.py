@@ -22,7 +22,7 @@ marginals are estimated by Markov chain Monte Carlo over the consistent worlds t
   keep the world transitive, else the value transitivity leaves. This Rao-Blackwellisation
   removes the noise of the many pairs that transitivity does not touch (measured: it beats
   averaging the moved box's candidate relations, which was tried and dropped);
-* several chains run in parallel (one thread each, on all cores), each from its own random world (one sweep that takes
+* several chains run in parallel, each from its own random world (one sweep that takes
   every proposal, starting from the closure of the hard evidence), so that chains which
   fail to mix disagree and widen the error bars instead of agreeing on their start; the
   first sweeps are discarded (burn-in), the rest are grouped into batches, and the standard error of
@@ -55,7 +55,7 @@ import numpy as np
 from unstack.errors import InvalidArgument
 from unstack.reasoner.arguments import check_budget, check_count, check_matrix, check_seed
 from unstack.reasoner.world_masks import ONE_WORD_BOXES, mask_words, pack, unpack
-from unstack.threads import map_on_threads
+from unstack.threads import PARALLEL_KERNELS
 
 __all__ = [
     "DEFAULT_CHAINS",
@@ -303,15 +303,15 @@ class _Chains:
 
         n = probabilities.shape[0]
         self.wide = mask_words(n) > 0 if wide is None else wide
-        self._run: Callable[..., int]
+        self._run: Callable[..., None]
         if self.wide:
-            from unstack.reasoner._wide_kernels import run_chain as run_wide
+            from unstack.reasoner._wide_kernels import run_chains as run_wide
 
             self._run = run_wide
         else:
-            from unstack.reasoner._sampler_kernels import run_chain
+            from unstack.reasoner._sampler_kernels import run_chains
 
-            self._run = run_chain
+            self._run = run_chains
         self.probabilities = probabilities
         self.log_tables = _log_tables(probabilities)
         successors, predecessors = _start_state(probabilities, wide=self.wide)
@@ -347,35 +347,30 @@ class _Chains:
         if self.wide:
             weights = (blocks.log_weights, self.linear_weights)
             extra = (moves, self.cursors)
-
-        def run(chain: int) -> int:
-            return int(
-                self._run(
-                    chain,
-                    self.probabilities,
-                    *self.log_tables,
-                    self.successors[chain],
-                    self.predecessors[chain],
-                    self.rng,
-                    sweeps,
-                    self.tries,
-                    record,
-                    self.sums[chain],
-                    scatter,
-                    blocks.members,
-                    blocks.sizes,
-                    blocks.counts,
-                    blocks.masks,
-                    *weights,
-                    blocks.cumulative,
-                    blocks.marginals,
-                    blocks.pairs,
-                    blocks.block_of,
-                    *extra,
-                )
+        with PARALLEL_KERNELS:
+            self._run(
+                self.probabilities,
+                *self.log_tables,
+                self.successors,
+                self.predecessors,
+                self.rng,
+                sweeps,
+                self.tries,
+                record,
+                self.sums,
+                self.accepted,
+                scatter,
+                blocks.members,
+                blocks.sizes,
+                blocks.counts,
+                blocks.masks,
+                *weights,
+                blocks.cumulative,
+                blocks.marginals,
+                blocks.pairs,
+                blocks.block_of,
+                *extra,
             )
-
-        self.accepted += np.array(map_on_threads(run, range(len(self.rng))), dtype=np.int64)
 
 
 def sampled_marginals(
