@@ -62,6 +62,26 @@ def test_decisions_on_simulated_piles(small_dataset: Path) -> None:
     assert again["summary"] == result["summary"]
 
 
+def test_per_iset_records_pair_two_models_on_the_same_isets(small_dataset: Path) -> None:
+    from unstack.api import load_model
+    from unstack.experiments.decisions import paired_between_runs
+
+    default = evaluate_decisions(small_dataset, load_model(default_model_path()), r=4, isets=8, seed=2)
+    extended = evaluate_decisions(small_dataset, load_model("extended"), r=4, isets=8, seed=2)
+    assert [row["boxes"] for row in default["per_iset"]] == [row["boxes"] for row in extended["per_iset"]]
+    for row in default["per_iset"]:
+        assert row["picks"]["reasoner"] in row["boxes"] and len(row["costs"]) == 4
+    moved = np.array([row["moved"]["reasoner"] for row in default["per_iset"]])
+    assert moved.mean() == pytest.approx(default["summary"]["reasoner"]["boxes_moved"])
+    paired = paired_between_runs(default, extended)
+    gap = extended["summary"]["reasoner"]["boxes_moved"] - default["summary"]["reasoner"]["boxes_moved"]
+    assert paired["mean"] == pytest.approx(gap)
+    with pytest.raises(ValueError, match="drew their ISets differently \\(seed\\)"):
+        paired_between_runs(default, {**extended, "seed": 3})
+    with pytest.raises(ValueError, match="no per-ISet records"):
+        paired_between_runs(default, {key: value for key, value in extended.items() if key != "per_iset"})
+
+
 def test_experiment_commands(small_dataset: Path, tmp_path: Path) -> None:
     result = unstack("experiment", "table1", "--out", str(tmp_path), "--max-n", "5")
     assert result.returncode == 0, result.stderr
@@ -73,6 +93,17 @@ def test_experiment_commands(small_dataset: Path, tmp_path: Path) -> None:
     assert result.returncode == 0, result.stderr
     assert (tmp_path / "fig4.png").read_bytes()[:4] == b"\x89PNG"
     assert json.loads((tmp_path / "decisions.json").read_text())["isets"] == 6
+    first = tmp_path / "first.json"
+    (tmp_path / "decisions.json").rename(first)
+    common = ("experiment", "decisions", str(small_dataset), "--out", str(tmp_path), "--r", "4", "--isets", "6")
+    result = unstack(*common, "--model", "extended", "--pair-with", str(first))
+    assert result.returncode == 0, result.stderr
+    assert f"this run minus {first}:" in result.stdout
+    assert json.loads((tmp_path / "decisions.json").read_text())["against_earlier_run"]["file"] == str(first)
+    result = unstack(*common, "--seed", "5", "--pair-with", str(first))
+    assert result.returncode == 2 and result.stderr.strip().endswith(
+        "drew their ISets differently (seed): nothing to pair"
+    )
 
 
 @pytest.mark.parametrize(

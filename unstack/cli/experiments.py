@@ -181,24 +181,42 @@ def fig5a(
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets.")
 @click.option("--full", is_flag=True, help="The paper's size: 493 test ISets (overrides --isets).")
+@click.option("--pair-with", "pair_with", type=click.Path(dir_okay=False), default=None,
+              help="decisions.json of an earlier run on the same ISets (another model, say): "
+                   "prints unstack's boxes moved, this run minus that one, paired.")  # fmt: skip
 def decisions(
-    data_dir: str, out: str, model_path: str | None, r: int, isets: int, draw: str, seed: int, full: bool
+    data_dir: str,
+    out: str,
+    model_path: str | None,
+    r: int,
+    isets: int,
+    draw: str,
+    seed: int,
+    full: bool,
+    pair_with: str | None,
 ) -> None:
     """Fig. 4 and beyond: MSE(cost), first pick right and physical disturbance of every decision maker."""
     from unstack.cli.main import load_model_option
     from unstack.datasets import require_configurations
-    from unstack.experiments.decisions import DECISION_MAKERS, evaluate_decisions, plot_fig4
+    from unstack.experiments.decisions import DECISION_MAKERS, evaluate_decisions, paired_between_runs, plot_fig4
+    from unstack.jsonio import read_document
 
     if full:
         isets = PAPER_TEST_ISETS
     if r < 2 or isets < 1:
         raise UnstackError(f"expected --r >= 2 and --isets >= 1, got {r} and {isets}")
     require_configurations(data_dir)  # before any progress bar or output folder
+    earlier = read_document(pair_with).data if pair_with is not None else None
     model, name = load_model_option(model_path)
     folder = _out(out)
     with progress_bar("ISets") as report:
         result = evaluate_decisions(data_dir, model, r=r, isets=isets, seed=seed, progress=report, draw=draw)
     result["model"] = name
+    if earlier is not None:
+        try:
+            result["against_earlier_run"] = {"file": str(pair_with), **paired_between_runs(earlier, result)}
+        except ValueError as error:
+            raise UnstackError(f"{pair_with}: {error}") from None
     _write_json(folder / "decisions.json", result)
     plot_fig4(result, folder / "fig4.png")
     table = Table(title=f"{result['isets']} test ISets of {r} boxes ({data_dir})")
@@ -218,6 +236,9 @@ def decisions(
             f"{row['displacement_m']:.3f}",
         )
     Console().print(table)
+    if earlier is not None:
+        paired = result["against_earlier_run"]
+        click.echo(f"unstack's boxes moved, this run minus {pair_with}: {_paired(paired)}")
     click.echo(f"results in {folder / 'decisions.json'} and {folder / 'fig4.png'}")
 
 

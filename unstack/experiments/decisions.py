@@ -32,7 +32,10 @@ supports):
   scene: boxes of the whole pile (not only the ISet) that moved more than 2 cm when the chosen
   box was taken away, and the sum of their displacements;
 * for every other decision maker, the paired difference (other minus unstack) of each score
-  over the same ISets, with its standard error (``against_reasoner``).
+  over the same ISets, with its standard error (``against_reasoner``);
+* every ISet's own record (``per_iset``: its boxes, their true costs, each maker's pick and
+  the boxes it moved), so that two runs on the same ISets -- two models, say -- can be paired
+  afterwards (:func:`paired_between_runs`).
 
 Examples
 --------
@@ -59,6 +62,7 @@ __all__ = [
     "decision_scores",
     "evaluate_decisions",
     "iset_outcome",
+    "paired_between_runs",
     "paired_difference",
     "squared_regret",
     "uncovered_boxes",
@@ -286,6 +290,7 @@ def evaluate_decisions(
         "r": r,
         "isets": len(results),
         "seed": seed,
+        "draw": draw,
         "summary": summary,
         "against_reasoner": against_reasoner,
         "bins": _binned(results, scores),
@@ -294,7 +299,59 @@ def evaluate_decisions(
             "balanced_error_rate": float(np.mean([s.balanced_error_rate for s in results])),
             "average_entropy": float(np.mean([s.average_entropy for s in results])),
         },
+        "per_iset": [_iset_record(outcome, scores, k) for k, outcome in enumerate(results)],
     }
+
+
+def _iset_record(outcome: IsetOutcome, scores: dict[str, dict[str, np.ndarray]], k: int) -> dict[str, Any]:
+    """One ISet's boxes, true costs, picks (box ids) and boxes moved per maker."""
+    return {
+        "scene": Path(outcome.scene_file).name,
+        "boxes": list(outcome.ids),
+        "costs": outcome.costs.tolist(),
+        "picks": {maker: outcome.ids[pick] for maker, pick in outcome.picks.items()},
+        "moved": {maker: float(values["moved"][k]) for maker, values in scores.items()},
+    }
+
+
+def paired_between_runs(
+    first: dict[str, Any], second: dict[str, Any], *, maker: str = "reasoner"
+) -> dict[str, float | None]:
+    """Boxes moved by ``maker``, ``second`` run minus ``first``, paired over their common ISets.
+
+    Both runs must come from :func:`evaluate_decisions` on the same data, ``r``, seed and draw
+    (then they drew the same ISets, whatever model each used); an ISet is matched by its scene
+    and boxes.
+
+    Raises
+    ------
+    ValueError
+        The runs drew different ISets, or a run has no per-ISet records.
+
+    Examples
+    --------
+    >>> run = {"data": "d", "r": 2, "seed": 0, "draw": "random", "per_iset": [
+    ...     {"scene": "s", "boxes": ["a", "b"], "moved": {"reasoner": 1.0}}]}
+    >>> other = {**run, "per_iset": [{"scene": "s", "boxes": ["a", "b"], "moved": {"reasoner": 0.0}}]}
+    >>> paired_between_runs(run, other)["mean"]
+    -1.0
+    """
+    for run in (first, second):
+        if "per_iset" not in run:
+            raise ValueError("a run has no per-ISet records (made before they were kept): run it again")
+    settings = ("data", "r", "seed", "draw")
+    if any(first.get(key) != second.get(key) for key in settings):
+        differing = ", ".join(key for key in settings if first.get(key) != second.get(key))
+        raise ValueError(f"the runs drew their ISets differently ({differing}): nothing to pair")
+
+    def by_iset(run: dict[str, Any]) -> dict[tuple[str, tuple[str, ...]], float]:
+        return {(row["scene"], tuple(row["boxes"])): float(row["moved"][maker]) for row in run["per_iset"]}
+
+    ours, theirs = by_iset(first), by_iset(second)
+    common = [key for key in ours if key in theirs]
+    if not common:
+        raise ValueError("the runs share no ISet: nothing to pair")
+    return paired_difference(np.array([theirs[key] for key in common]), np.array([ours[key] for key in common]))
 
 
 def plot_fig4(result: dict[str, Any], output: str | os.PathLike[str]) -> None:
