@@ -55,3 +55,15 @@ def test_a_small_decision_loads_only_what_it_needs(repo: Path) -> None:
     lean = {"numba", "pysat", "networkx", "jsonschema", "rich", "scipy", *HEAVY}
     assert not loaded & lean, sorted(loaded & lean)
     assert "unstack.learning" not in json.loads(result.stderr)
+
+
+@pytest.mark.parametrize("arguments", [["--help"], ["train", "--help"], ["experiment", "--help"]])
+def test_help_lists_the_commands_without_loading_heavy_parts(arguments: list[str]) -> None:
+    """Listing the commands imports each lazy command's module; none of them may load scikit-learn."""
+    probe = PROBE.replace(
+        '["unstack", "decide", {file!r}, "--json", "--method", {method!r}]', repr(["unstack", *arguments])
+    )
+    result = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300, check=True)
+    loaded = {name.split(".")[0] for name in json.loads(result.stderr)}
+    assert "Usage: unstack" in result.stdout
+    assert not loaded & set(HEAVY), sorted(loaded & set(HEAVY))

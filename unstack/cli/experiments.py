@@ -14,9 +14,8 @@ from unstack.cli.main import MODEL_HELP, finite_seconds
 from unstack.cli.progress import progress_bar
 from unstack.errors import UnstackError
 from unstack.experiments.container import CONTAINER_MAKERS, CONTAINER_SAMPLES
-from unstack.learning.classifier import LEARNERS
+from unstack.learning.choices import LEARNERS, SPLITS
 from unstack.learning.features import FEATURE_SETS
-from unstack.learning.training import SPLITS
 from unstack.learning.training_data import ISET_DRAWS
 from unstack.reasoner.costs import COSTS, DEFAULT_COST
 from unstack.sim.unloading import REACH_RULES

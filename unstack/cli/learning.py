@@ -12,9 +12,8 @@ from rich.text import Text
 
 from unstack.cli.main import MODEL_HELP
 from unstack.errors import UnstackError
-from unstack.learning.classifier import LEARNERS
+from unstack.learning.choices import LEARNERS, SPLITS
 from unstack.learning.features import FEATURE_SETS
-from unstack.learning.training import SPLITS
 from unstack.learning.training_data import ISET_DRAWS
 
 __all__ = ["evaluate", "load_support_model", "metrics_view", "probabilities", "scene_supports", "train"]

@@ -47,10 +47,9 @@ from sklearn.pipeline import Pipeline
 from sklearn.utils.multiclass import type_of_target, unique_labels
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-__all__ = ["LEARNERS", "SupportClassifier", "default_grid", "fold_splitter", "make_learner"]
+from unstack.learning.choices import LEARNERS
 
-#: Learner names accepted by ``SupportClassifier(learner=...)``.
-LEARNERS = ("svm", "gradient_boosting", "calibrated_svm")
+__all__ = ["LEARNERS", "SupportClassifier", "default_grid", "fold_splitter", "make_learner"]
 
 
 def make_learner(name: str, random_state: int | None, *, calibration_folds: int = 5) -> Pipeline:

@@ -21,6 +21,7 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 from unstack.errors import UnstackError
+from unstack.learning.choices import SPLITS
 from unstack.learning.features import FeatureSettings
 from unstack.learning.holdout import HoldoutResult
 from unstack.learning.model_file import SupportModel
@@ -38,9 +39,6 @@ __all__ = [
 
 #: Configuration numbers of the n-th data set of a training run start at n times this.
 CONFIGURATION_OFFSET = 100_000
-#: How the rows are split for hold-out figures and folds: ``pairs`` (the paper: by relation)
-#: or ``configuration`` (each pile's relations on one side).
-SPLITS = ("pairs", "configuration")
 
 
 def pooled_examples(
