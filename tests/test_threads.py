@@ -89,3 +89,24 @@ def test_map_on_threads_runs_in_the_calling_thread_when_numba_may_use_one() -> N
 
     with ThreadPoolExecutor(max_workers=1) as pool:
         assert len(pool.submit(worker).result()) == 1
+
+
+def test_map_on_threads_raises_the_first_error_and_drops_the_items_not_started() -> None:
+    import threading
+
+    import numba
+
+    if numba.get_num_threads() < 2:
+        pytest.skip("one kernel thread: items run in the calling thread")
+    started = []
+
+    def fail_first(item: int) -> int:
+        started.append(item)
+        if item == 0:
+            raise ValueError("item 0 failed")
+        threading.Event().wait(0.05)
+        return item
+
+    with pytest.raises(ValueError, match="item 0 failed"):
+        map_on_threads(fail_first, range(200))
+    assert len(started) < 200

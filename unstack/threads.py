@@ -52,10 +52,15 @@ def map_on_threads(function: Callable[[int], _Result], items: Sequence[int]) -> 
     For functions that spend their time in ``nogil`` kernels. The results come back in the
     order of ``items``, so sums over them do not depend on scheduling. numba's thread count
     (``NUMBA_NUM_THREADS``, or ``numba.set_num_threads`` in the calling thread) is respected;
-    one thread, or one item, runs in the calling thread.
+    one thread, or one item, runs in the calling thread. When an item fails (or the caller
+    is interrupted), the items not yet started are cancelled and the error is raised.
     """
     threads = min(kernel_threads(), len(items))
     if threads <= 1:
         return [function(item) for item in items]
-    with ThreadPoolExecutor(max_workers=threads, thread_name_prefix="unstack-kernel") as pool:
-        return list(pool.map(function, items))
+    pool = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="unstack-kernel")
+    try:
+        futures = [pool.submit(function, item) for item in items]
+        return [future.result() for future in futures]
+    finally:  # an error or Ctrl-C: the items not started are dropped, not run to the end
+        pool.shutdown(wait=True, cancel_futures=True)
