@@ -120,6 +120,31 @@ def test_unloading_a_container_detects_again_after_every_pick(pile_with_a_hidden
         assert set(current.detected) <= {box.id for box in current.boxes}
 
 
+def test_a_box_that_leaves_the_container_leaves_the_pile(pile: Scene) -> None:
+    """A box falling off the apron (or through the floor) is lost: never scanned into a scene again."""
+    from dataclasses import replace
+
+    from unstack.sim.unloading import LOST_BELOW_FLOOR
+
+    outside = replace(pile.boxes[-1], position=np.array([-2.5, 0.0, 0.4]))  # beyond the apron, in the air
+    scene = Scene([*pile.boxes[:-1], outside], pile.points, pile.detected, metadata=pile.metadata, source="test")
+    seen: list[Scene] = []
+
+    def recording(current: Scene) -> str:
+        seen.append(current)
+        return highest_first(current)
+
+    run = unload_container(scene, recording)
+    assert [step.lost for step in run.steps if step.lost] == [(outside.id,)]
+    lost_at = next(number for number, step in enumerate(run.steps) if step.lost)
+    assert outside.id in run.steps[lost_at].fallen
+    assert all(outside.id not in {box.id for box in current.boxes} for current in seen[lost_at + 1 :])
+    assert outside.id not in run.order and run.stopped == "container empty"
+    assert seen[lost_at].box(outside.id).position[2] >= -LOST_BELOW_FLOOR  # in place until the step that lost it
+    again = execute_unloading(scene, [*run.order, outside.id])  # a fixed order skips the box it lost
+    assert again.order == run.order and any(outside.id in step.lost for step in again.steps)
+
+
 def test_a_pick_limit_stops_the_run_and_says_so(pile: Scene) -> None:
     run = unload_container(pile, highest_first, max_picks=2)
     assert len(run.order) == 2 and run.stopped == "pick limit"

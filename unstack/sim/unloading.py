@@ -29,6 +29,7 @@ from unstack.errors import UnstackError
 from unstack.scene import Scene
 
 __all__ = [
+    "LOST_BELOW_FLOOR",
     "REACH_RULES",
     "UnloadRun",
     "UnloadStep",
@@ -52,6 +53,10 @@ COVER_GAP = 0.03
 FALL_DROP = 0.2
 #: ... or tips it more than this (degrees between its old and new vertical axis).
 FALL_TILT_DEG = 45.0
+#: A box whose centre is this far below the container floor (z = 0) has left the container --
+#: fallen out of the open door side or, rarely, through the floor in the physics engine: it
+#: is no longer part of the pile (not scanned into a scene, not a candidate, not watched).
+LOST_BELOW_FLOOR = 1.0
 
 
 @dataclass(frozen=True)
@@ -63,6 +68,7 @@ class UnloadStep:
     displacement_m: float
     max_displacement_m: float
     fallen: tuple[str, ...] = ()
+    lost: tuple[str, ...] = ()  # boxes that left the container in this step (also in ``fallen``)
 
     @property
     def boxes_moved(self) -> int:
@@ -77,6 +83,7 @@ class UnloadStep:
             "displacement_m": self.displacement_m,
             "max_displacement_m": self.max_displacement_m,
             "fallen": list(self.fallen),
+            "lost": list(self.lost),
         }
 
 
@@ -135,7 +142,14 @@ def execute_unloading(scene: Scene, order: Sequence[str]) -> UnloadRun:
     unknown = [box_id for box_id in order if box_id not in scene.box_ids]
     if unknown or len(set(order)) != len(order):
         raise UnstackError(f"{scene.source}: the order names unknown or repeated boxes: {unknown or list(order)}")
-    return _execute(scene, lambda number, _world, _in_place: order[number] if number < len(order) else None)
+    pending = list(order)
+
+    def next_in_order(_number: int, _world: Any, in_place: list[str]) -> str | None:
+        while pending and pending[0] not in in_place:  # a box of the order that left the container
+            pending.pop(0)
+        return pending.pop(0) if pending else None
+
+    return _execute(scene, next_in_order)
 
 
 def execute_policy(scene: Scene, policy: Callable[[Scene], str], boxes: Sequence[str]) -> UnloadRun:
@@ -161,7 +175,10 @@ def execute_policy(scene: Scene, policy: Callable[[Scene], str], boxes: Sequence
     settings = _scene_settings(scene)
     remaining = list(boxes)
 
-    def sense_and_pick(number: int, world: Any, in_place: list[str]) -> str:
+    def sense_and_pick(number: int, world: Any, in_place: list[str]) -> str | None:
+        remaining[:] = [box_id for box_id in remaining if box_id in in_place]  # not those that left the container
+        if not remaining:
+            return None
         current_boxes = _boxes_in_place(scene, world, in_place)
         scan = scan_pile(world, settings.sensor, seed=number)
         current = Scene(current_boxes, scan.points, remaining, metadata=scene.metadata, source=scene.source)
@@ -171,9 +188,7 @@ def execute_policy(scene: Scene, policy: Callable[[Scene], str], boxes: Sequence
         remaining.remove(choice)
         return choice
 
-    return _execute(
-        scene, lambda number, world, in_place: sense_and_pick(number, world, in_place) if remaining else None
-    )
+    return _execute(scene, sense_and_pick)
 
 
 def reachable_boxes(boxes: Sequence[Any], candidates: Sequence[str], rule: str = "door") -> list[str]:
@@ -337,7 +352,11 @@ def _boxes_in_place(scene: Scene, world: Any, in_place: list[str]) -> list[Any]:
 
 
 def _execute(scene: Scene, next_box: Callable[[int, Any, list[str]], str | None]) -> UnloadRun:
-    """Rebuild the pile, then take out ``next_box(step, world, in_place)`` and measure, until it says None."""
+    """Rebuild the pile, then take out ``next_box(step, world, in_place)`` and measure, until it says None.
+
+    Boxes that leave the container (:data:`LOST_BELOW_FLOOR`) leave ``in_place`` with the step
+    that lost them (``UnloadStep.lost``).
+    """
     from unstack.geometry import rotation_angles_deg
     from unstack.sim.ground_truth import PARKING, run_horizon
     from unstack.sim.world import PhysicsWorld
@@ -353,7 +372,7 @@ def _execute(scene: Scene, next_box: Callable[[int, Any, list[str]], str | None]
         world.step(RESETTLE_SECONDS)
         settled, _ = world.poses()
         drift = float(np.max(np.linalg.norm(settled - start, axis=1), initial=0.0))
-        in_place = list(scene.box_ids)
+        in_place = [box_id for box_id, z in zip(scene.box_ids, settled[:, 2], strict=True) if z >= -LOST_BELOW_FLOOR]
         steps = []
         order = []
         for number in itertools.count():
@@ -374,6 +393,7 @@ def _execute(scene: Scene, next_box: Callable[[int, Any, list[str]], str | None]
                 rotation_angles_deg(before_turn, after_turn) > truth.rotation_threshold_deg
             )
             fallen = fallen_boxes(before, before_turn, after, after_turn)
+            lost = tuple(in_place[k] for k in np.flatnonzero(after[:, 2] < -LOST_BELOW_FLOOR))
             steps.append(
                 UnloadStep(
                     box_id,
@@ -381,8 +401,10 @@ def _execute(scene: Scene, next_box: Callable[[int, Any, list[str]], str | None]
                     float(moved[disturbed].sum()),
                     float(moved.max(initial=0.0)),
                     tuple(in_place[k] for k in np.flatnonzero(fallen)),
+                    lost,
                 )
             )
+            in_place = [other for other in in_place if other not in lost]
     return UnloadRun(tuple(order), tuple(steps), drift)
 
 
