@@ -19,8 +19,6 @@ Examples
 ...     pass
 >>> map_on_threads(lambda item: item * item, range(4))
 [0, 1, 4, 9]
->>> kernel_threads() >= 1
-True
 """
 
 from __future__ import annotations
@@ -30,20 +28,12 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from typing import TypeVar
 
-__all__ = ["PARALLEL_KERNELS", "kernel_threads", "map_on_threads"]
+__all__ = ["PARALLEL_KERNELS", "map_on_threads"]
 
 _Result = TypeVar("_Result")
 
 #: Held for the duration of every call into a ``parallel=True`` numba kernel (re-entrant).
 PARALLEL_KERNELS = threading.RLock()
-
-
-def kernel_threads() -> int:
-    """Threads the GIL-free kernels may use: numba's thread count in the calling thread
-    (``NUMBA_NUM_THREADS``, or ``numba.set_num_threads`` there)."""
-    from numba import get_num_threads
-
-    return int(get_num_threads())
 
 
 def map_on_threads(function: Callable[[int], _Result], items: Sequence[int]) -> list[_Result]:
@@ -55,7 +45,9 @@ def map_on_threads(function: Callable[[int], _Result], items: Sequence[int]) -> 
     one thread, or one item, runs in the calling thread. When an item fails (or the caller
     is interrupted), the items not yet started are cancelled and the error is raised.
     """
-    threads = min(kernel_threads(), len(items))
+    from numba import get_num_threads
+
+    threads = min(get_num_threads(), len(items))
     if threads <= 1:
         return [function(item) for item in items]
     pool = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="unstack-kernel")
