@@ -78,6 +78,9 @@ def test_per_iset_records_pair_two_models_on_the_same_isets(small_dataset: Path)
     assert paired["mean"] == pytest.approx(gap)
     with pytest.raises(ValueError, match="drew their ISets differently \\(seed\\)"):
         paired_between_runs(default, {**extended, "seed": 3})
+    broken = {**extended, "per_iset": [{"scene": "s"}]}
+    with pytest.raises(ValueError, match=r"per-ISet records are not those of a decisions\.json"):
+        paired_between_runs(default, broken)
     with pytest.raises(ValueError, match="no per-ISet records"):
         paired_between_runs(default, {key: value for key, value in extended.items() if key != "per_iset"})
 

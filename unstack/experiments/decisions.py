@@ -347,7 +347,12 @@ def paired_between_runs(
     def by_iset(run: dict[str, Any]) -> dict[tuple[str, tuple[str, ...]], float]:
         return {(row["scene"], tuple(row["boxes"])): float(row["moved"][maker]) for row in run["per_iset"]}
 
-    ours, theirs = by_iset(first), by_iset(second)
+    try:
+        ours, theirs = by_iset(first), by_iset(second)
+    except (KeyError, TypeError, ValueError) as error:
+        raise ValueError(
+            f"a run's per-ISet records are not those of a decisions.json ({error!r} missing or wrong)"
+        ) from None
     common = [key for key in ours if key in theirs]
     if not common:
         raise ValueError("the runs share no ISet: nothing to pair")
