@@ -85,6 +85,18 @@ def test_per_iset_records_pair_two_models_on_the_same_isets(small_dataset: Path)
         paired_between_runs(default, {key: value for key, value in extended.items() if key != "per_iset"})
 
 
+@pytest.mark.parametrize("spelling", ["./piles", "piles/", "other/../piles"])
+def test_runs_on_the_same_folder_spelt_differently_pair(spelling: str) -> None:
+    from unstack.experiments.decisions import paired_between_runs
+
+    run = {"data": "piles", "r": 2, "seed": 0, "draw": "random",
+           "per_iset": [{"scene": "s", "boxes": ["a", "b"], "moved": {"reasoner": 2.0}}]}  # fmt: skip
+    other = {**run, "data": spelling, "per_iset": [{"scene": "s", "boxes": ["a", "b"], "moved": {"reasoner": 0.5}}]}
+    assert paired_between_runs(run, other)["mean"] == pytest.approx(-1.5)
+    with pytest.raises(ValueError, match=r"drew their ISets differently \(data\)"):
+        paired_between_runs(run, {**other, "data": "piles2"})
+
+
 def test_experiment_commands(small_dataset: Path, tmp_path: Path) -> None:
     result = unstack("experiment", "table1", "--out", str(tmp_path), "--max-n", "5")
     assert result.returncode == 0, result.stderr

@@ -340,8 +340,14 @@ def paired_between_runs(
         if "per_iset" not in run:
             raise ValueError("a run has no per-ISet records (made before they were kept): run it again")
     settings = ("data", "r", "seed", "draw")
-    if any(first.get(key) != second.get(key) for key in settings):
-        differing = ", ".join(key for key in settings if first.get(key) != second.get(key))
+
+    def setting(run: dict[str, Any], key: str) -> Any:
+        value = run.get(key)
+        # The same folder written as "piles", "./piles" or "piles/" draws the same ISets.
+        return os.path.normpath(value) if key == "data" and isinstance(value, str) else value
+
+    if any(setting(first, key) != setting(second, key) for key in settings):
+        differing = ", ".join(key for key in settings if setting(first, key) != setting(second, key))
         raise ValueError(f"the runs drew their ISets differently ({differing}): nothing to pair")
 
     def by_iset(run: dict[str, Any]) -> dict[tuple[str, tuple[str, ...]], float]:
