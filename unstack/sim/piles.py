@@ -197,6 +197,10 @@ def build_pile(settings: SimulationSettings, *, count: int, seed: int | np.rando
     """
     if settings.pile.arrangement == "wall":
         return build_wall(settings, count=count, seed=seed)
+    if settings.pile.arrangement == "structures":
+        from unstack.sim.structures import build_structures
+
+        return build_structures(settings, count=count, seed=seed)
     rng = np.random.default_rng(seed)
     world = PhysicsWorld(settings, door=True)
     pile = Pile(world)

@@ -45,10 +45,25 @@ SIZE_SETS: dict[str, tuple[tuple[float, float, float], ...]] = {
     "paper2": ((0.6, 0.4, 0.4), (0.4, 0.3, 0.3)),
     "four": ((0.6, 0.4, 0.4), (0.4, 0.3, 0.3), (0.5, 0.5, 0.3), (0.3, 0.3, 0.2)),
     "mixed": ((0.8, 0.6, 0.5), (0.6, 0.4, 0.4), (0.4, 0.3, 0.3), (0.5, 0.5, 0.3), (0.3, 0.2, 0.2), (0.25, 0.25, 0.15)),
+    # Twelve common carton shapes: large, cubes, flat (a tenth of a metre thick) and small.
+    "cartons": (
+        (0.8, 0.6, 0.5),
+        (0.6, 0.4, 0.4),
+        (0.6, 0.4, 0.12),
+        (0.5, 0.5, 0.3),
+        (0.5, 0.3, 0.25),
+        (0.45, 0.35, 0.1),
+        (0.4, 0.3, 0.3),
+        (0.4, 0.3, 0.15),
+        (0.3, 0.3, 0.3),
+        (0.3, 0.2, 0.2),
+        (0.25, 0.25, 0.15),
+        (0.22, 0.16, 0.1),
+    ),
 }
 #: How a pile is made: boxes dropped in waves (the paper's piles), or stacked in columns and
 #: rows from the back wall towards the door, as trailers are loaded (see :mod:`unstack.sim.piles`).
-ARRANGEMENTS = ("dropped", "wall")
+ARRANGEMENTS = ("dropped", "wall", "structures")
 
 
 class InvalidSettings(UnstackError):
@@ -98,8 +113,9 @@ class PileSettings:
         Cap on one settling phase (seconds of simulated time).
     max_refills : int
         Rounds of "drop, open the door, delete the boxes that fell out" before giving up.
-    arrangement : {"dropped", "wall"}
-        Dropped in waves, or stacked in columns and rows from the back wall (a key of
+    arrangement : {"dropped", "wall", "structures"}
+        Dropped in waves, stacked in columns and rows from the back wall, or set down by
+        hand as small structures on the floor (:mod:`unstack.sim.structures`; a key of
         :data:`ARRANGEMENTS`).
     fallen_share : float
         For walls: the expected share of boxes that are not stacked but dropped in front
@@ -300,6 +316,8 @@ FAMILIES: dict[str, str] = {
     "wall": "20-36 boxes of four sizes stacked in columns and rows from the back wall, as trailers are loaded, "
     "with gaps between columns and some fallen boxes in front",
     "mixed": "20-30 boxes of six sizes (large and small) and masses of 2-25 kg dropped into a 2 m section",
+    "staged": "6-14 boxes of twelve carton sizes set down by hand on the floor of a 3 m section: columns, "
+    "boxes leaning on columns, bridges across two columns, boxes across two",
 }
 
 
@@ -327,4 +345,11 @@ def family_settings(family: str) -> SimulationSettings:
         )
     if family == "mixed":
         return SimulationSettings(boxes=(20, 30), sizes="mixed", pile=PileSettings(mass_range=(2.0, 25.0)))
+    if family == "staged":
+        return SimulationSettings(
+            boxes=(6, 14),
+            sizes="cartons",
+            container=Container(depth=3.0),
+            pile=PileSettings(arrangement="structures", mass_range=(2.0, 25.0)),
+        )
     raise InvalidSettings(f"unknown pile family {family!r}; expected one of {', '.join(FAMILIES)}")
