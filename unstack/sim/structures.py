@@ -30,7 +30,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from unstack.sim.piles import Pile, PileBox, _delete_fallen
-from unstack.sim.settings import InvalidSettings, SimulationSettings
+from unstack.sim.settings import Container, InvalidSettings, SimulationSettings
 from unstack.sim.world import PhysicsWorld
 
 __all__ = ["STRUCTURE_KINDS", "build_structures"]
@@ -138,10 +138,10 @@ def _extent(placed: list[_Placed], turn: Rotation) -> np.ndarray:
 
 
 def _free_spot(
-    extent: np.ndarray, taken: list[np.ndarray], container: object, rng: np.random.Generator
+    extent: np.ndarray, taken: list[np.ndarray], container: Container, rng: np.random.Generator
 ) -> np.ndarray | None:
     """A random shift of ``extent`` that keeps it on the floor and clear of ``taken``, or None."""
-    depth, width = float(container.depth), float(container.width)  # type: ignore[attr-defined]
+    depth, width = container.depth, container.width
     low = np.array([MARGIN - extent[0], -width / 2.0 + MARGIN - extent[1]])
     high = np.array([depth - MARGIN - extent[2], width / 2.0 - MARGIN - extent[3]])
     if np.any(low > high):
