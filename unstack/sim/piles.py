@@ -26,12 +26,11 @@ Examples
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from types import TracebackType
-
 import numpy as np
 
+from unstack.sim.pile_bodies import Pile, PileBox, delete_fallen
 from unstack.sim.settings import InvalidSettings, SimulationSettings
+from unstack.sim.structures import build_structures
 from unstack.sim.world import PhysicsWorld
 
 __all__ = ["Pile", "PileBox", "build_pile", "build_wall", "random_orientation_xyzw"]
@@ -51,36 +50,6 @@ WALL_GAP = 0.06
 WALL_OFFSET = 0.04
 #: Largest yaw of a stacked box away from the container's axes (degrees).
 WALL_YAW_DEG = 4.0
-
-
-@dataclass
-class PileBox:
-    """A box of the pile: its body in the world and what it is."""
-
-    body: int
-    size: np.ndarray
-    mass: float
-
-
-@dataclass
-class Pile:
-    """A settled pile, with the door open, still alive in its physics world."""
-
-    world: PhysicsWorld
-    boxes: list[PileBox] = field(default_factory=list)
-    refills: int = 0
-
-    def close(self) -> None:
-        """Close the physics world."""
-        self.world.close()
-
-    def __enter__(self) -> Pile:
-        return self
-
-    def __exit__(
-        self, kind: type[BaseException] | None, value: BaseException | None, traceback: TracebackType | None
-    ) -> None:
-        self.close()
 
 
 def random_orientation_xyzw(rng: np.random.Generator, max_tilt_deg: float) -> np.ndarray:
@@ -156,24 +125,6 @@ def _drop_wave(world: PhysicsWorld, pile: Pile, count: int, rng: np.random.Gener
     return len(placed)
 
 
-def _delete_fallen(world: PhysicsWorld, pile: Pile) -> int:
-    """Delete the boxes whose centroid left the container; returns how many."""
-    container = world.settings.container
-    positions, _ = world.poses([box.body for box in pile.boxes])
-    inside = (
-        (positions[:, 0] > 0.0)
-        & (positions[:, 0] < container.depth)
-        & (np.abs(positions[:, 1]) < container.width / 2.0)
-        & (positions[:, 2] > 0.0)
-        & (positions[:, 2] < container.height)
-    )
-    for box, keep in zip(list(pile.boxes), inside, strict=True):
-        if not keep:
-            world.remove_box(box.body)
-            pile.boxes.remove(box)
-    return int(np.count_nonzero(~inside))
-
-
 def build_pile(settings: SimulationSettings, *, count: int, seed: int | np.random.SeedSequence) -> Pile:
     """Drop, settle, open the door and refill until the pile holds ``count`` boxes.
 
@@ -198,8 +149,6 @@ def build_pile(settings: SimulationSettings, *, count: int, seed: int | np.rando
     if settings.pile.arrangement == "wall":
         return build_wall(settings, count=count, seed=seed)
     if settings.pile.arrangement == "structures":
-        from unstack.sim.structures import build_structures
-
         return build_structures(settings, count=count, seed=seed)
     rng = np.random.default_rng(seed)
     world = PhysicsWorld(settings, door=True)
@@ -215,7 +164,7 @@ def build_pile(settings: SimulationSettings, *, count: int, seed: int | np.rando
                     break
             world.open_door()
             world.settle()
-            fallen = _delete_fallen(world, pile)
+            fallen = delete_fallen(world, pile)
             if fallen:
                 world.settle()
             if len(pile.boxes) == count:
@@ -353,7 +302,7 @@ def build_wall(settings: SimulationSettings, *, count: int, seed: int | np.rando
                 world.settle()
             world.open_door()
             world.settle()
-            if _delete_fallen(world, pile):
+            if delete_fallen(world, pile):
                 world.settle()
             if len(pile.boxes) == count:
                 pile.refills = round_index

@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from unstack.sim.piles import Pile, PileBox, _delete_fallen
+from unstack.sim.pile_bodies import Pile, PileBox, delete_fallen
 from unstack.sim.settings import Container, InvalidSettings, SimulationSettings
 from unstack.sim.world import PhysicsWorld
 
@@ -211,7 +211,7 @@ def build_structures(settings: SimulationSettings, *, count: int, seed: int | np
                 body = world.add_box(size, position, (turn * rotation).as_quat(), mass=mass)
                 pile.boxes.append(PileBox(body, size.copy(), mass))
         world.settle()
-        if _delete_fallen(world, pile):
+        if delete_fallen(world, pile):
             raise InvalidSettings("a staged box left the section while settling")
         return pile
     except BaseException:
