@@ -40,6 +40,18 @@ def test_render_writes_a_png(dataset: Path, tmp_path: Path) -> None:
     assert [path.name for path in tmp_path.iterdir()] == ["pile.png"]
 
 
+def test_simulate_a_staged_family_of_boxes_set_down_by_hand(tmp_path: Path) -> None:
+    import json
+
+    folder = tmp_path / "staged"
+    result = unstack("simulate", "--family", "staged", "--configs", "1", "--resolution", "96x72", "--min-pixels", "5",
+                     "--horizon", "0.5", "--seed", "2", "--out", str(folder))  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    settings = json.loads((folder / "manifest.json").read_text())["settings"]
+    assert settings["pile"]["arrangement"] == "structures" and settings["sizes"] == "cartons"
+    assert unstack("validate", str(folder / "config-0000.json")).returncode == 0
+
+
 @pytest.mark.parametrize(
     ("arguments", "message"),
     [
