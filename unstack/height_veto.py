@@ -21,7 +21,7 @@ Examples
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 
 from unstack.errors import InvalidArgument
 from unstack.scene import Scene
@@ -32,7 +32,13 @@ __all__ = ["HYBRID_MAX_COST", "highest_free_box"]
 HYBRID_MAX_COST = 0.5
 
 
-def highest_free_box(scene: Scene, expected_costs: Mapping[str, float], *, max_cost: float = HYBRID_MAX_COST) -> str:
+def highest_free_box(
+    scene: Scene,
+    expected_costs: Mapping[str, float],
+    *,
+    max_cost: float = HYBRID_MAX_COST,
+    candidates: Sequence[str] | None = None,
+) -> str:
     """The highest detected box whose expected cost is below ``max_cost``.
 
     Parameters
@@ -44,6 +50,8 @@ def highest_free_box(scene: Scene, expected_costs: Mapping[str, float], *, max_c
         decision.expected_costs))``).
     max_cost : float
         A box below it counts as free.
+    candidates : sequence of str, optional
+        Boxes to choose among instead of the scene's detected boxes (an ISet, say).
 
     Returns
     -------
@@ -56,7 +64,7 @@ def highest_free_box(scene: Scene, expected_costs: Mapping[str, float], *, max_c
     InvalidArgument
         A detected box without an expected cost, or no detected box.
     """
-    candidates = list(scene.detected)
+    candidates = list(scene.detected if candidates is None else candidates)
     missing = [box_id for box_id in candidates if box_id not in expected_costs]
     if missing or not candidates:
         raise InvalidArgument(f"expected an expected cost for every detected box; missing {missing or 'boxes'}")

@@ -18,6 +18,9 @@ decision maker picks the box to unload first:
 ``free``
     a geometric rule: a box is free when no other box of the ISet overlaps its footprint
     from above; the highest free box (the highest box if none is free).
+``hybrid``
+    height vetoed by unstack (:func:`unstack.height_veto.highest_free_box`): the highest box
+    of the ISet whose expected cost (``reasoner``'s) is below 0.5.
 ``random``
     uniform over the ISet; its figures are exact expectations over the choice, not samples.
 
@@ -68,7 +71,7 @@ __all__ = [
     "uncovered_boxes",
 ]
 
-DECISION_MAKERS = ("reasoner", "count", "priors", "highest", "free", "random")
+DECISION_MAKERS = ("reasoner", "count", "priors", "highest", "free", "hybrid", "random")
 
 
 def squared_regret(costs: np.ndarray, choice: int) -> float:
@@ -144,6 +147,7 @@ def free_pick(boxes: list[Any]) -> int:
 
 def iset_outcome(scene: Any, ids: list[str], model: Any) -> IsetOutcome:
     """Decide one ISet of a simulated scene with ``model`` and every decision maker; score the picks."""
+    from unstack.height_veto import highest_free_box
     from unstack.learning.metrics import classification_report
     from unstack.learning.probabilities import scene_support_probabilities
     from unstack.reasoner.decision import choose, decide
@@ -157,12 +161,15 @@ def iset_outcome(scene: Any, ids: list[str], model: Any) -> IsetOutcome:
     report = classification_report(truth[off], probabilities[off])
     boxes = [scene.box(box_id) for box_id in ids]
     priors_costs = probabilities.sum(axis=1)
+    decision = decide(supports)
+    expected_costs = dict(zip(decision.objects, map(float, decision.expected_costs), strict=True))
     picks = {
-        "reasoner": ids.index(decide(supports).choice),
+        "reasoner": ids.index(decision.choice),
         "count": ids.index(decide(supports, cost="count").choice),
         "priors": ids.index(choose(tuple(ids), priors_costs)[0]),
         "highest": int(np.argmax([box.position[2] for box in boxes])),
         "free": free_pick(boxes),
+        "hybrid": ids.index(highest_free_box(scene, expected_costs, candidates=ids)),
     }
     removal = scene.metadata.get("simulation", {}).get("removal", {})
     displacement = np.asarray(removal.get("displacement_m", np.zeros((len(scene.boxes),) * 2)))
