@@ -72,3 +72,13 @@ def test_a_wrong_pick_is_reported() -> None:
 @pytest.mark.parametrize("kind", ["plain_stack", "bridge", "leaning", "side_by_side"])
 def test_the_labels_of_a_case_agree_with_the_physics_engine(kind: str) -> None:
     assert physical_check(build_case(kind, seed=7)) == []
+
+
+def test_an_unknown_pick_is_refused() -> None:
+    from unstack.errors import UnstackError
+    from unstack.experiments.generalisation import picked
+
+    case = build_case("plain_stack", seed=0)
+    scene = canonical_scene(case, cloud="surface", seed=0)
+    with pytest.raises(UnstackError, match="unknown pick 'tallest'; expected one of min-cost, hybrid"):
+        picked(None, scene, "tallest")

@@ -448,7 +448,9 @@ def container(
 @click.option("--first-seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of the first scene of each kind (later ones follow).")  # fmt: skip
 @click.option("--physics", is_flag=True, help="Also check each scene's labels in the physics engine.")
-def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int, physics: bool) -> None:
+@click.option("--pick", type=click.Choice(["min-cost", "hybrid"]), default="min-cost", show_default=True,
+              help="min-cost: the decision's choice (Eq. 13); hybrid: the highest box of EC below 0.5.")  # fmt: skip
+def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int, physics: bool, pick: str) -> None:
     """The generalisation suite: hand-made canonical scenes, two clouds each, the decision checked.
 
     Each kind (a tower, a bridge, a wall, a leaning box, load nobody detected, ...) is drawn
@@ -458,7 +460,7 @@ def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int
     """
     from unstack.cli.main import load_model_option
     from unstack.experiments.canonical_scenes import CANONICAL_KINDS, build_case
-    from unstack.experiments.generalisation import physical_check, run_suite, suite_figure, summary_rows
+    from unstack.experiments.generalisation import physical_check, picked, run_suite, suite_figure, summary_rows
     from unstack.learning.probabilities import scene_support_probabilities
     from unstack.reasoner.decision import decide
 
@@ -467,7 +469,9 @@ def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int
     seed_list = list(range(first_seed, first_seed + seeds))
     with progress_bar("scenes") as report:
         results = run_suite(
-            lambda scene: decide(scene_support_probabilities(scene, model, model_name=name), seed=0),
+            lambda scene: picked(
+                decide(scene_support_probabilities(scene, model, model_name=name), seed=0), scene, pick
+            ),
             seeds=seed_list,
             progress=report,
         )
@@ -479,7 +483,7 @@ def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int
                 if problems:
                     physics_problems[f"{kind} seed {seed}"] = problems
     rows = summary_rows(results)
-    _write_json(folder / "generalisation.json", {"model": name, "seeds": seed_list, "summary": rows,
+    _write_json(folder / "generalisation.json", {"model": name, "pick": pick, "seeds": seed_list, "summary": rows,
                  "physics": physics_problems if physics else None,
                  "decisions": [result.to_dict() for result in results]})  # fmt: skip
     first = {(r.kind, r.cloud): r for r in results if r.seed == first_seed}

@@ -32,10 +32,12 @@ __all__ = [
     "CLOUDS",
     "FREE_MAX",
     "HOLD_SHARE",
+    "PICKS",
     "SuiteResult",
     "canonical_scene",
     "check_decision",
     "physical_check",
+    "picked",
     "run_suite",
     "suite_figure",
     "summary_rows",
@@ -43,6 +45,9 @@ __all__ = [
 
 #: The two ways a canonical scene is scanned.
 CLOUDS = ("sensor", "surface")
+#: How the first box is picked from a decision: its own minimum-EC choice (Eq. 13), or the
+#: hybrid (:func:`unstack.height_veto.highest_free_box`).
+PICKS = ("min-cost", "hybrid")
 #: A box that carries a load of k boxes must cost at least this share of k.
 HOLD_SHARE = 0.5
 #: A pickable box must cost less than this.
@@ -147,6 +152,34 @@ def check_decision(case: CanonicalCase, choice: str, expected_costs: dict[str, f
         if expected_costs[box] >= FREE_MAX:
             problems.append(f"EC({box}) = {expected_costs[box]:.3f} >= {FREE_MAX} although it holds up nothing")
     return tuple(problems)
+
+
+def picked(decision: Any, scene: Scene, pick: str) -> Any:
+    """``decision`` with its choice made by ``pick`` (a key of :data:`PICKS`); the costs unchanged.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from unstack.reasoner.decision import decide
+    >>> from unstack.scene import Box
+    >>> from unstack.supports import Supports
+    >>> boxes = [Box("tall", [0.4, 0.4, 0.8], [1.0, 0.0, 0.4]), Box("low", [0.4, 0.4, 0.3], [1.0, 0.5, 0.15])]
+    >>> scene = Scene(boxes, np.zeros((0, 3)), ["tall", "low"])
+    >>> decision = decide(Supports(["tall", "low"], [[0.0, 0.3], [0.0, 0.0]]))
+    >>> decision.choice, picked(decision, scene, "hybrid").choice
+    ('low', 'tall')
+    """
+    import dataclasses
+
+    from unstack.errors import UnstackError
+    from unstack.height_veto import highest_free_box
+
+    if pick not in PICKS:
+        raise UnstackError(f"unknown pick {pick!r}; expected one of {', '.join(PICKS)}")
+    if pick == "min-cost":
+        return decision
+    costs = dict(zip(decision.objects, map(float, decision.expected_costs), strict=True))
+    return dataclasses.replace(decision, choice=highest_free_box(scene, costs))
 
 
 def run_suite(
