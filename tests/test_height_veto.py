@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from unstack.errors import InvalidArgument
-from unstack.height_veto import HYBRID_MAX_COST, highest_free_box
+from unstack.height_veto import HYBRID_MAX_COST, highest_free_box, hybrid_choice
 from unstack.scene import Box, Scene
 
 
@@ -41,3 +41,12 @@ def test_a_lower_bound_vetoes_more(three_heights: Scene) -> None:
 def test_a_detected_box_without_a_cost_is_refused(three_heights: Scene) -> None:
     with pytest.raises(InvalidArgument, match=r"missing \['top'\]"):
         highest_free_box(three_heights, {"floor": 0.0, "middle": 0.1})
+
+
+@pytest.mark.parametrize("candidates", [None, ["floor", "middle"]])
+def test_the_hybrid_choice_reads_a_decisions_costs(three_heights: Scene, candidates: list[str] | None) -> None:
+    from types import SimpleNamespace
+
+    decision = SimpleNamespace(objects=("floor", "middle", "top"), expected_costs=np.array([0.0, 0.1, 0.9]))
+    expected = "middle"  # "top" is vetoed; among the candidates "middle" is the highest free box
+    assert hybrid_choice(three_heights, decision, candidates=candidates) == expected

@@ -22,11 +22,12 @@ Examples
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from typing import Any
 
 from unstack.errors import InvalidArgument
 from unstack.scene import Scene
 
-__all__ = ["HYBRID_MAX_COST", "highest_free_box"]
+__all__ = ["HYBRID_MAX_COST", "highest_free_box", "hybrid_choice"]
 
 #: A candidate whose expected cost is below this counts as holding nothing up.
 HYBRID_MAX_COST = 0.5
@@ -72,3 +73,22 @@ def highest_free_box(
     if not free:
         return min(sorted(candidates), key=lambda box_id: expected_costs[box_id])
     return max(free, key=lambda box_id: (float(scene.box(box_id).position[2]), box_id))
+
+
+def hybrid_choice(scene: Scene, decision: Any, *, candidates: Sequence[str] | None = None) -> str:
+    """The hybrid pick from a decision on ``scene``: :func:`highest_free_box` with its expected costs.
+
+    ``decision``: anything with ``objects`` and ``expected_costs`` (``unstack.decide(scene)``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from types import SimpleNamespace
+    >>> from unstack.scene import Box, Scene
+    >>> boxes = [Box("tall", [0.4, 0.4, 0.8], [1.0, 0.0, 0.4]), Box("low", [0.4, 0.4, 0.3], [1.0, 0.5, 0.15])]
+    >>> scene = Scene(boxes, np.zeros((0, 3)), ["tall", "low"])
+    >>> hybrid_choice(scene, SimpleNamespace(objects=("tall", "low"), expected_costs=np.array([0.2, 0.0])))
+    'tall'
+    """
+    costs = {box_id: float(cost) for box_id, cost in zip(decision.objects, decision.expected_costs, strict=True)}
+    return highest_free_box(scene, costs, candidates=candidates)

@@ -88,10 +88,9 @@ def container_policies(
         return float(scene.box(box_id).position[2])
 
     def hybrid(scene: Scene) -> str:
-        from unstack.height_veto import highest_free_box
+        from unstack.height_veto import hybrid_choice
 
-        made = decision(scene, "load")
-        return highest_free_box(scene, dict(zip(made.objects, map(float, made.expected_costs), strict=True)))
+        return hybrid_choice(scene, decision(scene, "load"))
 
     def highest(scene: Scene) -> str:
         return max(scene.detected, key=lambda box_id: (height(scene, box_id), box_id))

@@ -147,7 +147,7 @@ def free_pick(boxes: list[Any]) -> int:
 
 def iset_outcome(scene: Any, ids: list[str], model: Any) -> IsetOutcome:
     """Decide one ISet of a simulated scene with ``model`` and every decision maker; score the picks."""
-    from unstack.height_veto import highest_free_box
+    from unstack.height_veto import hybrid_choice
     from unstack.learning.metrics import classification_report
     from unstack.learning.probabilities import scene_support_probabilities
     from unstack.reasoner.decision import choose, decide
@@ -162,14 +162,13 @@ def iset_outcome(scene: Any, ids: list[str], model: Any) -> IsetOutcome:
     boxes = [scene.box(box_id) for box_id in ids]
     priors_costs = probabilities.sum(axis=1)
     decision = decide(supports)
-    expected_costs = dict(zip(decision.objects, map(float, decision.expected_costs), strict=True))
     picks = {
         "reasoner": ids.index(decision.choice),
         "count": ids.index(decide(supports, cost="count").choice),
         "priors": ids.index(choose(tuple(ids), priors_costs)[0]),
         "highest": int(np.argmax([box.position[2] for box in boxes])),
         "free": free_pick(boxes),
-        "hybrid": ids.index(highest_free_box(scene, expected_costs, candidates=ids)),
+        "hybrid": ids.index(hybrid_choice(scene, decision, candidates=ids)),
     }
     removal = scene.metadata.get("simulation", {}).get("removal", {})
     displacement = np.asarray(removal.get("displacement_m", np.zeros((len(scene.boxes),) * 2)))

@@ -172,14 +172,13 @@ def picked(decision: Any, scene: Scene, pick: str) -> Any:
     import dataclasses
 
     from unstack.errors import UnstackError
-    from unstack.height_veto import highest_free_box
+    from unstack.height_veto import hybrid_choice
 
     if pick not in PICKS:
         raise UnstackError(f"unknown pick {pick!r}; expected one of {', '.join(PICKS)}")
     if pick == "min-cost":
         return decision
-    costs = dict(zip(decision.objects, map(float, decision.expected_costs), strict=True))
-    return dataclasses.replace(decision, choice=highest_free_box(scene, costs))
+    return dataclasses.replace(decision, choice=hybrid_choice(scene, decision))
 
 
 def run_suite(
