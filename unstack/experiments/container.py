@@ -13,6 +13,10 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     candidate whose expected cost (the default model and cost) is below
     :data:`~unstack.height_veto.HYBRID_MAX_COST` -- the highest box the model does not
     believe holds anything up; when every candidate costs more, unstack's choice.
+``near_ties``
+    unstack's default with near ties broken by height
+    (:func:`unstack.height_veto.highest_near_minimum`): the highest candidate whose expected
+    cost is within :data:`~unstack.height_veto.NEAR_TIE_MARGIN` of the lowest.
 ``highest``
     the highest candidate first.
 ``footprint``
@@ -34,7 +38,7 @@ not time limits); resumable per pile; piles in parallel processes.
 Examples
 --------
 >>> CONTAINER_MAKERS[:4]
-('unstack', 'unstack_count', 'hybrid', 'highest')
+('unstack', 'unstack_count', 'hybrid', 'near_ties')
 """
 
 from __future__ import annotations
@@ -50,7 +54,9 @@ from unstack.scene import Scene
 
 __all__ = ["CONTAINER_MAKERS", "CONTAINER_SAMPLES", "container_experiment", "container_policies"]
 
-CONTAINER_MAKERS = ("unstack", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random", "lookahead")
+CONTAINER_MAKERS = (
+    "unstack", "unstack_count", "hybrid", "near_ties", "highest", "footprint", "nearest_door", "random", "lookahead",
+)  # fmt: skip
 #: Recorded sweeps per sampled group in each decision.
 CONTAINER_SAMPLES = 512
 
@@ -92,6 +98,13 @@ def container_policies(
 
         return hybrid_choice(scene, decision(scene, "load"))
 
+    def near_ties(scene: Scene) -> str:
+        from unstack.height_veto import highest_near_minimum
+
+        chosen = decision(scene, "load")
+        costs = {box_id: float(cost) for box_id, cost in zip(chosen.objects, chosen.expected_costs, strict=True)}
+        return highest_near_minimum(scene, costs)
+
     def highest(scene: Scene) -> str:
         return max(scene.detected, key=lambda box_id: (height(scene, box_id), box_id))
 
@@ -116,6 +129,7 @@ def container_policies(
         "unstack": deciding("load"),
         "unstack_count": deciding("count"),
         "hybrid": hybrid,
+        "near_ties": near_ties,
         "highest": highest,
         "footprint": footprint,
         "nearest_door": nearest_door,
