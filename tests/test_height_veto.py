@@ -6,13 +6,7 @@ import numpy as np
 import pytest
 
 from unstack.errors import InvalidArgument
-from unstack.height_veto import (
-    HYBRID_MAX_COST,
-    NEAR_TIE_MARGIN,
-    highest_free_box,
-    highest_near_minimum,
-    hybrid_choice,
-)
+from unstack.height_veto import HYBRID_MAX_COST, highest_free_box, hybrid_choice
 from unstack.scene import Box, Scene
 
 
@@ -56,37 +50,3 @@ def test_the_hybrid_choice_reads_a_decisions_costs(three_heights: Scene, candida
     decision = SimpleNamespace(objects=("floor", "middle", "top"), expected_costs=np.array([0.0, 0.1, 0.9]))
     expected = "middle"  # "top" is vetoed; among the candidates "middle" is the highest free box
     assert hybrid_choice(three_heights, decision, candidates=candidates) == expected
-
-
-@pytest.mark.parametrize(
-    ("costs", "expected"),
-    [
-        ({"floor": 0.00, "middle": 0.01, "top": 0.04}, "top"),  # all within the margin: the highest
-        ({"floor": 0.00, "middle": 0.04, "top": 0.09}, "middle"),  # "top" costs more than a near tie
-        ({"floor": 1.00, "middle": 0.30, "top": 0.33}, "top"),  # the margin is above the lowest, not above 0
-        ({"floor": 0.00, "middle": 0.80, "top": 1.00}, "floor"),  # no near tie: Eq. 13's minimum
-    ],
-)
-def test_near_ties_in_expected_cost_go_to_the_highest_box(
-    three_heights: Scene, costs: dict[str, float], expected: str
-) -> None:
-    assert highest_near_minimum(three_heights, costs) == expected
-
-
-def test_a_zero_margin_keeps_the_minimum_expected_cost(three_heights: Scene) -> None:
-    costs = {"floor": 0.0, "middle": NEAR_TIE_MARGIN / 2, "top": 0.0}
-    assert highest_near_minimum(three_heights, costs, margin=0.0) == "top"
-    assert highest_near_minimum(three_heights, {**costs, "top": 0.01}, margin=0.0) == "floor"
-
-
-@pytest.mark.parametrize("margin", [-0.01, float("nan"), float("inf")])
-def test_a_negative_or_non_finite_margin_is_refused(three_heights: Scene, margin: float) -> None:
-    with pytest.raises(InvalidArgument, match="expected a finite margin >= 0"):
-        highest_near_minimum(three_heights, {"floor": 0.0, "middle": 0.0, "top": 0.0}, margin=margin)
-
-
-def test_near_ties_choose_among_the_candidates_only(three_heights: Scene) -> None:
-    costs = {"floor": 0.0, "middle": 0.01}
-    assert highest_near_minimum(three_heights, costs, candidates=["floor", "middle"]) == "middle"
-    with pytest.raises(InvalidArgument, match=r"missing \['top'\]"):
-        highest_near_minimum(three_heights, costs)

@@ -236,6 +236,7 @@ def decide(
     seed: int | None = None,
     samples: int | None = None,
     time_limit: float | None = None,
+    near_tie_margin: float | None = None,
 ) -> Decision:
     """Which box to unload first: from a scene (through a model) or from support probabilities.
 
@@ -258,6 +259,12 @@ def decide(
         :data:`~unstack.reasoner.sampling.DEFAULT_SAMPLES`).
     time_limit : float, optional
         Seconds for the whole decision instead of a fixed number of sweeps (not reproducible).
+    near_tie_margin : float, optional
+        Boxes whose expected cost is within this many boxes of the lowest count as tied, and
+        the highest of them is taken. Default: 0.05
+        (:data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`) for a scene (and for supports
+        that carry heights), Eq. 13's minimum for supports without heights; 0 keeps Eq. 13
+        exactly.
 
     Returns
     -------
@@ -284,7 +291,15 @@ def decide(
     from unstack.reasoner.decision import decide as decide_supports
 
     supports = _supports(scene_or_supports, model)
-    return decide_supports(supports, method=method, cost=cost, seed=seed, samples=samples, time_limit=time_limit)
+    return decide_supports(
+        supports,
+        method=method,
+        cost=cost,
+        seed=seed,
+        samples=samples,
+        time_limit=time_limit,
+        near_tie_margin=near_tie_margin,
+    )
 
 
 def plan(
@@ -297,6 +312,7 @@ def plan(
     samples: int | None = None,
     time_limit: float | None = None,
     progress: Callable[[int, int], None] | None = None,
+    near_tie_margin: float | None = None,
 ) -> Plan:
     """An unloading order: decide, take the chosen box out, decide again on the rest.
 
@@ -304,7 +320,7 @@ def plan(
     ----------
     scene_or_supports : Scene or Supports
         A scene gets its probabilities from ``model`` once, before the first step.
-    model, method, cost, seed, samples, time_limit
+    model, method, cost, seed, samples, time_limit, near_tie_margin
         As in :func:`decide` (the budget applies to each step; without one each step
         samples :data:`~unstack.reasoner.plan.PLAN_SAMPLES` sweeps per group, from where
         the previous step's chains ended).
@@ -332,5 +348,12 @@ def plan(
 
     supports = _supports(scene_or_supports, model)
     return unloading_plan(
-        supports, method=method, cost=cost, seed=seed, samples=samples, time_limit=time_limit, progress=progress
+        supports,
+        method=method,
+        cost=cost,
+        seed=seed,
+        samples=samples,
+        time_limit=time_limit,
+        progress=progress,
+        near_tie_margin=near_tie_margin,
     )

@@ -21,19 +21,16 @@ Examples
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 from unstack.errors import InvalidArgument
 from unstack.scene import Scene
 
-__all__ = ["HYBRID_MAX_COST", "NEAR_TIE_MARGIN", "highest_free_box", "highest_near_minimum", "hybrid_choice"]
+__all__ = ["HYBRID_MAX_COST", "highest_free_box", "hybrid_choice"]
 
 #: A candidate whose expected cost is below this counts as holding nothing up.
 HYBRID_MAX_COST = 0.5
-#: Expected costs within this many boxes of the lowest count as tied (ties go to the highest box).
-NEAR_TIE_MARGIN = 0.05
 
 
 def highest_free_box(
@@ -68,74 +65,14 @@ def highest_free_box(
     InvalidArgument
         A detected box without an expected cost, or no detected box.
     """
-    candidates = _with_costs(scene, expected_costs, candidates)
+    candidates = list(scene.detected if candidates is None else candidates)
+    missing = [box_id for box_id in candidates if box_id not in expected_costs]
+    if missing or not candidates:
+        raise InvalidArgument(f"expected an expected cost for every detected box; missing {missing or 'boxes'}")
     free = [box_id for box_id in candidates if expected_costs[box_id] < max_cost]
     if not free:
         return min(sorted(candidates), key=lambda box_id: expected_costs[box_id])
     return max(free, key=lambda box_id: (float(scene.box(box_id).position[2]), box_id))
-
-
-def highest_near_minimum(
-    scene: Scene,
-    expected_costs: Mapping[str, float],
-    *,
-    margin: float = NEAR_TIE_MARGIN,
-    candidates: Sequence[str] | None = None,
-) -> str:
-    """The highest box whose expected cost is within ``margin`` of the lowest: near ties go to height.
-
-    Eq. 13 takes the box of lowest expected cost; when several boxes cost almost nothing
-    (within ``margin`` expected boxes moved of the lowest), which of them is taken is left to
-    sampling noise and box ids. Here it goes to the highest of them: a low box, even one that
-    holds nothing up, is more often pressed on by its neighbours.
-
-    Parameters
-    ----------
-    scene : Scene
-        Its ``detected`` boxes are the candidates; a box's height is its centre's z.
-    expected_costs : mapping of str to float
-        The expected cost of every candidate.
-    margin : float
-        Expected costs at most this far above the lowest count as tied; 0 keeps Eq. 13's
-        minimum (ties in cost still go to the highest box).
-    candidates : sequence of str, optional
-        Boxes to choose among instead of the scene's detected boxes.
-
-    Returns
-    -------
-    str
-        Ties in height go to the larger id.
-
-    Raises
-    ------
-    InvalidArgument
-        A candidate without an expected cost, no candidate, or a negative or non-finite margin.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from unstack.scene import Box, Scene
-    >>> boxes = [Box("top", [0.4, 0.4, 0.4], [1.0, 0.0, 0.6]), Box("low", [0.4, 0.4, 0.3], [1.0, 0.5, 0.15])]
-    >>> scene = Scene(boxes, np.zeros((0, 3)), ["top", "low"])
-    >>> highest_near_minimum(scene, {"top": 0.03, "low": 0.01})
-    'top'
-    >>> highest_near_minimum(scene, {"top": 0.09, "low": 0.01})
-    'low'
-    """
-    if not math.isfinite(margin) or margin < 0:
-        raise InvalidArgument(f"expected a finite margin >= 0 (expected boxes moved), got {margin}")
-    candidates = _with_costs(scene, expected_costs, candidates)
-    lowest = min(expected_costs[box_id] for box_id in candidates)
-    tied = [box_id for box_id in candidates if expected_costs[box_id] <= lowest + margin]
-    return max(tied, key=lambda box_id: (float(scene.box(box_id).position[2]), box_id))
-
-
-def _with_costs(scene: Scene, expected_costs: Mapping[str, float], candidates: Sequence[str] | None) -> list[str]:
-    chosen = list(scene.detected if candidates is None else candidates)
-    missing = [box_id for box_id in chosen if box_id not in expected_costs]
-    if missing or not chosen:
-        raise InvalidArgument(f"expected an expected cost for every detected box; missing {missing or 'boxes'}")
-    return chosen
 
 
 def hybrid_choice(scene: Scene, decision: Any, *, candidates: Sequence[str] | None = None) -> str:

@@ -47,6 +47,10 @@ class Supports:
         Expected number of *undetected* boxes resting on each box (what the point cloud
         shows on it that no detected box explains; see :mod:`unstack.hidden_load`). The
         ``load`` cost counts it; 0 when not given.
+    heights : array-like, shape (n,), optional
+        Height of each box's centre above the floor in metres (a scene's boxes give it).
+        With it, the decision breaks near ties in expected cost by height
+        (:data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`); without it, Eq. 13's minimum.
     metadata : dict, optional
         Free-form provenance, kept when saving.
     source : str, optional
@@ -64,6 +68,7 @@ class Supports:
     metadata: dict[str, Any]
     source: str
     hidden_load: np.ndarray | None
+    heights: np.ndarray | None
 
     def __init__(
         self,
@@ -74,6 +79,7 @@ class Supports:
         source: str = "<array>",
         *,
         hidden_load: Any = None,
+        heights: Any = None,
     ) -> None:
         ids = check_ids(objects, source=source)
         matrix = check_probability_matrix(probabilities, len(ids), source=source)
@@ -97,7 +103,12 @@ class Supports:
                     f"expected a non-negative number, got {load_vector[negative[0]]}",
                 )
             load_vector.setflags(write=False)
+        height_vector = None
+        if heights is not None:
+            height_vector = check_vector(heights, len(ids), source=source, path="$.heights", error=InvalidSupports)
+            height_vector.setflags(write=False)
         object.__setattr__(self, "hidden_load", load_vector)
+        object.__setattr__(self, "heights", height_vector)
         object.__setattr__(self, "objects", ids)
         object.__setattr__(self, "probabilities", matrix)
         object.__setattr__(self, "masses", mass_vector)
@@ -132,6 +143,7 @@ class Supports:
         order = [self.index(object_id) for object_id in object_ids]
         masses = None if self.masses is None else self.masses[order]
         load = None if self.hidden_load is None else self.hidden_load[order]
+        heights = None if self.heights is None else self.heights[order]
         return Supports(
             list(object_ids),
             self.probabilities[np.ix_(order, order)],
@@ -139,6 +151,7 @@ class Supports:
             self.metadata,
             self.source,
             hidden_load=load,
+            heights=heights,
         )
 
     def to_dict(self) -> dict[str, Any]:
@@ -152,6 +165,8 @@ class Supports:
             data["masses"] = self.masses.tolist()
         if self.hidden_load is not None:
             data["hidden_load"] = self.hidden_load.tolist()
+        if self.heights is not None:
+            data["heights"] = self.heights.tolist()
         if self.metadata:
             data["metadata"] = self.metadata
         return data
@@ -172,6 +187,7 @@ class Supports:
             data.get("metadata"),
             source=document.source,
             hidden_load=data.get("hidden_load"),
+            heights=data.get("heights"),
         )
 
 

@@ -209,3 +209,32 @@ def test_bad_sampling_options_exit_2(option: list[str], message: str) -> None:
     result = unstack("decide", PILE5, *option)
     assert result.returncode == 2 and message in result.stderr and "Traceback" not in result.stderr
     assert result.stderr.startswith("unstack: error: unstack decide: ") and result.stderr.count("\n") == 1
+
+
+def test_decide_on_a_scene_breaks_near_ties_by_height(tmp_path: Path) -> None:
+    from unstack.scene import Box, Scene
+
+    boxes = [
+        Box("low", [0.4, 0.4, 0.3], [1.2, -0.35, 0.151]),
+        Box("high", [0.4, 0.4, 0.6], [1.2, 0.35, 0.301]),
+    ]
+    path = tmp_path / "two.scene.json"
+    Scene(boxes, np.zeros((0, 3)), ["low", "high"]).save(path)
+    default = unstack("decide", str(path), "--json")
+    assert default.returncode == 0, default.stderr
+    document = json.loads(default.stdout)
+    assert document["choice"] == "high" and document["near_tie_margin"] == 0.05
+    assert sorted(document["ties"]) == ["high", "low"]
+    strict = json.loads(unstack("decide", str(path), "--json", "--near-ties", "0").stdout)
+    assert "near_tie_margin" not in strict and strict["choice"] == min(
+        strict["objects"], key=lambda box: (strict["expected_costs"][strict["objects"].index(box)], box)
+    )
+    table = unstack("decide", str(path))
+    words = " ".join(table.stdout.split())  # rich wraps the headline
+    assert "Unload first: high (tied with low: EC within 0.05 of the lowest; the highest box wins)" in words
+
+
+def test_near_ties_on_supports_without_heights_exit_2() -> None:
+    result = unstack("decide", PILE5, "--near-ties", "0.1")
+    assert result.returncode == 2 and result.stderr.count("\n") == 1
+    assert "carry no heights" in result.stderr and "pile5.supports.json" in result.stderr

@@ -78,16 +78,17 @@ def test_the_hybrid_takes_the_highest_box_the_model_does_not_believe_loaded() ->
     assert policies["hybrid"](scene) == "free"
 
 
-def test_near_ties_take_the_higher_of_two_free_boxes() -> None:
+def test_unstack_breaks_near_ties_by_height_and_min_cost_keeps_eq13() -> None:
     boxes = [
-        Box("low", [0.4, 0.4, 0.3], [1.2, -0.35, 0.151]),
-        Box("high", [0.4, 0.4, 0.6], [1.2, 0.35, 0.301]),
+        Box("a_low", [0.4, 0.4, 0.3], [1.2, -0.35, 0.151]),
+        Box("b_high", [0.4, 0.4, 0.6], [1.2, 0.35, 0.301]),
     ]
-    scene = Scene(boxes, surface_cloud(boxes, viewpoint=[-2.0, 0.0, 1.5], seed=0), ["low", "high"])
-    policies = container_policies(load_model(default_model_path()), seed=0, makers=("unstack", "near_ties"))
-    assert policies["near_ties"](scene) == "high"
+    scene = Scene(boxes, surface_cloud(boxes, viewpoint=[-2.0, 0.0, 1.5], seed=0), ["a_low", "b_high"])
+    policies = container_policies(load_model(default_model_path()), seed=0, makers=("unstack", "min_cost"))
+    assert policies["unstack"](scene) == "b_high"  # two free boxes: the higher
+    assert policies["min_cost"](scene) == "a_low"  # Eq. 13: the lower expected cost (or the smaller id)
 
 
-def test_near_ties_never_take_a_box_under_load() -> None:
-    policies = container_policies(load_model(default_model_path()), seed=0, makers=("near_ties",))
-    assert policies["near_ties"](_tall_loaded_and_short_free()) == "free"
+def test_unstack_never_takes_a_box_under_load() -> None:
+    policies = container_policies(load_model(default_model_path()), seed=0, makers=("unstack",))
+    assert policies["unstack"](_tall_loaded_and_short_free()) == "free"

@@ -80,5 +80,21 @@ def test_an_unknown_pick_is_refused() -> None:
 
     case = build_case("plain_stack", seed=0)
     scene = canonical_scene(case, cloud="surface", seed=0)
-    with pytest.raises(UnstackError, match="unknown pick 'tallest'; expected one of min-cost, hybrid"):
+    with pytest.raises(UnstackError, match="unknown pick 'tallest'; expected one of default, min-cost, hybrid"):
         picked(None, scene, "tallest")
+
+
+@pytest.mark.parametrize(("pick", "expected"), [("default", "high"), ("min-cost", "low"), ("hybrid", "high")])
+def test_the_suite_can_pick_by_each_rule(pick: str, expected: str) -> None:
+    import numpy as np
+
+    from unstack.experiments.generalisation import picked
+    from unstack.scene import Box, Scene
+    from unstack.supports import Supports
+
+    boxes = [Box("low", [0.4, 0.4, 0.3], [1.0, 0.0, 0.15]), Box("high", [0.4, 0.4, 0.6], [1.0, 0.5, 0.3])]
+    scene = Scene(boxes, np.zeros((0, 3)), ["low", "high"])
+    decision = decide(Supports(["low", "high"], [[0.0, 0.01], [0.03, 0.0]], heights=[0.15, 0.3]))
+    chosen = picked(decision, scene, pick)
+    assert chosen.choice == expected
+    assert chosen.expected_costs.tolist() == decision.expected_costs.tolist()

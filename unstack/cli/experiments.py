@@ -448,8 +448,9 @@ def container(
 @click.option("--first-seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of the first scene of each kind (later ones follow).")  # fmt: skip
 @click.option("--physics", is_flag=True, help="Also check each scene's labels in the physics engine.")
-@click.option("--pick", type=click.Choice(["min-cost", "hybrid"]), default="min-cost", show_default=True,
-              help="min-cost: the decision's choice (Eq. 13); hybrid: the highest box of EC below 0.5.")  # fmt: skip
+@click.option("--pick", type=click.Choice(["default", "min-cost", "hybrid"]), default="default", show_default=True,
+              help="default: the decision's choice (near ties broken by height); min-cost: Eq. 13's minimum; "
+                   "hybrid: the highest box of EC below 0.5.")  # fmt: skip
 def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int, physics: bool, pick: str) -> None:
     """The generalisation suite: hand-made canonical scenes, two clouds each, the decision checked.
 

@@ -162,6 +162,14 @@ def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
             "also samples groups of 8).",
         ),
         click.option("--seed", type=click.IntRange(min=0), default=None, help="Seed of the sampler."),
+        click.option(
+            "--near-ties",
+            "near_tie_margin",
+            type=click.FloatRange(min=0.0, max=100.0),
+            default=None,
+            help="Expected costs within this many boxes of the lowest are tied and the highest box is taken "
+            "(default 0.05 for a scene or supports with heights; 0: Eq. 13's minimum exactly).",
+        ),
     ]
     for option in reversed(options):
         command = option(command)

@@ -82,12 +82,14 @@ def decision_view(decision: Decision) -> Group:
         if "warning" in decision.sampling:
             footer.append(f"\nwarning: {decision.sampling['warning']}", style="bold yellow")
     headline = Text.assemble(("Unload first: ", "bold"), (printable(decision.choice), "bold green"))
+    near = decision.near_tie_margin
     if decision.choice_probability < 1.0 or decision.sampling is not None:
-        headline.append(f"  (P(truly the minimum EC) = {decision.choice_probability:.3f})")
+        what = f"within {near:g} of the minimum EC" if near else "the minimum EC"
+        headline.append(f"  (P(truly {what}) = {decision.choice_probability:.3f})")
     if len(decision.ties) > 1:
-        headline.append(
-            f"  (tied with {', '.join(printable(t) for t in decision.ties if t != decision.choice)}; smallest id wins)"
-        )
+        others = ", ".join(printable(t) for t in decision.ties if t != decision.choice)
+        rule = f"EC within {near:g} of the lowest; the highest box wins" if near else "smallest id wins"
+        headline.append(f"  (tied with {others}: {rule})")
     return Group(headline, costs, matrix, footer)
 
 

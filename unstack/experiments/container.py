@@ -5,18 +5,19 @@ pile is scanned and the boxes detected again, only boxes reachable from the door
 candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`):
 
 ``unstack``
-    the default model's probabilities and the default cost (hidden load counted).
+    unstack's default decision: the default model's probabilities, the default cost (hidden
+    load counted) and near ties in expected cost broken by height
+    (:data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`).
+``min_cost``
+    the same expected costs with Eq. 13's minimum (no near ties; the default before
+    2026-12-01).
 ``unstack_count``
-    the same probabilities with Eq. 11's cost (detected boxes supported).
+    the same probabilities with Eq. 11's cost (detected boxes supported) and Eq. 13's minimum.
 ``hybrid``
     height vetoed by unstack (:func:`unstack.height_veto.highest_free_box`): the highest
     candidate whose expected cost (the default model and cost) is below
     :data:`~unstack.height_veto.HYBRID_MAX_COST` -- the highest box the model does not
     believe holds anything up; when every candidate costs more, unstack's choice.
-``near_ties``
-    unstack's default with near ties broken by height
-    (:func:`unstack.height_veto.highest_near_minimum`): the highest candidate whose expected
-    cost is within :data:`~unstack.height_veto.NEAR_TIE_MARGIN` of the lowest.
 ``highest``
     the highest candidate first.
 ``footprint``
@@ -38,7 +39,7 @@ not time limits); resumable per pile; piles in parallel processes.
 Examples
 --------
 >>> CONTAINER_MAKERS[:4]
-('unstack', 'unstack_count', 'hybrid', 'near_ties')
+('unstack', 'min_cost', 'unstack_count', 'hybrid')
 """
 
 from __future__ import annotations
@@ -55,7 +56,7 @@ from unstack.scene import Scene
 __all__ = ["CONTAINER_MAKERS", "CONTAINER_SAMPLES", "container_experiment", "container_policies"]
 
 CONTAINER_MAKERS = (
-    "unstack", "unstack_count", "hybrid", "near_ties", "highest", "footprint", "nearest_door", "random", "lookahead",
+    "unstack", "min_cost", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random", "lookahead",
 )  # fmt: skip
 #: Recorded sweeps per sampled group in each decision.
 CONTAINER_SAMPLES = 512
@@ -78,15 +79,16 @@ def container_policies(
 
     rng = np.random.default_rng(seed)
 
-    def decision(scene: Scene, cost: str) -> Any:
+    def decision(scene: Scene, cost: str, margin: float | None = None) -> Any:
         from unstack.learning.probabilities import scene_support_probabilities
         from unstack.reasoner.decision import decide
 
-        return decide(scene_support_probabilities(scene, model), cost=cost, samples=samples, seed=seed)
+        supports = scene_support_probabilities(scene, model)
+        return decide(supports, cost=cost, samples=samples, seed=seed, near_tie_margin=margin)
 
-    def deciding(cost: str) -> Callable[[Scene], str]:
+    def deciding(cost: str, margin: float | None = None) -> Callable[[Scene], str]:
         def policy(scene: Scene) -> str:
-            return str(decision(scene, cost).choice)
+            return str(decision(scene, cost, margin).choice)
 
         return policy
 
@@ -97,13 +99,6 @@ def container_policies(
         from unstack.height_veto import hybrid_choice
 
         return hybrid_choice(scene, decision(scene, "load"))
-
-    def near_ties(scene: Scene) -> str:
-        from unstack.height_veto import highest_near_minimum
-
-        chosen = decision(scene, "load")
-        costs = {box_id: float(cost) for box_id, cost in zip(chosen.objects, chosen.expected_costs, strict=True)}
-        return highest_near_minimum(scene, costs)
 
     def highest(scene: Scene) -> str:
         return max(scene.detected, key=lambda box_id: (height(scene, box_id), box_id))
@@ -127,9 +122,9 @@ def container_policies(
 
     every = {
         "unstack": deciding("load"),
-        "unstack_count": deciding("count"),
+        "min_cost": deciding("load", 0.0),
+        "unstack_count": deciding("count", 0.0),
         "hybrid": hybrid,
-        "near_ties": near_ties,
         "highest": highest,
         "footprint": footprint,
         "nearest_door": nearest_door,

@@ -6,7 +6,10 @@ decision maker picks the box to unload first:
 ``reasoner``
     unstack: the classifier's probabilities, the consistent worlds, minimum EC (Eq. 12)
     with the default cost (``load``: every box counted with the undetected load the cloud
-    shows on it).
+    shows on it); Eq. 13's minimum, as the paper decides.
+``near_ties``
+    unstack's default choice: the same expected costs, near ties (within
+    :data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`) broken by height.
 ``count``
     the same with Eq. 11's count exactly (``cost="count"``): the load nobody detected is
     not counted.
@@ -71,7 +74,7 @@ __all__ = [
     "uncovered_boxes",
 ]
 
-DECISION_MAKERS = ("reasoner", "count", "priors", "highest", "free", "hybrid", "random")
+DECISION_MAKERS = ("reasoner", "near_ties", "count", "priors", "highest", "free", "hybrid", "random")
 
 
 def squared_regret(costs: np.ndarray, choice: int) -> float:
@@ -150,7 +153,7 @@ def iset_outcome(scene: Any, ids: list[str], model: Any) -> IsetOutcome:
     from unstack.height_veto import hybrid_choice
     from unstack.learning.metrics import classification_report
     from unstack.learning.probabilities import scene_support_probabilities
-    from unstack.reasoner.decision import choose, decide
+    from unstack.reasoner.decision import NEAR_TIE_MARGIN, choose, decide
 
     supports = scene_support_probabilities(scene, model, boxes=ids)
     index = [scene.box_ids.index(box_id) for box_id in ids]
@@ -161,10 +164,12 @@ def iset_outcome(scene: Any, ids: list[str], model: Any) -> IsetOutcome:
     report = classification_report(truth[off], probabilities[off])
     boxes = [scene.box(box_id) for box_id in ids]
     priors_costs = probabilities.sum(axis=1)
-    decision = decide(supports)
+    decision = decide(supports, near_tie_margin=0.0)
+    near_tie, _ = choose(tuple(ids), decision.expected_costs, heights=supports.heights, margin=NEAR_TIE_MARGIN)
     picks = {
         "reasoner": ids.index(decision.choice),
-        "count": ids.index(decide(supports, cost="count").choice),
+        "near_ties": ids.index(near_tie),
+        "count": ids.index(decide(supports, cost="count", near_tie_margin=0.0).choice),
         "priors": ids.index(choose(tuple(ids), priors_costs)[0]),
         "highest": int(np.argmax([box.position[2] for box in boxes])),
         "free": free_pick(boxes),

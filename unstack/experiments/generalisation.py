@@ -45,9 +45,10 @@ __all__ = [
 
 #: The two ways a canonical scene is scanned.
 CLOUDS = ("sensor", "surface")
-#: How the first box is picked from a decision: its own minimum-EC choice (Eq. 13), or the
-#: hybrid (:func:`unstack.height_veto.highest_free_box`).
-PICKS = ("min-cost", "hybrid")
+#: How the first box is picked from a decision: its own choice (the default: near ties in
+#: expected cost broken by height), Eq. 13's minimum, or the hybrid
+#: (:func:`unstack.height_veto.highest_free_box`).
+PICKS = ("default", "min-cost", "hybrid")
 #: A box that carries a load of k boxes must cost at least this share of k.
 HOLD_SHARE = 0.5
 #: A pickable box must cost less than this.
@@ -165,7 +166,7 @@ def picked(decision: Any, scene: Scene, pick: str) -> Any:
     >>> from unstack.supports import Supports
     >>> boxes = [Box("tall", [0.4, 0.4, 0.8], [1.0, 0.0, 0.4]), Box("low", [0.4, 0.4, 0.3], [1.0, 0.5, 0.15])]
     >>> scene = Scene(boxes, np.zeros((0, 3)), ["tall", "low"])
-    >>> decision = decide(Supports(["tall", "low"], [[0.0, 0.3], [0.0, 0.0]]))
+    >>> decision = decide(Supports(["tall", "low"], [[0.0, 0.3], [0.0, 0.0]], heights=[0.4, 0.15]))
     >>> decision.choice, picked(decision, scene, "hybrid").choice
     ('low', 'tall')
     """
@@ -173,11 +174,15 @@ def picked(decision: Any, scene: Scene, pick: str) -> Any:
 
     from unstack.errors import UnstackError
     from unstack.height_veto import hybrid_choice
+    from unstack.reasoner.decision import choose
 
     if pick not in PICKS:
         raise UnstackError(f"unknown pick {pick!r}; expected one of {', '.join(PICKS)}")
-    if pick == "min-cost":
+    if pick == "default":
         return decision
+    if pick == "min-cost":
+        choice, ties = choose(tuple(decision.objects), decision.expected_costs)
+        return dataclasses.replace(decision, choice=choice, ties=ties, near_tie_margin=0.0)
     return dataclasses.replace(decision, choice=hybrid_choice(scene, decision))
 
 

@@ -84,7 +84,8 @@ def closed_loop_policies(
 
     def reasoner(scene: Any) -> str:
         supports = scene_support_probabilities(scene, model)
-        return str(decide(supports, cost=cost, samples=samples, time_limit=time_limit, seed=seed).choice)
+        decision = decide(supports, cost=cost, samples=samples, time_limit=time_limit, seed=seed, near_tie_margin=0.0)
+        return str(decision.choice)
 
     def highest(scene: Any) -> str:
         return str(min(scene.detected, key=lambda box_id: (-scene.box(box_id).position[2], box_id)))
@@ -109,7 +110,8 @@ def unloading_orders(
 
     supports = scene_support_probabilities(scene, model)
     detected = list(scene.detected)
-    plan = unloading_plan(supports, cost=cost, samples=samples, time_limit=time_limit, seed=seed)
+    # Eq. 13's minimum at every step (no near ties by height): the open-loop figures of the results page
+    plan = unloading_plan(supports, cost=cost, samples=samples, time_limit=time_limit, seed=seed, near_tie_margin=0.0)
 
     def raw_priors(remaining: list[str]) -> str:
         subset = supports.subset(remaining)

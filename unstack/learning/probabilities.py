@@ -111,4 +111,5 @@ def scene_support_probabilities(
         metadata=metadata,
         source=scene.source,
         hidden_load=hidden_load(scene, objects),
+        heights=[float(scene.boxes[k].position[2]) for k in detected],
     )

@@ -23,7 +23,7 @@ import numpy as np
 
 from unstack.errors import InvalidArgument, InvalidFile
 
-__all__ = ["check_budget", "check_choice", "check_count", "check_matrix", "check_seed"]
+__all__ = ["check_budget", "check_choice", "check_count", "check_margin", "check_matrix", "check_seed"]
 
 
 def check_budget(value: Any, name: str) -> float:
@@ -51,6 +51,22 @@ def check_budget(value: Any, name: str) -> float:
     if not (math.isfinite(seconds) and seconds > 0):
         raise InvalidArgument(f"{name} must be a positive, finite number of seconds, got {seconds}")
     return seconds
+
+
+def check_margin(value: Any, name: str) -> float:
+    """A non-negative, finite number of expected boxes moved (``near_tie_margin``).
+
+    Examples
+    --------
+    >>> check_margin(0, "near_tie_margin")
+    0.0
+    """
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        raise InvalidArgument(f"{name} must be a number of expected boxes moved, got {value!r}")
+    margin = float(value)
+    if not (math.isfinite(margin) and margin >= 0):
+        raise InvalidArgument(f"{name} must be a finite number >= 0 (expected boxes moved), got {margin}")
+    return margin
 
 
 def check_count(value: Any, name: str, minimum: int = 1) -> int:

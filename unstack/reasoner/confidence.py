@@ -33,9 +33,15 @@ CONTENDER_SIGMAS = 6.0
 
 
 def choice_probability(
-    expected_costs: np.ndarray, covariance: np.ndarray, choice: int, *, seed: int | None = 0, draws: int = DRAWS
+    expected_costs: np.ndarray,
+    covariance: np.ndarray,
+    choice: int,
+    *,
+    seed: int | None = 0,
+    draws: int = DRAWS,
+    margin: float = 0.0,
 ) -> float:
-    """Probability that box ``choice`` has the smallest true expected cost.
+    """Probability that box ``choice`` has the smallest true expected cost (within ``margin``).
 
     Parameters
     ----------
@@ -49,6 +55,9 @@ def choice_probability(
         Seed of the normal draws.
     draws : int
         Number of draws.
+    margin : float
+        The choice counts as right when its true cost is at most this far above the smallest
+        (the near-tie margin of the decision; 0: it must be the smallest).
 
     Returns
     -------
@@ -66,4 +75,7 @@ def choice_probability(
     columns = np.searchsorted(contenders, uncertain)
     block = covariance[np.ix_(uncertain, uncertain)]
     samples[:, columns] = rng.multivariate_normal(expected_costs[uncertain], block, size=draws, method="eigh")
-    return float(np.mean(contenders[np.argmin(samples, axis=1)] == choice))
+    if margin == 0.0:
+        return float(np.mean(contenders[np.argmin(samples, axis=1)] == choice))
+    own = int(np.searchsorted(contenders, choice))
+    return float(np.mean(samples[:, own] <= samples.min(axis=1) + margin))

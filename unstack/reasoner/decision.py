@@ -9,6 +9,14 @@ Ties. Boxes whose EC is within ``1e-12 * max(1, min EC)`` of the minimum are tie
 choice among them is the smallest id in Unicode code-point order. The rule depends on the
 ids only, so reordering the boxes in the input never changes the choice.
 
+Near ties. When the supports carry the boxes' heights (a scene's do), boxes whose EC lies
+within :data:`NEAR_TIE_MARGIN` expected boxes moved of the minimum count as tied and the
+highest of them is taken (equal heights: the smallest id). Which of several boxes that
+hold up almost nothing comes first is otherwise left to sampling noise and ids; the
+highest is the one its neighbours press on least. Emptying whole containers in the
+physics engine, this moved fewer boxes than Eq. 13's minimum (docs/results.md).
+``near_tie_margin=0`` keeps Eq. 13 exactly.
+
 Examples
 --------
 >>> from unstack.supports import Supports
@@ -29,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from unstack.errors import InvalidArgument, NoConsistentWorld
-from unstack.reasoner.arguments import check_budget, check_choice, check_count, check_seed
+from unstack.reasoner.arguments import check_budget, check_choice, check_count, check_margin, check_seed
 from unstack.reasoner.components import support_components
 from unstack.reasoner.confidence import choice_probability
 from unstack.reasoner.costs import COSTS, DEFAULT_COST, cost_weights, expected_costs, own_costs
@@ -43,6 +51,7 @@ __all__ = [
     "DECISION_FORMAT",
     "DEFAULT_COST",
     "METHODS",
+    "NEAR_TIE_MARGIN",
     "TIE_TOLERANCE",
     "Decision",
     "choose",
@@ -65,6 +74,9 @@ LOW_ACCEPTANCE = 0.05
 HIGH_RHAT = 1.1
 #: Relative tolerance under which two expected costs count as tied.
 TIE_TOLERANCE = 1e-12
+#: Expected costs within this many boxes of the lowest count as tied when heights are known;
+#: the highest of them is taken.
+NEAR_TIE_MARGIN = 0.05
 
 
 @dataclass(frozen=True, eq=False)
@@ -88,7 +100,9 @@ class Decision:
     consistent_worlds : int or None
         Number of consistent worlds of non-zero probability, when the method counted them.
     ties : tuple of str
-        Every box whose EC equals the minimum (the choice is the smallest id).
+        Every box the choice was made among, by id: those whose EC equals the minimum (the
+        choice is the smallest id), or with a near-tie margin, those within it of the
+        minimum (the choice is the highest).
     components : tuple of tuple of str
         Groups of boxes linked by non-zero support probabilities; the reasoning runs on each
         group alone (see :mod:`unstack.reasoner.components`).
@@ -111,6 +125,8 @@ class Decision:
         out-of-distribution warnings from the support model), one sentence each.
     sampling_seconds : float
         Wall time of the sampled groups (0 when none was sampled).
+    near_tie_margin : float
+        The near-tie margin the choice was made with (0: Eq. 13's minimum).
 
     Examples
     --------
@@ -138,12 +154,12 @@ class Decision:
     sampling: dict[str, Any] | None = None
     warnings: tuple[str, ...] = ()
     sampling_seconds: float = 0.0
+    near_tie_margin: float = 0.0
 
     def ranking(self) -> list[tuple[str, float, float]]:
         """Every box with its expected cost and that cost's standard error, best first.
 
-        The choice comes first, then the boxes tied with it (by id), then the rest by
-        expected cost (ties by id), as :func:`choose` orders them.
+        The choice comes first, then the rest by expected cost (ties by id).
 
         Returns
         -------
@@ -157,11 +173,10 @@ class Decision:
         'a'
         """
         errors = self.expected_cost_errors if self.expected_cost_errors is not None else np.zeros(len(self.objects))
-        tied = set(self.ties)
 
-        def key(i: int) -> tuple[int, float, str]:
+        def key(i: int) -> tuple[bool, float, str]:
             box = self.objects[i]
-            return (0, 0.0, box) if box in tied else (1, float(self.expected_costs[i]), box)
+            return (box != self.choice, float(self.expected_costs[i]), box)
 
         order = sorted(range(len(self.objects)), key=key)
         return [(self.objects[i], float(self.expected_costs[i]), float(errors[i])) for i in order]
@@ -200,6 +215,8 @@ class Decision:
         if self.consistent_worlds is not None:
             data["consistent_worlds"] = self.consistent_worlds
         data["ties"] = list(self.ties)
+        if self.near_tie_margin:
+            data["near_tie_margin"] = self.near_tie_margin
         data["components"] = [list(group) for group in self.components]
         data["component_methods"] = list(self.component_methods)
         if self.expected_cost_errors is not None and self.marginal_errors is not None:
@@ -218,8 +235,13 @@ class Decision:
         return data
 
 
-def choose(objects: tuple[str, ...], costs: np.ndarray) -> tuple[str, tuple[str, ...]]:
+def choose(
+    objects: tuple[str, ...], costs: np.ndarray, *, heights: np.ndarray | None = None, margin: float = 0.0
+) -> tuple[str, tuple[str, ...]]:
     """Pick the minimum-EC box; ties (within :data:`TIE_TOLERANCE`) go to the smallest id.
+
+    With ``heights`` and a ``margin``, every box within ``margin`` of the minimum is tied and
+    the highest of them is taken (equal heights: the smallest id).
 
     Parameters
     ----------
@@ -227,25 +249,37 @@ def choose(objects: tuple[str, ...], costs: np.ndarray) -> tuple[str, tuple[str,
         Box ids.
     costs : numpy.ndarray, shape (n,)
         Expected cost of each box.
+    heights : numpy.ndarray, shape (n,), optional
+        Height of each box's centre (needed for a margin).
+    margin : float
+        Near-tie margin in expected boxes moved.
 
     Returns
     -------
     choice : str
     ties : tuple of str
-        Every box within the tolerance of the minimum, by id.
+        Every box within the tolerance (or the margin) of the minimum, by id.
 
     Examples
     --------
     >>> choose(("b", "a", "c"), np.array([0.5, 0.5, 0.7]))
     ('a', ('a', 'b'))
+    >>> choose(("b", "a", "c"), np.array([0.5, 0.5, 0.53]), heights=np.array([0.2, 0.2, 0.6]), margin=0.05)
+    ('c', ('a', 'b', 'c'))
     """
     costs = np.asarray(costs, dtype=np.float64)
     if costs.shape != (len(objects),) or len(objects) == 0 or not np.all(np.isfinite(costs)):
         raise InvalidArgument(f"expected one finite cost per object ({len(objects)}), got shape {costs.shape}")
     lowest = float(np.min(costs))
     tolerance = TIE_TOLERANCE * max(1.0, abs(lowest))
-    tied = tuple(sorted(objects[i] for i in np.flatnonzero(costs <= lowest + tolerance)))
-    return tied[0], tied
+    if heights is None and margin:
+        raise InvalidArgument("a near-tie margin is broken by height: expected the boxes' heights")
+    within = np.flatnonzero(costs <= lowest + max(tolerance, margin))
+    tied = tuple(sorted(objects[i] for i in within))
+    if heights is None or not margin:
+        return tied[0], tied
+    height = {objects[i]: float(heights[i]) for i in within}
+    return max(tied, key=height.__getitem__), tied
 
 
 def _group_methods(method: str, sizes: list[int], time_limit: float | None, max_boxes: int | None = None) -> list[str]:
@@ -399,6 +433,7 @@ def decide(
     samples: int | None = None,
     seed: int | None = None,
     cache: WorkCache | None = None,
+    near_tie_margin: float | None = None,
 ) -> Decision:
     """Choose the box to unload first (Eq. 12) from pairwise support probabilities.
 
@@ -435,6 +470,10 @@ def decide(
         Work kept from earlier decisions on related scenes (an unloading plan's steps):
         unchanged groups are reused, sampled groups start from earlier chains
         (:mod:`unstack.reasoner.reuse`).
+    near_tie_margin : float, optional
+        Expected costs within this many boxes of the lowest count as tied and the highest
+        box of them is taken (needs ``supports.heights``). Default: :data:`NEAR_TIE_MARGIN`
+        when the supports carry heights, else 0; 0 keeps Eq. 13's minimum exactly.
 
     Returns
     -------
@@ -471,6 +510,7 @@ def decide(
     if samples is not None:
         samples = check_count(samples, "samples")
     seed = check_seed(seed)
+    margin = _near_tie_margin(supports, near_tie_margin)
     n = supports.n_objects
     weights = cost_weights(supports, cost)
     evidence = _propagate(supports)
@@ -500,7 +540,7 @@ def decide(
             covariance[block] = result.sampled.errors_of(weights[group])[1]
         worlds = None if worlds is None or result.worlds is None else worlds * result.worlds
     costs = expected_costs(marginals, weights, own_costs(supports, cost))
-    choice, ties = choose(supports.objects, costs)
+    choice, ties = choose(supports.objects, costs, heights=supports.heights, margin=margin)
     largest = int(np.argmax([len(group) for group in groups]))
     return Decision(
         objects=supports.objects,
@@ -511,7 +551,9 @@ def decide(
         expected_cost_errors=np.sqrt(np.diag(covariance)),
         marginals=marginals,
         marginal_errors=marginal_errors,
-        choice_probability=choice_probability(costs, covariance, supports.objects.index(choice), seed=seed),
+        choice_probability=choice_probability(
+            costs, covariance, supports.objects.index(choice), seed=seed, margin=margin
+        ),
         sampling=_sampling_summary(results, seed),
         method=methods[largest],
         cost=cost,
@@ -521,4 +563,17 @@ def decide(
         seconds=time.perf_counter() - start,
         warnings=_model_warnings(supports),
         sampling_seconds=sum(result.sampled.seconds for result in results if result.sampled is not None),
+        near_tie_margin=margin,
     )
+
+
+def _near_tie_margin(supports: Supports, margin: float | None) -> float:
+    if margin is None:
+        return NEAR_TIE_MARGIN if supports.heights is not None else 0.0
+    margin = check_margin(margin, "near_tie_margin")
+    if margin and supports.heights is None:
+        raise InvalidArgument(
+            f"{supports.source}: near_tie_margin breaks near ties by height, but these supports carry no "
+            'heights (a Scene\'s do; or add "heights" to the supports file)'
+        )
+    return margin

@@ -115,6 +115,7 @@ def unloading_plan(
     samples: int | None = None,
     seed: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    near_tie_margin: float | None = None,
 ) -> Plan:
     """Order every box by repeated minimum-EC decisions (see the module docstring).
 
@@ -122,7 +123,7 @@ def unloading_plan(
     ----------
     supports : Supports
         The detected boxes and their support probabilities.
-    method, cost, time_limit, samples, seed
+    method, cost, time_limit, samples, seed, near_tie_margin
         As in :func:`~unstack.reasoner.decision.decide`, applied to each step (so with a
         seed and no ``time_limit`` the plan is reproducible); without a budget each step
         samples :data:`PLAN_SAMPLES` sweeps per group, and ``auto`` counts groups of up to
@@ -160,6 +161,7 @@ def unloading_plan(
             seed=seed,
             cache=work,
             max_boxes=PLAN_EXACT_MAX_BOXES if method == "auto" else None,
+            near_tie_margin=near_tie_margin,
         )
         chosen = decision.objects.index(decision.choice)
         steps.append(PlanStep(decision.choice, float(decision.expected_costs[chosen]), tuple(remaining), decision))
