@@ -114,3 +114,15 @@ def test_the_choice_is_the_highest_within_the_margin_and_never_worse_than_the_ma
     chosen = objects.index(choice)
     assert costs[chosen] <= min(costs) + margin + 1e-12
     assert heights[chosen] == max(heights[objects.index(box)] for box in ties)
+
+
+def test_a_plan_breaks_near_ties_at_every_step_and_says_so(low_free_high_free_and_loaded: Supports) -> None:
+    from unstack.reasoner.plan import unloading_plan
+
+    plan = unloading_plan(low_free_high_free_and_loaded)
+    assert plan.order == ["high", "base", "low"]  # 'high' first (near tie), then 'base' (0 vs 'low' 0: higher)
+    document = plan.to_dict()
+    assert all(step["near_tie_margin"] == NEAR_TIE_MARGIN for step in document["steps"])
+    jsonschema.validate(json.loads(json.dumps(document)), load_schema("unstack.plan/1"))
+    strict = unloading_plan(low_free_high_free_and_loaded, near_tie_margin=0.0)
+    assert strict.order[0] == "low" and "near_tie_margin" not in strict.to_dict()["steps"][0]

@@ -99,6 +99,7 @@ class Plan:
                     "ties": list(step.decision.ties),
                     "expected_cost_error": step.expected_cost_error,
                     "choice_probability": step.decision.choice_probability,
+                    **({"near_tie_margin": step.decision.near_tie_margin} if step.decision.near_tie_margin else {}),
                 }
                 for step in self.steps
             ],
