@@ -203,6 +203,9 @@ def test_plan_with_sampling(twelve_boxes: Path) -> None:
         (["--time-limit", "-1"], "--time-limit"),
         (["--method", "fast"], "--method"),
         (["--seed", "-1"], "--seed"),
+        (["--near-ties", "nan"], "--near-ties"),
+        (["--near-ties", "-0.1"], "--near-ties"),
+        (["--near-ties", "inf"], "--near-ties"),
     ],
 )
 def test_bad_sampling_options_exit_2(option: list[str], message: str) -> None:

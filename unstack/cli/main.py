@@ -117,6 +117,12 @@ def finite_seconds(_ctx: click.Context, _param: click.Parameter, value: float | 
     return value
 
 
+def finite_margin(_ctx: click.Context, _param: click.Parameter, value: float | None) -> float | None:
+    if value is not None and not (math.isfinite(value) and value >= 0):
+        raise click.BadParameter(f"expected a finite number >= 0 of expected boxes moved, got {value}")
+    return value
+
+
 def load_model_option(model: str | None) -> tuple[Any, str]:
     """The model of ``--model`` (a shipped model's name or a file; the default when None) and its name."""
     from unstack.api import load_model, model_label
@@ -165,8 +171,9 @@ def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
         click.option(
             "--near-ties",
             "near_tie_margin",
-            type=click.FloatRange(min=0.0, max=100.0),
+            type=float,
             default=None,
+            callback=finite_margin,
             help="Expected costs within this many boxes of the lowest are tied and the highest box is taken "
             "(default 0.05 for a scene or supports with heights; 0: Eq. 13's minimum exactly).",
         ),
