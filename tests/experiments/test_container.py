@@ -92,3 +92,22 @@ def test_unstack_breaks_near_ties_by_height_and_min_cost_keeps_eq13() -> None:
 def test_unstack_never_takes_a_box_under_load() -> None:
     policies = container_policies(load_model(default_model_path()), seed=0, makers=("unstack",))
     assert policies["unstack"](_tall_loaded_and_short_free()) == "free"
+
+
+def test_containers_run_on_a_dask_cluster_with_the_same_results(small_dataset: Path) -> None:
+    from distributed import Client, LocalCluster
+
+    model = load_model(default_model_path())
+    options = {"piles": 1, "makers": ("unstack", "highest"), "max_picks": 2, "samples": 64}
+    local = container_experiment(small_dataset, model, **options)  # type: ignore[arg-type]
+    with (
+        LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster,
+        Client(cluster) as client,
+    ):
+        remote = container_experiment(small_dataset, model, client=client, **options)  # type: ignore[arg-type]
+    assert remote["runs"] == local["runs"]
+
+
+def test_an_unreachable_scheduler_is_one_line(small_dataset: Path, tmp_path: Path) -> None:
+    result = unstack("experiment", "container", str(small_dataset), "--out", str(tmp_path), "--scheduler", "nonsense")
+    assert result.returncode == 2 and result.stderr.count("\n") == 1 and "tcp://HOST:PORT" in result.stderr

@@ -384,6 +384,8 @@ def unload(
               help="Recorded sweeps per sampled group in each decision.")  # fmt: skip
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True)
 @click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Piles run in parallel.")
+@click.option("--scheduler", default=None,
+              help="Address of a dask.distributed scheduler (tcp://HOST:PORT): piles run on its workers.")  # fmt: skip
 def container(
     data_dir: str,
     out: str,
@@ -397,6 +399,7 @@ def container(
     samples: int,
     seed: int,
     jobs: int,
+    scheduler: str | None,
 ) -> None:
     """Empty whole containers as a robot does: scan and detect again before every pick.
 
@@ -412,14 +415,21 @@ def container(
     chosen = tuple(name.strip() for name in makers.split(",") if name.strip())
     model, name = load_model_option(model_path)
     container_policies(model, seed=seed, makers=chosen)  # an unknown maker is one line, before any work
+    from unstack.sim.dataset import connect_scheduler
+
+    client = connect_scheduler(scheduler) if scheduler else None  # fails in seconds, before any output
     folder = _out(out)
-    with progress_bar("piles") as report:
-        result = container_experiment(
-            data_dir, model, piles=piles, makers=chosen, detector_noise=detector_noise,
-            detector_misses=detector_misses, reach=reach,
-            max_picks=max_picks, samples=samples, seed=seed, progress=report,
-            checkpoints=folder / "container-piles", n_jobs=jobs,
-        )  # fmt: skip
+    try:
+        with progress_bar("piles") as report:
+            result = container_experiment(
+                data_dir, model, piles=piles, makers=chosen, detector_noise=detector_noise,
+                detector_misses=detector_misses, reach=reach,
+                max_picks=max_picks, samples=samples, seed=seed, progress=report,
+                checkpoints=folder / "container-piles", n_jobs=jobs, client=client,
+            )  # fmt: skip
+    finally:
+        if client is not None:
+            client.close()
     result["model"] = name
     _write_json(folder / "container.json", result)
     table = Table(title=f"Emptying {result['piles']} piles of {data_dir}, detecting again before every pick")

@@ -45,7 +45,7 @@ Examples
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -158,6 +158,15 @@ def _run_pile(
     return number, {"scene": path.name, "boxes": len(scene.boxes), "runs": runs}
 
 
+def _on_cluster(client: Any, arguments: list[tuple[Any, ...]]) -> Iterator[tuple[int, dict[str, Any]]]:
+    """Run the piles on a dask.distributed cluster, yielding results as they finish."""
+    from distributed import as_completed
+
+    futures = [client.submit(_run_pile, *task, pure=False) for task in arguments]
+    for future in as_completed(futures):  # type: ignore[no-untyped-call]
+        yield future.result()
+
+
 def _pile_metrics(run: dict[str, Any]) -> dict[str, float]:
     steps = run["steps"]
     return {
@@ -183,6 +192,7 @@ def container_experiment(
     progress: Callable[[int, int], None] | None = None,
     checkpoints: str | os.PathLike[str] | None = None,
     n_jobs: int = 1,
+    client: Any = None,
 ) -> dict[str, Any]:
     """Empty the first ``piles`` piles of a data set with every decision maker; compare them.
 
@@ -190,7 +200,8 @@ def container_experiment(
     moved, boxes fallen, share of calm picks) and boxes moved per pick, the paired
     differences from ``unstack`` (mean and standard error over piles), and every run.
     ``checkpoints``: a folder keeping each pile's result; a run started again with the same
-    settings reuses them.
+    settings reuses them. ``n_jobs``: piles run in parallel processes; ``client``: on the
+    workers of a ``distributed.Client`` instead (the results depend on neither).
     """
     import hashlib
     import json
@@ -231,10 +242,15 @@ def container_experiment(
     todo = [number for number, result in enumerate(results) if result is None]
     if progress is not None:
         progress(len(files) - len(todo), len(files))
-    tasks = (
-        delayed(_run_pile)(files[number], number, model, makers, {**settings, "seed": seed + number}) for number in todo
-    )
-    for number, pile in Parallel(n_jobs=n_jobs, return_as="generator_unordered")(tasks):
+    arguments = [(files[number], number, model, makers, {**settings, "seed": seed + number}) for number in todo]
+    running: Iterator[tuple[int, dict[str, Any]]]
+    if client is None:
+        running = Parallel(n_jobs=n_jobs, return_as="generator_unordered")(
+            delayed(_run_pile)(*task) for task in arguments
+        )
+    else:
+        running = _on_cluster(client, arguments)
+    for number, pile in running:
         results[number] = pile
         if folder is not None:
             stored = {"key": key(number, files[number]), "result": pile}
