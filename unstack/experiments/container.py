@@ -51,6 +51,7 @@ from typing import Any
 
 import numpy as np
 
+from unstack.experiments.dispatch import run_unordered
 from unstack.scene import Scene
 
 __all__ = ["CONTAINER_MAKERS", "CONTAINER_SAMPLES", "container_experiment", "container_policies"]
@@ -158,15 +159,6 @@ def _run_pile(
     return number, {"scene": path.name, "boxes": len(scene.boxes), "runs": runs}
 
 
-def _on_cluster(client: Any, arguments: list[tuple[Any, ...]]) -> Iterator[tuple[int, dict[str, Any]]]:
-    """Run the piles on a dask.distributed cluster, yielding results as they finish."""
-    from distributed import as_completed
-
-    futures = [client.submit(_run_pile, *task, pure=False) for task in arguments]
-    for future in as_completed(futures):  # type: ignore[no-untyped-call]
-        yield future.result()
-
-
 def _pile_metrics(run: dict[str, Any]) -> dict[str, float]:
     steps = run["steps"]
     return {
@@ -206,8 +198,6 @@ def container_experiment(
     import hashlib
     import json
 
-    from joblib import Parallel, delayed
-
     from unstack.atomic import atomic_write_text
     from unstack.datasets import require_configurations
     from unstack.experiments.decisions import paired_difference
@@ -243,13 +233,7 @@ def container_experiment(
     if progress is not None:
         progress(len(files) - len(todo), len(files))
     arguments = [(files[number], number, model, makers, {**settings, "seed": seed + number}) for number in todo]
-    running: Iterator[tuple[int, dict[str, Any]]]
-    if client is None:
-        running = Parallel(n_jobs=n_jobs, return_as="generator_unordered")(
-            delayed(_run_pile)(*task) for task in arguments
-        )
-    else:
-        running = _on_cluster(client, arguments)
+    running: Iterator[tuple[int, dict[str, Any]]] = run_unordered(_run_pile, arguments, n_jobs=n_jobs, client=client)
     for number, pile in running:
         results[number] = pile
         if folder is not None:

@@ -36,12 +36,13 @@ Examples
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from unstack.experiments.dispatch import run_unordered
 from unstack.reasoner.costs import DEFAULT_COST
 
 __all__ = [
@@ -181,15 +182,6 @@ def _run_pile(
     return number, {"scene": path.name, "boxes": len(scene.boxes), "detected": len(scene.detected), "runs": executed}
 
 
-def _on_cluster(client: Any, arguments: list[tuple[Any, ...]]) -> Iterator[tuple[int, dict[str, Any]]]:
-    """Run the piles on a dask.distributed cluster, yielding results as they finish."""
-    from distributed import as_completed
-
-    futures = [client.submit(_run_pile, *task, pure=False) for task in arguments]
-    for future in as_completed(futures):  # type: ignore[no-untyped-call]
-        yield future.result()
-
-
 def unloading_experiment(
     data_dir: str | os.PathLike[str],
     model: Any,
@@ -220,8 +212,6 @@ def unloading_experiment(
     """
     import json
 
-    from joblib import Parallel, delayed
-
     from unstack.atomic import atomic_write_text
     from unstack.datasets import require_configurations
 
@@ -238,12 +228,7 @@ def unloading_experiment(
     if progress is not None:
         progress(len(files) - len(todo), len(files))
     arguments = [(files[number], number, model, budget, seed + number, closed_loop, cost) for number in todo]
-    if client is None:
-        results = Parallel(n_jobs=n_jobs, return_as="generator_unordered")(
-            delayed(_run_pile)(*task) for task in arguments
-        )
-    else:
-        results = _on_cluster(client, arguments)
+    results = run_unordered(_run_pile, arguments, n_jobs=n_jobs, client=client)
     for number, pile in results:
         piles[number] = pile
         if folder is not None:
