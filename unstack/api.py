@@ -261,7 +261,7 @@ def decide(
         Seconds for the whole decision instead of a fixed number of sweeps (not reproducible).
     near_tie_margin : float, optional
         Boxes whose expected cost is within this many boxes of the lowest count as tied, and
-        the highest of them is taken. Default: 0.05
+        the one resting highest is taken (boxes resting on one layer: the lowest cost). Default: 0.05
         (:data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`) for a scene (and for supports
         that carry heights), Eq. 13's minimum for supports without heights; 0 keeps Eq. 13
         exactly.

@@ -8,7 +8,9 @@ over X's footprint that no detected box explains (points inside a detected box g
 :func:`container_planes`):
 
 * the points over X's footprint swept :data:`FRONT_REACH` towards the door (a box resting
-  on X that is deeper than X shows its front face in front of X's footprint);
+  on X that is deeper than X shows its front face in front of X's footprint) and grown by
+  :data:`SIDE_REACH` on every side (a box as wide as X shows its side faces on the edge of
+  X's footprint, and depth noise scatters them to either side of it);
 * the lowest unexplained point above X's top must lie within one typical box height (plus
   :data:`STACK_GAP`) of it -- a box resting on X whose front face is not seen still shows
   its top there;
@@ -44,7 +46,7 @@ import numpy as np
 from unstack.geometry import bounding_boxes, box_corners, convex_hull_2d, footprint, points_in_box
 from unstack.scene import Box, Scene
 
-__all__ = ["EXPLAINED_MARGIN", "STACK_GAP", "container_planes", "hidden_load"]
+__all__ = ["EXPLAINED_MARGIN", "SIDE_REACH", "STACK_GAP", "container_planes", "hidden_load"]
 
 #: Points within this distance of a detected box belong to it (metres).
 EXPLAINED_MARGIN = 0.02
@@ -58,6 +60,8 @@ MAX_RISE = 1.5
 COVERAGE_BIN = 0.04
 #: The footprint is swept this far towards the door (-x) before looking for load (metres).
 FRONT_REACH = 0.08
+#: ... and grown this far on every side (metres): a range sensor's depth noise.
+SIDE_REACH = 0.02
 #: The cloud's extreme points on one side (top, back, left, right) are a container plane when
 #: they spread over more than this (metres) in both directions of the plane (a 1 m deep
 #: section's side walls, not the face of a carton of up to 0.7 m) ...
@@ -73,6 +77,10 @@ FLOOR_BAND = 0.05
 #: The sides a container plane can stand on: (axis, +1 for the highest coordinate, -1 for the
 #: lowest). The door side (-x) is open and the floor lies under every box.
 PLANE_SIDES = ((2, 1), (0, 1), (1, -1), (1, 1))
+
+
+#: The footprint grown by :data:`SIDE_REACH`: its corners moved diagonally (a square's Minkowski sum).
+_SIDE_OFFSETS = SIDE_REACH * np.array([[1.0, 1.0], [1.0, -1.0], [-1.0, 1.0], [-1.0, -1.0]])
 
 
 def _over(polygon: np.ndarray, points: np.ndarray) -> np.ndarray:
@@ -196,11 +204,11 @@ def hidden_load(scene: Scene, detected: Sequence[str] | None = None) -> np.ndarr
     free_points = points[free]
     typical_height = float(np.median([np.ptp(box_corners(box)[:, 2]) for box in boxes]))
     for k, box in enumerate(boxes):
-        low, high = bounds[k, :2] - [FRONT_REACH, 0.0], bounds[k, 3:5]
+        low, high = bounds[k, :2] - [FRONT_REACH + SIDE_REACH, SIDE_REACH], bounds[k, 3:5] + SIDE_REACH
         column = free_points[np.all((free_points[:, :2] >= low) & (free_points[:, :2] <= high), axis=1)]
         if len(column) == 0:
             continue
-        polygon = footprint(box)
+        polygon = np.vstack([footprint(box) + offset for offset in _SIDE_OFFSETS])
         swept = convex_hull_2d(np.vstack([polygon, polygon - [FRONT_REACH, 0.0]]))
         result[k] = _load_on(column[_over(swept, column)], bounds[k, 5], low[1], high[1], typical_height)
     return result

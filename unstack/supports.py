@@ -48,8 +48,8 @@ class Supports:
         shows on it that no detected box explains; see :mod:`unstack.hidden_load`). The
         ``load`` cost counts it; 0 when not given.
     heights : array-like, shape (n,), optional
-        Height of each box's centre above the floor in metres (a scene's boxes give it).
-        With it, the decision breaks near ties in expected cost by height
+        The height each box rests at: its lowest point above the floor in metres (a scene's
+        boxes give it). With it, near ties in expected cost go to the box resting highest
         (:data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`); without it, Eq. 13's minimum.
     metadata : dict, optional
         Free-form provenance, kept when saving.

@@ -214,15 +214,16 @@ def test_bad_sampling_options_exit_2(option: list[str], message: str) -> None:
     assert result.stderr.startswith("unstack: error: unstack decide: ") and result.stderr.count("\n") == 1
 
 
-def test_decide_on_a_scene_breaks_near_ties_by_height(tmp_path: Path) -> None:
+def test_decide_on_a_scene_gives_near_ties_to_the_box_resting_highest(tmp_path: Path) -> None:
     from unstack.scene import Box, Scene
 
     boxes = [
         Box("low", [0.4, 0.4, 0.3], [1.2, -0.35, 0.151]),
-        Box("high", [0.4, 0.4, 0.6], [1.2, 0.35, 0.301]),
+        Box("base", [0.4, 0.4, 0.3], [1.2, 0.35, 0.151]),
+        Box("high", [0.4, 0.4, 0.3], [1.2, 0.35, 0.452]),
     ]
-    path = tmp_path / "two.scene.json"
-    Scene(boxes, np.zeros((0, 3)), ["low", "high"]).save(path)
+    path = tmp_path / "three.scene.json"
+    Scene(boxes, np.zeros((0, 3)), ["low", "base", "high"]).save(path)
     default = unstack("decide", str(path), "--json")
     assert default.returncode == 0, default.stderr
     document = json.loads(default.stdout)
@@ -234,7 +235,7 @@ def test_decide_on_a_scene_breaks_near_ties_by_height(tmp_path: Path) -> None:
     )
     table = unstack("decide", str(path))
     words = " ".join(table.stdout.split())  # rich wraps the headline
-    assert "Unload first: high (tied with low: EC within 0.05 of the lowest; the highest box wins)" in words
+    assert "Unload first: high (tied with low: EC within 0.05 of the lowest; the box resting highest wins)" in words
 
 
 def test_near_ties_on_supports_without_heights_exit_2() -> None:

@@ -459,7 +459,7 @@ def container(
               help="Seed of the first scene of each kind (later ones follow).")  # fmt: skip
 @click.option("--physics", is_flag=True, help="Also check each scene's labels in the physics engine.")
 @click.option("--pick", type=click.Choice(["default", "min-cost", "hybrid"]), default="default", show_default=True,
-              help="default: the decision's choice (near ties broken by height); min-cost: Eq. 13's minimum; "
+              help="default: the decision's choice (near ties to the box resting highest); min-cost: Eq. 13's minimum; "
                    "hybrid: the highest box of EC below 0.5.")  # fmt: skip
 def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int, physics: bool, pick: str) -> None:
     """The generalisation suite: hand-made canonical scenes, two clouds each, the decision checked.

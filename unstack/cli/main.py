@@ -174,8 +174,8 @@ def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
             type=float,
             default=None,
             callback=finite_margin,
-            help="Expected costs within this many boxes of the lowest are tied and the highest box is taken "
-            "(default 0.05 for a scene or supports with heights; 0: Eq. 13's minimum exactly).",
+            help="Expected costs within this many boxes of the lowest are tied and the box resting highest is taken; "
+            "on one layer the lowest cost (default 0.05 for a scene or supports with heights; 0: Eq. 13's minimum).",
         ),
     ]
     for option in reversed(options):

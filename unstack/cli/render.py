@@ -88,7 +88,7 @@ def decision_view(decision: Decision) -> Group:
         headline.append(f"  (P(truly {what}) = {decision.choice_probability:.3f})")
     if len(decision.ties) > 1:
         others = ", ".join(printable(t) for t in decision.ties if t != decision.choice)
-        rule = f"EC within {near:g} of the lowest; the highest box wins" if near else "smallest id wins"
+        rule = f"EC within {near:g} of the lowest; the box resting highest wins" if near else "smallest id wins"
         headline.append(f"  (tied with {others}: {rule})")
     return Group(headline, costs, matrix, footer)
 

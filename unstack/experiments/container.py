@@ -6,7 +6,7 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
 
 ``unstack``
     unstack's default decision: the default model's probabilities, the default cost (hidden
-    load counted) and near ties in expected cost broken by height
+    load counted) and near ties in expected cost to the box resting highest
     (:data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`).
 ``min_cost``
     the same expected costs with Eq. 13's minimum (no near ties; the default before

@@ -9,7 +9,7 @@ decision maker picks the box to unload first:
     shows on it); Eq. 13's minimum, as the paper decides.
 ``near_ties``
     unstack's default choice: the same expected costs, near ties (within
-    :data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`) broken by height.
+    :data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`) to the box resting highest.
 ``count``
     the same with Eq. 11's count exactly (``cost="count"``): the load nobody detected is
     not counted.

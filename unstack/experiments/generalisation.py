@@ -46,7 +46,7 @@ __all__ = [
 #: The two ways a canonical scene is scanned.
 CLOUDS = ("sensor", "surface")
 #: How the first box is picked from a decision: its own choice (the default: near ties in
-#: expected cost broken by height), Eq. 13's minimum, or the hybrid
+#: expected cost to the box resting highest), Eq. 13's minimum, or the hybrid
 #: (:func:`unstack.height_veto.highest_free_box`).
 PICKS = ("default", "min-cost", "hybrid")
 #: A box that carries a load of k boxes must cost at least this share of k.
@@ -166,7 +166,7 @@ def picked(decision: Any, scene: Scene, pick: str) -> Any:
     >>> from unstack.supports import Supports
     >>> boxes = [Box("tall", [0.4, 0.4, 0.8], [1.0, 0.0, 0.4]), Box("low", [0.4, 0.4, 0.3], [1.0, 0.5, 0.15])]
     >>> scene = Scene(boxes, np.zeros((0, 3)), ["tall", "low"])
-    >>> decision = decide(Supports(["tall", "low"], [[0.0, 0.3], [0.0, 0.0]], heights=[0.4, 0.15]))
+    >>> decision = decide(Supports(["tall", "low"], [[0.0, 0.3], [0.0, 0.0]], heights=[0.0, 0.0]))
     >>> decision.choice, picked(decision, scene, "hybrid").choice
     ('low', 'tall')
     """

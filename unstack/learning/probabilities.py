@@ -20,6 +20,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from unstack.geometry import box_corners
 from unstack.learning.features import pair_features
 from unstack.learning.model_file import SupportModel
 from unstack.scene import Scene
@@ -111,5 +112,5 @@ def scene_support_probabilities(
         metadata=metadata,
         source=scene.source,
         hidden_load=hidden_load(scene, objects),
-        heights=[float(scene.boxes[k].position[2]) for k in detected],
+        heights=[float(box_corners(scene.boxes[k])[:, 2].min()) for k in detected],
     )

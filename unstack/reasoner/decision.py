@@ -9,13 +9,17 @@ Ties. Boxes whose EC is within ``1e-12 * max(1, min EC)`` of the minimum are tie
 choice among them is the smallest id in Unicode code-point order. The rule depends on the
 ids only, so reordering the boxes in the input never changes the choice.
 
-Near ties. When the supports carry the boxes' heights (a scene's do), boxes whose EC lies
-within :data:`NEAR_TIE_MARGIN` expected boxes moved of the minimum count as tied and the
-highest of them is taken (equal heights: the smallest id). Which of several boxes that
-hold up almost nothing comes first is otherwise left to sampling noise and ids; the
-highest is the one its neighbours press on least. Emptying whole containers in the
-physics engine, this moved fewer boxes than Eq. 13's minimum (docs/results.md).
-``near_tie_margin=0`` keeps Eq. 13 exactly.
+Near ties. When the supports carry the heights the boxes rest at (their lowest points; a
+scene's supports do), boxes whose EC lies within :data:`NEAR_TIE_MARGIN` expected boxes
+moved of the minimum count as tied, and the tied box resting highest is taken: a box on
+top of others before the boxes under it. Tied boxes resting on one layer (within
+:data:`LAYER_TOLERANCE` of the highest) are decided by their EC as in Eq. 13 (then the
+smallest id), so a box standing on the floor is never preferred to another on the floor
+for being taller -- a box leaning on it may be what the model missed. Which of several
+boxes that hold up almost nothing comes first is otherwise left to small differences of
+the model; the one resting highest is the one its neighbours press on least. Emptying
+whole containers in the physics engine, near ties moved fewer boxes than Eq. 13's minimum
+(docs/results.md). ``near_tie_margin=0`` keeps Eq. 13 exactly.
 
 Examples
 --------
@@ -50,6 +54,7 @@ from unstack.supports import Supports
 __all__ = [
     "DECISION_FORMAT",
     "DEFAULT_COST",
+    "LAYER_TOLERANCE",
     "METHODS",
     "NEAR_TIE_MARGIN",
     "TIE_TOLERANCE",
@@ -75,8 +80,12 @@ HIGH_RHAT = 1.1
 #: Relative tolerance under which two expected costs count as tied.
 TIE_TOLERANCE = 1e-12
 #: Expected costs within this many boxes of the lowest count as tied when heights are known;
-#: the highest of them is taken.
+#: the tied box resting highest is taken.
 NEAR_TIE_MARGIN = 0.05
+#: Tied boxes resting within this height (metres) of the highest rest on one layer and are
+#: decided by their expected cost: ten times a box detector's height error (5 mm), under the
+#: height of any carton.
+LAYER_TOLERANCE = 0.05
 
 
 @dataclass(frozen=True, eq=False)
@@ -240,8 +249,9 @@ def choose(
 ) -> tuple[str, tuple[str, ...]]:
     """Pick the minimum-EC box; ties (within :data:`TIE_TOLERANCE`) go to the smallest id.
 
-    With ``heights`` and a ``margin``, every box within ``margin`` of the minimum is tied and
-    the highest of them is taken (equal heights: the smallest id).
+    With ``heights`` and a ``margin``, every box within ``margin`` of the minimum is tied;
+    of the tied boxes resting within :data:`LAYER_TOLERANCE` of the highest, the one of
+    lowest EC is taken (equal ECs: the smallest id).
 
     Parameters
     ----------
@@ -250,7 +260,7 @@ def choose(
     costs : numpy.ndarray, shape (n,)
         Expected cost of each box.
     heights : numpy.ndarray, shape (n,), optional
-        Height of each box's centre (needed for a margin).
+        The height each box rests at: its lowest point above the floor (needed for a margin).
     margin : float
         Near-tie margin in expected boxes moved.
 
@@ -264,8 +274,16 @@ def choose(
     --------
     >>> choose(("b", "a", "c"), np.array([0.5, 0.5, 0.7]))
     ('a', ('a', 'b'))
-    >>> choose(("b", "a", "c"), np.array([0.5, 0.5, 0.53]), heights=np.array([0.2, 0.2, 0.6]), margin=0.05)
+
+    ``c`` rests on top of another box; ``a`` and ``b`` stand on the floor:
+
+    >>> choose(("b", "a", "c"), np.array([0.5, 0.5, 0.53]), heights=np.array([0.0, 0.0, 0.3]), margin=0.05)
     ('c', ('a', 'b', 'c'))
+
+    On one layer the lower EC wins, however tall the box:
+
+    >>> choose(("tall", "short"), np.array([0.056, 0.019]), heights=np.array([0.0, 0.01]), margin=0.05)
+    ('short', ('short', 'tall'))
     """
     costs = np.asarray(costs, dtype=np.float64)
     if costs.shape != (len(objects),) or len(objects) == 0 or not np.all(np.isfinite(costs)):
@@ -278,8 +296,11 @@ def choose(
     tied = tuple(sorted(objects[i] for i in within))
     if heights is None or not margin:
         return tied[0], tied
-    height = {objects[i]: float(heights[i]) for i in within}
-    return max(tied, key=height.__getitem__), tied
+    rests = np.asarray(heights, dtype=np.float64)
+    top = float(np.max(rests[within]))
+    layer = [i for i in within if rests[i] >= top - LAYER_TOLERANCE]
+    least = min(float(costs[i]) for i in layer)
+    return min(objects[i] for i in layer if costs[i] <= least + tolerance), tied
 
 
 def _group_methods(method: str, sizes: list[int], time_limit: float | None, max_boxes: int | None = None) -> list[str]:
@@ -471,8 +492,9 @@ def decide(
         unchanged groups are reused, sampled groups start from earlier chains
         (:mod:`unstack.reasoner.reuse`).
     near_tie_margin : float, optional
-        Expected costs within this many boxes of the lowest count as tied and the highest
-        box of them is taken (needs ``supports.heights``). Default: :data:`NEAR_TIE_MARGIN`
+        Expected costs within this many boxes of the lowest count as tied and the box
+        resting highest of them is taken (one layer: the lowest EC; needs
+        ``supports.heights``). Default: :data:`NEAR_TIE_MARGIN`
         when the supports carry heights, else 0; 0 keeps Eq. 13's minimum exactly.
 
     Returns
