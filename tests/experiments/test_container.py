@@ -78,14 +78,15 @@ def test_the_hybrid_takes_the_highest_box_the_model_does_not_believe_loaded() ->
     assert policies["hybrid"](scene) == "free"
 
 
-def test_unstack_breaks_near_ties_by_height_and_min_cost_keeps_eq13() -> None:
+def test_unstack_gives_near_ties_to_the_box_resting_highest_and_min_cost_keeps_eq13() -> None:
     boxes = [
         Box("a_low", [0.4, 0.4, 0.3], [1.2, -0.35, 0.151]),
-        Box("b_high", [0.4, 0.4, 0.6], [1.2, 0.35, 0.301]),
+        Box("base", [0.4, 0.4, 0.3], [1.2, 0.35, 0.151]),
+        Box("b_high", [0.4, 0.4, 0.3], [1.2, 0.35, 0.452]),
     ]
-    scene = Scene(boxes, surface_cloud(boxes, viewpoint=[-2.0, 0.0, 1.5], seed=0), ["a_low", "b_high"])
+    scene = Scene(boxes, surface_cloud(boxes, viewpoint=[-2.0, 0.0, 1.5], seed=0), ["a_low", "base", "b_high"])
     policies = container_policies(load_model(default_model_path()), seed=0, makers=("unstack", "min_cost"))
-    assert policies["unstack"](scene) == "b_high"  # two free boxes: the higher
+    assert policies["unstack"](scene) == "b_high"  # two free boxes: the one resting higher
     assert policies["min_cost"](scene) == "a_low"  # Eq. 13: the lower expected cost (or the smaller id)
 
 
