@@ -20,7 +20,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from unstack.geometry import box_corners
+from unstack.geometry import bounding_boxes
 from unstack.learning.features import pair_features
 from unstack.learning.model_file import SupportModel
 from unstack.scene import Scene
@@ -112,5 +112,5 @@ def scene_support_probabilities(
         metadata=metadata,
         source=scene.source,
         hidden_load=hidden_load(scene, objects),
-        heights=[float(box_corners(scene.boxes[k])[:, 2].min()) for k in detected],
+        heights=bounding_boxes([scene.boxes[k] for k in detected])[:, 2],  # the heights the boxes rest at
     )
