@@ -174,14 +174,15 @@ def test_timing_only_on_request() -> None:
 
 
 def test_warm_up_reports_each_kernel() -> None:
-    result = unstack("warm-up")
+    result = unstack("warm-up", "--jobs", "2")
     assert result.returncode == 0, result.stderr
     lines = result.stderr.splitlines()
-    assert lines[0].startswith("warm-up: compiling 4 groups of kernels")
-    assert [line.split("] ")[1].split(" ready")[0] for line in lines[1:]] == [
+    assert lines[0].startswith("warm-up: compiling 4 groups of kernels in 2 processes")
+    assert [line.split("] ")[0] for line in lines[1:]] == [f"warm-up: [{k}/4" for k in range(1, 5)]
+    assert sorted(line.split("] ")[1].split(" ready")[0] for line in lines[1:]) == [
         "exact engine",
+        "feature kernels",
         "sampler",
         "wide sampler",
-        "feature kernels",
     ]
     assert result.stdout.startswith("warm-up: done in ")
