@@ -256,7 +256,7 @@ def decide(
         every run, whatever the machine's load.
     samples : int, optional
         Recorded sweeps per sampled group (default
-        :data:`~unstack.reasoner.sampling.DEFAULT_SAMPLES`).
+        :func:`~unstack.reasoner.sampling.default_samples` of its size).
     time_limit : float, optional
         Seconds for the whole decision instead of a fixed number of sweeps (not reproducible).
     near_tie_margin : float, optional

@@ -224,13 +224,13 @@ def test_a_contradiction_names_the_file(tmp_path: Path) -> None:
 
 def test_default_budget_is_a_number_of_sweeps_reproducible_for_a_seed() -> None:
     from unstack.reasoner.decision import decide as decide_supports
-    from unstack.reasoner.sampling import DEFAULT_SAMPLES
+    from unstack.reasoner.sampling import default_samples
 
     rng = np.random.default_rng(5)
     p = rng.uniform(0.05, 0.95, (9, 9))
     np.fill_diagonal(p, 0.0)
     supports = Supports([f"b{i}" for i in range(9)], p)
     first, second = (decide_supports(supports, seed=11) for _ in range(2))
-    assert first.sampling is not None and first.sampling["samples"] == [DEFAULT_SAMPLES]
+    assert first.sampling is not None and first.sampling["samples"] == [default_samples(9)] == [8192]
     np.testing.assert_array_equal(first.expected_costs, second.expected_costs)
     np.testing.assert_array_equal(first.expected_cost_errors, second.expected_cost_errors)

@@ -17,7 +17,8 @@ and ``tries`` proposals with weights ``target / proposal`` (an ensemble of indep
 proposals, which keeps the target invariant). Any order of the boxes gives a consistent
 result, and drawing the order before the move keeps detailed balance.
 
-After each sweep (``n`` moves) every ordered pair adds its Rao-Blackwellised value: the
+A sweep is a pass over the pairs and ``moves`` re-insertions (the next boxes in turn); after
+each sweep every ordered pair adds its Rao-Blackwellised value: the
 probability of ``S_ij = 1`` given every other relation of the state, which is ``p_ij``
 when both values keep the world transitive and the current value when only one does.
 
@@ -596,8 +597,13 @@ def _run_chain(
     block_marginals: np.ndarray,
     block_pairs: np.ndarray,
     block_of: np.ndarray,
+    moves: int,
+    cursors: np.ndarray,
 ) -> int:
-    """Run ``sweeps`` sweeps of one chain; add the estimates when ``record``."""
+    """Run ``sweeps`` sweeps of one chain; add the estimates when ``record``.
+
+    A sweep re-inserts ``moves`` boxes, the next ones in turn from ``cursors[chain]`` (every
+    box when ``moves == n``)."""
     n = probabilities.shape[0]
     pair_sums = np.zeros(_STRIDE * _STRIDE)
     order = np.empty(n, dtype=np.int64)
@@ -609,7 +615,9 @@ def _run_chain(
     accepted = 0
     for _ in range(sweeps):
         _flip_pairs(probabilities, successors, predecessors, rng, chain)
-        for x in range(n):
+        for _ in range(moves):
+            x = cursors[chain]
+            cursors[chain] = (x + 1) % n
             if _reinsert(
                 x,
                 probabilities,
@@ -675,6 +683,8 @@ def run_chains(
     block_marginals: np.ndarray,
     block_pairs: np.ndarray,
     block_of: np.ndarray,
+    moves: int,
+    cursors: np.ndarray,
 ) -> None:
     """Advance every chain by ``sweeps`` sweeps (chains run in parallel).
 
@@ -686,7 +696,8 @@ def run_chains(
     the starting worlds of the chains);
     ``accepted``: ``(chains,)`` counts of moves that changed the state;
     ``block_*``: the blocks redrawn exactly after every sweep
-    (:class:`~unstack.reasoner.block_gibbs.BlockTables`; no blocks: zero rows).
+    (:class:`~unstack.reasoner.block_gibbs.BlockTables`; no blocks: zero rows);
+    a sweep re-inserts ``moves`` boxes, in turn from ``cursors`` (``(chains,)``, updated).
     """
     for c in prange(successors.shape[0]):
         accepted[c] += _run_chain(
@@ -711,4 +722,6 @@ def run_chains(
             block_marginals,
             block_pairs,
             block_of,
+            moves,
+            cursors,
         )

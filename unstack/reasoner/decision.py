@@ -482,9 +482,8 @@ def decide(
         Not reproducible (the sweeps that fit depend on the machine's load).
     samples : int, optional
         Recorded sweeps per sampled group (default
-        :data:`~unstack.reasoner.sampling.DEFAULT_SAMPLES`, or
-        :data:`~unstack.reasoner.sampling.WIDE_SAMPLES` for a group of more than 63 boxes, when
-        ``time_limit`` is not given either); reproducible for a ``seed``.
+        :func:`~unstack.reasoner.sampling.default_samples` of its size, when ``time_limit`` is
+        not given either); reproducible for a ``seed``.
     seed : int, optional
         Seed of the sampler and of the choice probability.
     cache : WorkCache, optional

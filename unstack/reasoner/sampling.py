@@ -17,7 +17,8 @@ marginals are estimated by Markov chain Monte Carlo over the consistent worlds t
   (a Gibbs pass over pairs): local moves that keep the chain moving where every
   re-insertion proposal is far less probable than the current world (dense matrices of
   20 boxes and more, where re-insertion alone stalled at an acceptance of 0);
-* after every sweep (one move per box) each pair contributes the probability of its
+* a sweep is one pair pass, :data:`MOVES` re-insertions (the next boxes in turn; every box
+  in a group of up to 8) and, after it, the record: each pair contributes the probability of its
   relation *given all the other relations*: the pair's own ``p`` whenever both values
   keep the world transitive, else the value transitivity leaves. This Rao-Blackwellisation
   removes the noise of the many pairs that transitivity does not touch (measured: it beats
@@ -61,10 +62,12 @@ __all__ = [
     "DEFAULT_CHAINS",
     "DEFAULT_SAMPLES",
     "DEFAULT_TRIES",
+    "MOVES",
     "RARE_SWEEPS",
     "WIDE_MOVES",
     "WIDE_SAMPLES",
     "SampledMarginals",
+    "default_samples",
     "restrict_worlds",
     "sample_worlds",
     "sampled_marginals",
@@ -72,9 +75,10 @@ __all__ = [
 
 #: Independent chains (they run on all cores).
 DEFAULT_CHAINS = 8
-#: Recorded sweeps (over all chains) when neither ``samples`` nor ``time_limit`` is given:
-#: reproducible for a seed. Measured on the 39- and 40-box classifier matrices of
-#: ``benchmarks/data`` (2 cores, both busy with other work): 0.98-1.07 s per group; 1024 and
+#: Recorded sweeps (over all chains) when neither ``samples`` nor ``time_limit`` is given and a
+#: sweep re-inserts every box: reproducible for a seed (:func:`default_samples` scales it for
+#: larger groups). When every sweep re-inserted every box, measured on the 39- and 40-box
+#: classifier matrices of ``benchmarks/data`` (2 cores, both busy with other work): 0.98-1.07 s per group; 1024 and
 #: 2048 sweeps took 0.34-0.37 s and 0.53-0.62 s (worst summed EC error 0.11 and 0.08 vs 0.06).
 DEFAULT_SAMPLES = 4096
 #: The default budget of a group of more than 63 boxes: its sweeps cost more (about 1 ms
@@ -87,11 +91,19 @@ WIDE_SAMPLES = 2048
 #: 0.0216 / 0.0275 with 1 / 2 / 3 proposals (worst 0.025 / 0.039 / 0.040); a second pass
 #: over the pairs per sweep made it worse (0.023).
 DEFAULT_TRIES = 1
-#: Re-insertions per sweep in a group of more than 63 boxes (the boxes in turn; a smaller
-#: group re-inserts every box every sweep). The pair pass, the block updates and the record
+#: Re-insertions per sweep in a group of more than 63 boxes (the boxes in turn; smaller groups
+#: re-insert :data:`MOVES`). The pair pass, the block updates and the record
 #: still cover every pair each sweep: on weakly linked groups they do most of the mixing,
 #: and 150 boxes sampled about 3 times faster for about the same error (benchmarks/wide_moves.py).
 WIDE_MOVES = 16
+#: Re-insertions per sweep in a group of up to 63 boxes (the next boxes in turn; every box when
+#: there are fewer). A sweep also runs the pair pass and records every pair, so fewer
+#: re-insertions mean more, cheaper, sweeps in the same time. Measured on 8 classifier piles of
+#: 37-40 boxes, 40 boxes in weakly linked groups and 24 dense boxes, 1 s per run, 3 seeds
+#: (``benchmarks/narrow_moves.py``; docs page "Benchmarks"): mean worst EC error 0.039 / 0.038
+#: / **0.029** / 0.037 on the piles with 64 (every box) / 16 / 8 / 4 re-insertions per sweep,
+#: 0.013 / 0.008 / 0.010 / 0.010 on the weak groups, 0.38 / 0.42 / 0.30 / 0.35 on dense boxes.
+MOVES = 8
 #: Below this expected number of sweeps with a relation across a block, its ECs' standard
 #: errors get the rare-event floor (:meth:`SampledMarginals.rare_event_floor`).
 RARE_SWEEPS = 30
@@ -225,6 +237,32 @@ def _rare_blocks(block_of: np.ndarray, link_rates: np.ndarray, samples: int) -> 
     ]
 
 
+def _moves(n: int) -> int:
+    """Re-insertions per sweep in a group of ``n`` boxes."""
+    return min(n, WIDE_MOVES if n > ONE_WORD_BOXES else MOVES)
+
+
+def default_samples(n: int) -> int:
+    """Recorded sweeps of a group of ``n`` boxes when no budget is given (reproducible).
+
+    :data:`DEFAULT_SAMPLES` when a sweep re-inserts every box (up to :data:`MOVES` boxes);
+    for larger groups up to 63 boxes, whose sweeps re-insert :data:`MOVES` boxes and so cost
+    less, ``DEFAULT_SAMPLES * min(3, ceil(n / MOVES))``: three times the sweeps took about
+    the time the former budget (4096 sweeps of every box) took on 37-40-box classifier piles
+    and 1.2-2 times on 40 boxes in weakly linked groups, with smaller errors on both
+    (``benchmarks/narrow_moves.py --sweeps``; docs page "Benchmarks"). More than 63 boxes:
+    :data:`WIDE_SAMPLES`.
+
+    Examples
+    --------
+    >>> default_samples(5), default_samples(12), default_samples(40), default_samples(150)
+    (4096, 8192, 12288, 2048)
+    """
+    if n > ONE_WORD_BOXES:
+        return WIDE_SAMPLES
+    return DEFAULT_SAMPLES * min(3, -(-n // _moves(n)))
+
+
 def _start_state(probabilities: np.ndarray, *, wide: bool) -> tuple[np.ndarray, np.ndarray]:
     """Bit masks of the transitive closure of the relations forced by probability 1."""
     n = probabilities.shape[0]
@@ -323,7 +361,7 @@ class _Chains:
         self.sums = np.zeros((chains, n, n))
         self.blocks = block_tables(probabilities, strong_blocks(probabilities) if blocks else [])
         self.linear_weights = np.exp(self.blocks.log_weights)
-        self.moves = min(n, WIDE_MOVES) if n > ONE_WORD_BOXES else n
+        self.moves = _moves(n)
         self.cursors = np.zeros(chains, dtype=np.int64)
         self.moves_done = 0
         if start is None:
@@ -336,17 +374,15 @@ class _Chains:
     def advance(self, sweeps: int, *, record: bool = False, scatter: bool = False) -> None:
         """Run every chain ``sweeps`` sweeps; with ``record`` the conditionals go to ``sums``.
 
-        A sweep re-inserts every box, or :data:`WIDE_MOVES` of them in turn in a group of more
-        than 63 boxes (the scattering sweep re-inserts every box).
+        A sweep re-inserts :data:`MOVES` boxes in turn, :data:`WIDE_MOVES` in a group of more
+        than 63 boxes, every box in a smaller group (the scattering sweep re-inserts every box).
         """
         moves = self.probabilities.shape[0] if scatter else self.moves
         self.moves_done += len(self.rng) * sweeps * moves
         blocks = self.blocks
         weights: tuple[np.ndarray, ...] = (blocks.log_weights,)
-        extra: tuple[Any, ...] = ()
         if self.wide:
             weights = (blocks.log_weights, self.linear_weights)
-            extra = (moves, self.cursors)
         with PARALLEL_KERNELS:
             self._run(
                 self.probabilities,
@@ -369,7 +405,8 @@ class _Chains:
                 blocks.marginals,
                 blocks.pairs,
                 blocks.block_of,
-                *extra,
+                moves,
+                self.cursors,
             )
 
 
@@ -394,8 +431,7 @@ def sampled_marginals(
         first with :func:`~unstack.reasoner.pruning.propagate_evidence`).
     samples : int, optional
         Recorded sweeps over all chains; the run is reproducible for a given ``seed``.
-        Neither this nor ``time_limit``: :data:`DEFAULT_SAMPLES` (:data:`WIDE_SAMPLES` for more
-        than 63 boxes).
+        Neither this nor ``time_limit``: :func:`default_samples` of the group's size.
     time_limit : float, optional
         Seconds of sampling (burn-in included); not reproducible. With ``samples`` too,
         whichever comes first.
@@ -475,7 +511,7 @@ def _sampled_marginals(
     start = time.perf_counter() if start is None else start
     n = p.shape[0]
     if samples is None and time_limit is None:
-        samples = DEFAULT_SAMPLES if n <= ONE_WORD_BOXES else WIDE_SAMPLES
+        samples = default_samples(n)
     deadline = None if time_limit is None else start + time_limit
     per_chain = None if samples is None else -(-samples // chains)
     state = _Chains(p, chains=chains, seed=seed, burn_in=burn_in, tries=tries, blocks=blocks, start=warm, wide=wide)
