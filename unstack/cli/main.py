@@ -269,7 +269,7 @@ def plan(file: str, as_json: bool, output: str | None, model: str | None, **reas
     """Order all detected boxes by repeated decisions: pick, remove from the set, decide again.
 
     With sampling, the budget (--samples or --time-limit) applies to each step; without one
-    each step samples 1024 sweeps per group, starting from the previous step's chains, so a
+    each step samples 2048 sweeps per group, starting from the previous step's chains, so a
     seed reproduces the plan. A progress bar on a terminal counts the steps.
     """
     import unstack

@@ -36,8 +36,10 @@ PLAN_FORMAT = "unstack.plan/1"
 #: Largest group a plan's step counts exactly with ``auto`` (8 boxes take 2.6-4 s a step).
 PLAN_EXACT_MAX_BOXES = 7
 #: Recorded sweeps per sampled group and step when neither ``samples`` nor ``time_limit``
-#: is given (the chains start warm from the previous step).
-PLAN_SAMPLES = 1024
+#: is given (the chains start warm from the previous step). 2048 since a sweep re-inserts
+#: :data:`~unstack.reasoner.sampling.MOVES` boxes (it was 1024 sweeps of every box): about
+#: the same time per plan, and no larger standard errors (docs page "Benchmarks", "Plans").
+PLAN_SAMPLES = 2048
 
 
 @dataclass(frozen=True)
