@@ -14,6 +14,7 @@ from unstack.cli.main import MODEL_HELP, finite_seconds
 from unstack.cli.progress import progress_bar
 from unstack.errors import UnstackError
 from unstack.experiments.container import CONTAINER_MAKERS, CONTAINER_SAMPLES
+from unstack.experiments.unloading import UNLOAD_SAMPLES
 from unstack.learning.choices import LEARNERS, SPLITS
 from unstack.learning.features import FEATURE_SETS
 from unstack.learning.training_data import ISET_DRAWS
@@ -278,7 +279,7 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
 @click.option("--out", required=True, type=click.Path(), help="Folder for unloading.json and unloading.png.")
 @click.option("--model", "model_path", default=None, help=MODEL_HELP)
 @click.option("--configs", type=click.IntRange(min=1), default=4, show_default=True, help="Piles (the first N).")
-@click.option("--samples", type=click.IntRange(min=1), default=1024, show_default=True,
+@click.option("--samples", type=click.IntRange(min=1), default=UNLOAD_SAMPLES, show_default=True,
               help="Recorded sweeps per sampled group in each decision (reproducible with the seed).")  # fmt: skip
 @click.option("--time-limit", type=float, default=None, callback=finite_seconds,
               help="Seconds per decision instead of --samples (not reproducible).")  # fmt: skip

@@ -57,8 +57,10 @@ __all__ = [
 
 UNLOADING_MAKERS = ("reasoner", "priors", "highest", "free", "random")
 #: Recorded sweeps per sampled group in each decision of the experiment (a 40-box group:
-#: about 0.35 s on 2 busy cores, the experiment's former 0.3 s time limit).
-UNLOAD_SAMPLES = 1024
+#: about 0.35 s on 2 busy cores, the experiment's former 0.3 s time limit, with 1024 sweeps of
+#: every box; 3 times the sweeps since a sweep re-inserts
+#: :data:`~unstack.reasoner.sampling.MOVES` boxes, as the default budget).
+UNLOAD_SAMPLES = 3072
 #: ``(samples, time_limit)`` of every decision.
 Budget = tuple[int | None, float | None]
 #: The makers that sense the pile again before each pick (``closed_loop=True``; the others
