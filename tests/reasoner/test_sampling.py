@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from unstack.errors import UnstackError
+from unstack.reasoner import sampling
 from unstack.reasoner.marginals import exact_marginals
 from unstack.reasoner.pruning import propagate_evidence
 from unstack.reasoner.sampling import sample_worlds, sampled_marginals
@@ -52,6 +53,22 @@ def test_marginals_agree_with_the_exact_engine(rng: np.random.Generator, n: int,
     assert np.all(np.abs(result.marginals - exact)[off] <= 5 * result.standard_errors[off] + 2e-3)
     costs, covariance = result.errors_of(np.ones(n))
     assert np.all(np.abs(costs - exact.sum(axis=1)) <= 5 * np.sqrt(np.diag(covariance)) + 2e-3)
+
+
+@pytest.mark.parametrize("moves", [1, 2])
+def test_sweeps_of_a_few_re_insertions_in_turn_agree_with_the_exact_engine(
+    rng: np.random.Generator, moves: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Groups of more than ``MOVES`` boxes re-insert only the next ``MOVES`` boxes per sweep."""
+    monkeypatch.setattr(sampling, "MOVES", moves)
+    p = random_probabilities(rng, 6, "dense")
+    exact = exact_marginals(p).marginals
+    result = sampled_marginals(p, samples=16_000, seed=1, blocks=False)
+    assert result.samples == 16_000
+    costs, covariance = result.errors_of(np.ones(6))
+    assert np.all(np.abs(costs - exact.sum(axis=1)) <= 5 * np.sqrt(np.diag(covariance)) + 2e-3)
+    off = ~np.eye(6, dtype=bool)
+    assert np.all(np.abs(result.marginals - exact)[off] <= 5 * result.standard_errors[off] + 2e-3)
 
 
 def test_independent_components_up_to_forty_boxes(rng: np.random.Generator) -> None:
