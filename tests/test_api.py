@@ -62,6 +62,21 @@ def test_wrong_arguments_are_invalid_arguments(examples: Path) -> None:
         unstack.load_model(3)  # type: ignore[arg-type]
     with pytest.raises(InvalidArgument, match="model must be a model name, a model file path or a SupportModel"):
         unstack.decide(unstack.load_scene(examples / "pile5.scene.json"), model=3.0)  # type: ignore[arg-type]
+    with pytest.raises(InvalidArgument, match=r"pile5\.supports\.json: statics adjusts the probabilities a model"):
+        unstack.decide(supports, statics=False)
+    with pytest.raises(InvalidArgument, match="statics must be True or False, got 'no'"):
+        unstack.support_probabilities(unstack.load_scene(examples / "scene3.json"), statics="no")  # type: ignore[arg-type]
+
+
+def test_statics_raises_the_box_leant_on_and_can_be_turned_off(examples: Path) -> None:
+    scene = unstack.load_scene(examples / "leaning.scene.json")
+    raised, kept = unstack.support_probabilities(scene), unstack.support_probabilities(scene, statics=False)
+    upright, lean = raised.objects.index("upright"), raised.objects.index("lean")
+    assert raised.probabilities[upright, lean] == 0.65 > kept.probabilities[upright, lean]
+    changed = raised.probabilities != kept.probabilities
+    assert changed.sum() == 1 and changed[upright, lean]
+    order = unstack.plan(scene, seed=0).order
+    assert order.index("lean") < order.index("upright")  # the leaning box comes off first
 
 
 @pytest.mark.slow

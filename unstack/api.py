@@ -177,7 +177,7 @@ def _model(model: Any) -> SupportModel:
     return loaded
 
 
-def support_probabilities(scene: Scene, model: ModelArgument = None) -> Supports:
+def support_probabilities(scene: Scene, model: ModelArgument = None, *, statics: bool = True) -> Supports:
     """``P(SUPP(X, Y))`` for every ordered pair of a scene's detected boxes, from a model.
 
     Parameters
@@ -187,6 +187,10 @@ def support_probabilities(scene: Scene, model: ModelArgument = None) -> Supports
     model : str, path-like or SupportModel, optional
         A shipped model's name, a model file, or a loaded model; ``None``: the default
         model (loaded once per process).
+    statics : bool
+        Raise the probability that a box holds up a box leaning on it, where statics says
+        the leaning box cannot stand on its base (:mod:`unstack.statics`; each raise is a
+        warning); ``False``: the model's probabilities alone.
 
     Returns
     -------
@@ -210,20 +214,27 @@ def support_probabilities(scene: Scene, model: ModelArgument = None) -> Supports
         raise InvalidArgument(f"expected a Scene, got {type(scene).__name__}")
     from unstack.learning.probabilities import scene_support_probabilities
 
+    if not isinstance(statics, bool):
+        raise InvalidArgument(f"statics must be True or False, got {statics!r}")
     loaded = _model(model)
-    return scene_support_probabilities(scene, loaded, model_name=model_label(loaded))
+    return scene_support_probabilities(scene, loaded, model_name=model_label(loaded), statics=statics)
 
 
-def _supports(scene_or_supports: Any, model: Any) -> Supports:
+def _supports(scene_or_supports: Any, model: Any, statics: bool = True) -> Supports:
     if isinstance(scene_or_supports, Supports):
         if model is not None:
             raise InvalidArgument(
                 f"{scene_or_supports.source}: a model turns a scene into support probabilities; these are "
                 "support probabilities already, so the model would be ignored (pass no model)"
             )
+        if statics is not True:
+            raise InvalidArgument(
+                f"{scene_or_supports.source}: statics adjusts the probabilities a model gives a scene; these are "
+                "support probabilities already, so statics=False would be ignored"
+            )
         return scene_or_supports
     if isinstance(scene_or_supports, Scene):
-        return support_probabilities(scene_or_supports, model)
+        return support_probabilities(scene_or_supports, model, statics=statics)
     raise InvalidArgument(f"expected a Scene or Supports, got {type(scene_or_supports).__name__}")
 
 
@@ -237,6 +248,7 @@ def decide(
     samples: int | None = None,
     time_limit: float | None = None,
     near_tie_margin: float | None = None,
+    statics: bool = True,
 ) -> Decision:
     """Which box to unload first: from a scene (through a model) or from support probabilities.
 
@@ -265,6 +277,9 @@ def decide(
         (:data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`) for a scene (and for supports
         that carry heights), Eq. 13's minimum for supports without heights; 0 keeps Eq. 13
         exactly.
+    statics : bool
+        For a scene: raise the probability that a box holds up a box leaning on it
+        (:func:`support_probabilities`); ``False`` keeps the model's probabilities.
 
     Returns
     -------
@@ -290,7 +305,7 @@ def decide(
     """
     from unstack.reasoner.decision import decide as decide_supports
 
-    supports = _supports(scene_or_supports, model)
+    supports = _supports(scene_or_supports, model, statics)
     return decide_supports(
         supports,
         method=method,
@@ -313,6 +328,7 @@ def plan(
     time_limit: float | None = None,
     progress: Callable[[int, int], None] | None = None,
     near_tie_margin: float | None = None,
+    statics: bool = True,
 ) -> Plan:
     """An unloading order: decide, take the chosen box out, decide again on the rest.
 
@@ -320,7 +336,7 @@ def plan(
     ----------
     scene_or_supports : Scene or Supports
         A scene gets its probabilities from ``model`` once, before the first step.
-    model, method, cost, seed, samples, time_limit, near_tie_margin
+    model, method, cost, seed, samples, time_limit, near_tie_margin, statics
         As in :func:`decide` (the budget applies to each step; without one each step
         samples :data:`~unstack.reasoner.plan.PLAN_SAMPLES` sweeps per group, from where
         the previous step's chains ended).
@@ -346,7 +362,7 @@ def plan(
     """
     from unstack.reasoner.plan import unloading_plan
 
-    supports = _supports(scene_or_supports, model)
+    supports = _supports(scene_or_supports, model, statics)
     return unloading_plan(
         supports,
         method=method,

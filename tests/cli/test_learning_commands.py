@@ -131,3 +131,34 @@ def test_an_empty_point_cloud_is_a_one_line_warning(tmp_path: Path) -> None:
         f"unstack: warning: {scene}: the point cloud is empty; undetected load and cloud features cannot be seen\n"
     )
     assert json.loads(result.stdout)["format"] == "unstack.supports/1"
+
+
+LEANING = "examples/leaning.scene.json"
+
+
+def test_a_box_leant_on_gets_its_support_from_statics_with_a_warning() -> None:
+    result = unstack("decide", LEANING, "--json")
+    assert result.returncode == 0, result.stderr
+    decision = json.loads(result.stdout)
+    costs = dict(zip(decision["objects"], decision["expected_costs"], strict=True))
+    assert decision["choice"] == "free" and costs["upright"] > 0.6
+    assert "without 'upright' (its centre of mass lies" in result.stderr
+    assert any("P(upright supports lean) raised from" in warning for warning in decision["warnings"])
+
+
+def test_no_statics_keeps_the_models_probabilities(tmp_path: Path) -> None:
+    with_statics = unstack("probabilities", LEANING, "-o", str(tmp_path / "with.json"))
+    without = unstack("probabilities", LEANING, "--no-statics", "-o", str(tmp_path / "without.json"))
+    assert with_statics.returncode == without.returncode == 0, without.stderr
+    raised = json.loads((tmp_path / "with.json").read_text())
+    kept = json.loads((tmp_path / "without.json").read_text())
+    upright, lean = (raised["objects"].index(name) for name in ("upright", "lean"))
+    assert raised["probabilities"][upright][lean] == 0.65 > kept["probabilities"][upright][lean]
+    assert raised["metadata"]["leaning"][0]["supporter"] == "upright" and kept["metadata"]["leaning"] == []
+    assert without.stderr == ""
+
+
+def test_no_statics_on_a_supports_file_is_one_line() -> None:
+    result = unstack("decide", "examples/pile5.supports.json", "--no-statics")
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert "--no-statics applies to a scene file" in result.stderr

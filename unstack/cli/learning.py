@@ -10,7 +10,7 @@ from rich.console import Console, Group
 from rich.table import Table
 from rich.text import Text
 
-from unstack.cli.main import MODEL_HELP
+from unstack.cli.main import MODEL_HELP, STATICS_HELP
 from unstack.errors import UnstackError
 from unstack.learning.choices import LEARNERS, SPLITS
 from unstack.learning.features import FEATURE_SETS
@@ -27,11 +27,11 @@ def load_support_model(path: str | None) -> tuple[Any, str]:
     return load_model_option(path)
 
 
-def scene_supports(scene: Any, model_path: str | None) -> Any:
+def scene_supports(scene: Any, model_path: str | None, statics: bool = True) -> Any:
     """Support probabilities of a scene's detected boxes (:func:`unstack.support_probabilities`)."""
     from unstack.api import support_probabilities
 
-    return support_probabilities(scene, model_path)
+    return support_probabilities(scene, model_path, statics=statics)
 
 
 def metrics_view(report: dict[str, Any], title: str) -> Group:
@@ -254,12 +254,13 @@ def evaluate(
 @click.argument("scene_file", type=str)
 @click.option("--model", "model_path", default=None, help=MODEL_HELP)
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None, help="Write the JSON here (atomically).")
-def probabilities(scene_file: str, model_path: str | None, output: str | None) -> None:
+@click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)
+def probabilities(scene_file: str, model_path: str | None, output: str | None, statics: bool) -> None:
     """Support probabilities of a scene's detected boxes, as unstack.supports/1 JSON."""
     from unstack.atomic import atomic_write_text
     from unstack.scene import load_scene
 
-    supports = scene_supports(load_scene(scene_file), model_path)
+    supports = scene_supports(load_scene(scene_file), model_path, statics)
     for line in supports.metadata.get("warnings", []):
         click.echo(f"unstack: warning: {line}", err=True)
     text = json.dumps(supports.to_dict(), indent=2) + "\n"

@@ -31,6 +31,10 @@ MODEL_HELP = (
     "Model file, or a shipped model: general (the default: pose features, five pile families), paper (the "
     "paper's SVM, for the reproduction) or extended (the paper's piles with contact features)."
 )
+STATICS_HELP = (
+    "For a scene: a box that cannot stand on its base and leans on another makes that one its supporter "
+    "(P raised to at least 0.65, with a warning); --no-statics keeps the model's probabilities."
+)
 
 #: Commands whose modules load only when they run (their imports are heavy).
 LAZY_COMMANDS = {
@@ -101,15 +105,17 @@ def _emit(as_json: bool, document: dict[str, Any], render: Callable[[], Any]) ->
         Console(highlight=False).print(render())
 
 
-def _load_input(path: str, model: str | None) -> Any:
-    """A scene or supports file; ``--model`` only means something for a scene."""
+def _load_input(path: str, model: str | None, statics: bool = True) -> Any:
+    """A scene or supports file; ``--model`` and ``--no-statics`` only mean something for a scene."""
     import unstack
 
     loaded = unstack.load(path)
-    if model is not None and isinstance(loaded, unstack.Supports):
-        raise UnstackError(
-            f"{loaded.source}: --model applies to a scene file; this file holds support probabilities already"
-        )
+    if isinstance(loaded, unstack.Supports):
+        for given, option in ((model is not None, "--model"), (not statics, "--no-statics")):
+            if given:
+                raise UnstackError(
+                    f"{loaded.source}: {option} applies to a scene file; this file holds support probabilities already"
+                )
     return loaded
 
 
@@ -205,6 +211,7 @@ def cli() -> None:
 @click.option("--timing", is_flag=True, help="Add wall-clock seconds to the JSON (it is canonical without them).")
 @_reasoning_options
 @click.option("--model", "model", default=None, help=MODEL_HELP)
+@click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)
 def decide(file: str, as_json: bool, output: str | None, timing: bool, model: str | None, **reasoning: Any) -> None:
     """Print which box to unload first, the expected cost of every box and P(support | consistent).
 
@@ -216,7 +223,7 @@ def decide(file: str, as_json: bool, output: str | None, timing: bool, model: st
     import unstack
 
     _check_output(output)
-    decision = unstack.decide(_load_input(file, model), model=model, **reasoning)
+    decision = unstack.decide(_load_input(file, model, reasoning["statics"]), model=model, **reasoning)
     document = decision.to_dict(timing=timing)
     _write_output(output, document)
     _print_warnings(decision.warnings)
@@ -265,6 +272,7 @@ def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str, 
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON plan to this file.")
 @_reasoning_options
 @click.option("--model", "model", default=None, help=MODEL_HELP)
+@click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)
 def plan(file: str, as_json: bool, output: str | None, model: str | None, **reasoning: Any) -> None:
     """Order all detected boxes by repeated decisions: pick, remove from the set, decide again.
 
@@ -276,7 +284,7 @@ def plan(file: str, as_json: bool, output: str | None, model: str | None, **reas
     from unstack.cli.progress import progress_bar
 
     _check_output(output)
-    supports = _load_input(file, model)
+    supports = _load_input(file, model, reasoning["statics"])
     with progress_bar("planning: steps") as report:
         result = unstack.plan(supports, model=model, progress=report, **reasoning)
     document = result.to_dict()

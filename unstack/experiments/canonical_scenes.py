@@ -223,19 +223,35 @@ def _tall_alone(builder: _Builder, in_container: bool) -> CanonicalCase:
     return builder.case("tall_alone", in_container=in_container)
 
 
+def _reach_below(section: np.ndarray, height: float) -> float:
+    """The largest x of a convex xz section (its corners) at heights up to ``height``."""
+    from unstack.geometry import convex_hull_2d
+
+    hull = convex_hull_2d(section)
+    reach = [float(x) for x, z in hull if z <= height]
+    for (x0, z0), (x1, z1) in zip(hull, np.roll(hull, -1, axis=0), strict=True):
+        if (z0 - height) * (z1 - height) < 0:  # the edge crosses the height
+            reach.append(float(x0 + (x1 - x0) * (height - z0) / (z1 - z0)))
+    return max(reach)
+
+
 def _leaning(builder: _Builder, in_container: bool) -> CanonicalCase:
     wall_size = np.array([0.4, 0.5, float(builder.rng.uniform(0.5, 0.7))])
     builder.place("upright", wall_size, ORIGIN_X + 0.3, 0.0)
     lean = np.array([0.15, 0.4, float(builder.rng.uniform(0.5, 0.7))])
-    angle = np.radians(float(builder.rng.uniform(15.0, 25.0)))
+    # Tipped past its corner's angle (by 4 degrees at least), or it would right itself.
+    corner = np.degrees(np.arctan2(lean[0], lean[2]))
+    angle = np.radians(max(float(builder.rng.uniform(15.0, 25.0)), corner + 4.0))
     # Rotated about y so that its top tips towards +x onto the upright box's front face.
     quaternion = [0.0, float(np.sin(angle / 2)), 0.0, float(np.cos(angle / 2))]
-    probe = Box("lean", lean, [0.0, 0.0, 0.0], quaternion)
     from unstack.geometry import box_corners
 
-    corners = box_corners(probe)
+    corners = box_corners(Box("lean", lean, [0.0, 0.0, 0.0], quaternion))
+    lift = -float(corners[:, 2].min()) + 0.001  # its lowest edge on the floor
     front_face = ORIGIN_X + 0.3 - wall_size[0] / 2
-    position = [front_face - float(corners[:, 0].max()) - 0.002, 0.0, -float(corners[:, 2].min()) + 0.001]
+    # It touches the upright box's front face, or that face's top edge when it is the taller.
+    reach = _reach_below(corners[:, [0, 2]] + [0.0, lift], builder.tops["upright"])
+    position = [front_face - reach - 0.002, 0.0, lift]
     builder.boxes["lean"] = Box("lean", lean, position, quaternion)
     builder.tops["lean"] = position[2] + float(corners[:, 2].max())
     builder.rests_on["lean"] = ["upright"]

@@ -55,7 +55,12 @@ def _out_of_distribution(
 
 
 def scene_support_probabilities(
-    scene: Scene, model: SupportModel, *, model_name: str = "", boxes: Sequence[str] | None = None
+    scene: Scene,
+    model: SupportModel,
+    *,
+    model_name: str = "",
+    boxes: Sequence[str] | None = None,
+    statics: bool = True,
 ) -> Supports:
     """``P(SUPP(X, Y))`` for every ordered pair of the scene's detected boxes.
 
@@ -68,6 +73,10 @@ def scene_support_probabilities(
         Recorded in the metadata (for example the model file's path).
     boxes : sequence of str, optional
         Box ids to use instead of the scene's detected boxes (an ISet drawn from them).
+    statics : bool
+        Raise ``P(X supports Y)`` where ``Y`` cannot stand on its base and leans on ``X``
+        (:mod:`unstack.statics`; each raise is a warning and is listed in
+        ``metadata["leaning"]``); ``False``: the model's probabilities alone.
 
     Returns
     -------
@@ -94,6 +103,17 @@ def scene_support_probabilities(
         doubts += _out_of_distribution(
             scene.source, model, features, [(objects[i], objects[j]) for i, j in zip(rows, columns, strict=True)]
         )
+    leaning: list[dict[str, object]] = []
+    if statics and n > 1:
+        from unstack.statics import leaning_supports, raise_leaning_supports
+
+        found = leaning_supports(scene, objects)
+        probabilities, raised = raise_leaning_supports(probabilities, objects, found)
+        doubts += [f"{scene.source}: {sentence}" for sentence in raised]
+        leaning = [
+            {"leaning": f.leaning, "supporter": f.supporter, "overhang_m": round(f.overhang, 4), "on_floor": f.on_floor}
+            for f in found
+        ]
     from unstack.hidden_load import hidden_load
 
     masses = [scene.boxes[k].mass for k in detected]
@@ -104,6 +124,8 @@ def scene_support_probabilities(
         "features": model.features.to_dict(),
         "clipped_to": [PROBABILITY_FLOOR, 1.0 - PROBABILITY_FLOOR],
         "warnings": doubts,
+        "statics": statics,
+        "leaning": leaning,
     }
     return Supports(
         objects,
