@@ -125,11 +125,27 @@ def test_every_leaning_scene_of_the_suite_is_found_on_both_clouds(seed: int) -> 
         assert [(f.supporter, f.leaning) for f in found] == [("upright", "lean")]
 
 
-@pytest.mark.parametrize("kind", [kind for kind in CANONICAL_KINDS if kind != "leaning"])
-def test_no_other_kind_of_the_suite_leans(kind: str) -> None:
+@pytest.mark.parametrize("kind", list(CANONICAL_KINDS))
+def test_every_finding_on_the_suite_is_a_box_the_other_rests_on(kind: str) -> None:
     for seed in range(3):
         case = build_case(kind, seed=seed)
-        assert leaning_supports(canonical_scene(case, cloud="surface", seed=seed)) == [], seed
+        for finding in leaning_supports(canonical_scene(case, cloud="surface", seed=seed)):
+            assert finding.supporter in case.rests_on[finding.leaning], (seed, finding)
+
+
+def test_a_box_across_a_gap_is_held_by_both_boxes_under_it() -> None:
+    case = build_case("pyramid", seed=0)
+    found = {(f.supporter, f.leaning) for f in leaning_supports(canonical_scene(case, cloud="surface", seed=0))}
+    across = {(under, name) for name, unders in case.rests_on.items() if len(unders) == 2 for under in unders}
+    assert across and across <= found
+
+
+@pytest.mark.parametrize(("kind", "seed"), [("plain_stack", 4), ("plain_stack", 18), ("in_front_of_column", 8)])
+def test_a_box_on_one_box_alone_is_left_to_the_model(kind: str, seed: int) -> None:
+    """Scenes whose noisy surface cloud has a few points under a stacked box: they do not make
+    the box under it "necessary" (on simulated piles such raises were mostly wrong)."""
+    case = build_case(kind, seed=seed)
+    assert leaning_supports(canonical_scene(case, cloud="surface", seed=seed)) == []
 
 
 @settings(max_examples=25, deadline=None)

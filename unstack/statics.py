@@ -1,25 +1,27 @@
-"""Boxes that cannot stand on what is under them: a leaning box is held by what it leans on.
+"""Boxes that cannot stand on what is under them without another: statics finds supporters.
 
 A learned model reads support from the geometry of a pair of boxes; the piles it was trained
 on rarely hold a lone box standing on its edge and leaning on another, and it calls the box
-leant on nearly free (the generalisation page of the docs). Statics settles that case
-without a model. For each detected box ``Y`` tilted by at least :data:`MIN_TILT_DEG`:
+leant on nearly free (the generalisation page of the docs). Statics settles such cases
+without a model. For each detected box ``Y``:
 
 * its *base* is where something holds it from below: the points of its surface within
   :data:`CONTACT_GAP` of the floor, the points where a detected box touches it with a
   push that is mostly upward (within 45 degrees of vertical), and the points of the cloud
-  just under its downward faces (an undetected box under it shows there);
-* when its centre of mass (the box's centre) lies more than :data:`MIN_OVERHANG` outside
-  the convex hull of its base seen from above, it would tip over that edge of the hull;
-* a detected box ``X`` that touches ``Y`` at least :data:`MIN_RISE` above its lowest point,
-  beyond that edge, and pushes it back (its push has a horizontal part of at least
-  :data:`MIN_PUSH` against the overhang and does not press ``Y`` down) holds ``Y`` up;
-* when ``Y`` stands, a detected box in its base without whose contacts it would tip (the
-  centre more than :data:`MIN_OVERHANG` outside the rest of the base, and that box's contacts
-  beyond its edge) holds ``Y`` up too: a box on its edge whose top rests on another's top
-  edge, a plank from one box to another;
+  just under its downward faces that lie on no detected box (an undetected box under it);
+* a box tilted by at least :data:`MIN_TILT_DEG` whose centre of mass (the box's centre) lies
+  more than :data:`MIN_OVERHANG` outside the convex hull of its base seen from above would
+  tip over that edge: a detected box ``X`` that touches it at least :data:`MIN_RISE` above
+  its lowest point, beyond that edge, and pushes it back (its push has a horizontal part of
+  at least :data:`MIN_PUSH` against the overhang and does not press ``Y`` down) holds it up
+  -- the box it leans on;
+* a box that stands, tilted or not, is held up by a detected box of its base without whose
+  contacts it would tip (the centre more than :data:`MIN_OVERHANG` outside the rest of the
+  base, that box's contacts beyond its edge): a box across a gap between two, a box on its
+  edge whose top rests on another's top edge, a plank from one box to another;
 * for each box that holds ``Y`` up, ``P(X supports Y)`` is raised to at least
-  :data:`LEAN_SUPPORT_PROBABILITY`, never lowered.
+  :data:`LEAN_SUPPORT_PROBABILITY`, never lowered. A box that rests on one box alone is not
+  raised: on simulated piles the model's low probabilities there were mostly right.
 
 Contacts are found on a grid of points over ``Y``'s faces: a point touches ``X`` when it
 lies within :data:`CONTACT_GAP` of ``X`` and within :data:`CONTACT_BAND` of the closest
@@ -118,9 +120,10 @@ class Leaning:
         )
 
 
-def _face_samples(box: Box) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Points on a grid over the box's six faces, their outward normals, which local bounds
-    each point lies on (boolean, shape (m, 3)), and the box's rotation."""
+def _face_samples(box: Box, *, downward_only: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Points on a grid over the box's six faces (``downward_only``: the faces whose outward
+    normal points down, all a box standing on a face rests on), their outward normals, which
+    local bounds each point lies on (boolean, shape (m, 3)), and the box's rotation."""
     rotation = rotation_matrix(box.orientation_xyzw)
     half = box.size / 2.0
     local: list[np.ndarray] = []
@@ -133,6 +136,8 @@ def _face_samples(box: Box) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndar
         ]
         a, b = np.meshgrid(*grids, indexing="ij")
         for sign in (-1.0, 1.0):
+            if downward_only and sign * rotation[2, axis] > -UPWARD:
+                continue
             face = np.zeros((a.size, 3))
             face[:, first], face[:, second], face[:, axis] = a.ravel(), b.ravel(), sign * half[axis]
             normal = np.zeros(3)
@@ -209,11 +214,16 @@ def _near(bounds: np.ndarray, row: int, margin: float) -> np.ndarray:
     return near
 
 
-def _cloud_under(points: np.ndarray, box: Box, bound: np.ndarray) -> np.ndarray:
+def _cloud_under(points: np.ndarray, box: Box, bound: np.ndarray, others: Sequence[Box]) -> np.ndarray:
     """Points of the cloud just under the box's downward faces, away from its edges (its own
-    visible faces, noisy near the edges, are not taken for something under it)."""
+    visible faces, noisy near the edges, are not taken for something under it), and not on
+    a detected box (whose contacts count already)."""
     low, high = bound[:3] - CONTACT_GAP, bound[3:] + CONTACT_GAP
     candidates = points[np.all((points >= low) & (points <= high), axis=1)]
+    for other in others:
+        if len(candidates) == 0:
+            break
+        candidates = candidates[_distances(candidates, other)[0] > CONTACT_BAND]
     if len(candidates) == 0:
         return candidates[:, :2]
     distance, normals, _, rotation = _distances(candidates, box)
@@ -246,9 +256,8 @@ def leaning_supports(scene: Scene, objects: Sequence[str] | None = None) -> list
     bounds = bounding_boxes(boxes) if boxes else np.zeros((0, 6))
     found: list[Leaning] = []
     for row, box in enumerate(boxes):
-        if tilt_deg(box) < MIN_TILT_DEG:
-            continue
-        samples, normals, on_bounds, rotation = _face_samples(box)
+        tilted = tilt_deg(box) >= MIN_TILT_DEG
+        samples, normals, on_bounds, rotation = _face_samples(box, downward_only=not tilted)
         base: dict[int, np.ndarray] = {_FLOOR: samples[samples[:, 2] <= CONTACT_GAP, :2]}
         beside: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         for other in np.flatnonzero(_near(bounds, row, CONTACT_GAP)).tolist():
@@ -267,9 +276,10 @@ def leaning_supports(scene: Scene, objects: Sequence[str] | None = None) -> list
             side = np.abs(pushes[:, 2]) < UPWARD
             if np.any(side):
                 beside[other] = (samples[touching][side], pushes[side])
-        base[_CLOUD] = _cloud_under(scene.points, box, bounds[row])
+        touched = [boxes[key] for key in base if key >= 0]
+        base[_CLOUD] = _cloud_under(scene.points, box, bounds[row], touched)
         lowest = float(samples[:, 2].min())
-        tipping = _tipping(box, base, exclude=None)
+        tipping = _tipping(box, base, exclude=None) if tilted else None
         if tipping is not None:  # it cannot stand on its base: what it leans on holds it
             overhang, edge, direction, on_floor = tipping
             for supporter, (contacts, pushes) in beside.items():
@@ -284,6 +294,8 @@ def leaning_supports(scene: Scene, objects: Sequence[str] | None = None) -> list
             continue
         for supporter in (key for key, part in base.items() if key >= 0 and len(part)):
             # it stands, but would it without this box? (a box on its edge resting on another's top edge)
+            if not any(len(part) for key, part in base.items() if key not in (supporter, _CLOUD)):
+                continue  # it rests on this box alone (as far as anyone knows): left to the model
             without = _tipping(box, base, exclude=supporter)
             if without is None:
                 continue

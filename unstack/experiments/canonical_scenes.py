@@ -54,6 +54,8 @@ class CanonicalCase:
         Whether the scene stands in a container section (walls, ceiling) or in the open.
     hidden_load : tuple of str
         Detected boxes whose only load is undetected (only the cloud shows it).
+    rests_on : dict of str to tuple of str
+        The boxes each box rests on directly (the floor: none).
     """
 
     kind: str
@@ -64,6 +66,7 @@ class CanonicalCase:
     load: dict[str, float] = field(default_factory=dict)
     in_container: bool = True
     hidden_load: tuple[str, ...] = ()
+    rests_on: dict[str, tuple[str, ...]] = field(default_factory=dict)
 
 
 def _yaw(degrees: float) -> list[float]:
@@ -131,6 +134,7 @@ class _Builder:
             load={name: self.carried(name) for name in holds},
             in_container=in_container,
             hidden_load=hidden,
+            rests_on={name: tuple(under) for name, under in self.rests_on.items()},
         )
 
 
