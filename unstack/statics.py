@@ -217,9 +217,10 @@ def _near(bounds: np.ndarray, row: int, margin: float) -> np.ndarray:
 def _cloud_under(points: np.ndarray, box: Box, bound: np.ndarray, others: Sequence[Box]) -> np.ndarray:
     """Points of the cloud just under the box's downward faces, away from its edges (its own
     visible faces, noisy near the edges, are not taken for something under it), and not on
-    a detected box (whose contacts count already)."""
+    a detected box (whose contacts count already). ``points`` are sorted by x."""
     low, high = bound[:3] - CONTACT_GAP, bound[3:] + CONTACT_GAP
-    candidates = points[np.all((points >= low) & (points <= high), axis=1)]
+    slab = points[np.searchsorted(points[:, 0], low[0]) : np.searchsorted(points[:, 0], high[0], side="right")]
+    candidates = slab[np.all((slab >= low) & (slab <= high), axis=1)]
     for other in others:
         if len(candidates) == 0:
             break
@@ -254,6 +255,7 @@ def leaning_supports(scene: Scene, objects: Sequence[str] | None = None) -> list
     index = {box_id: k for k, box_id in enumerate(scene.box_ids)}
     boxes = [scene.boxes[index[name]] for name in names]
     bounds = bounding_boxes(boxes) if boxes else np.zeros((0, 6))
+    cloud = scene.points[np.argsort(scene.points[:, 0], kind="stable")]  # sorted once, sliced per box
     found: list[Leaning] = []
     for row, box in enumerate(boxes):
         tilted = tilt_deg(box) >= MIN_TILT_DEG
@@ -277,7 +279,7 @@ def leaning_supports(scene: Scene, objects: Sequence[str] | None = None) -> list
             if np.any(side):
                 beside[other] = (samples[touching][side], pushes[side])
         touched = [boxes[key] for key in base if key >= 0]
-        base[_CLOUD] = _cloud_under(scene.points, box, bounds[row], touched)
+        base[_CLOUD] = _cloud_under(cloud, box, bounds[row], touched)
         lowest = float(samples[:, 2].min())
         tipping = _tipping(box, base, exclude=None) if tilted else None
         if tipping is not None:  # it cannot stand on its base: what it leans on holds it
