@@ -67,7 +67,8 @@ __all__ = [
     "raise_leaning_supports",
 ]
 
-#: Boxes tilted less than this (degrees from standing on a face) are not examined.
+#: Boxes tilted less than this (degrees from standing on a face) are examined only for what
+#: their base needs, not for leaning: their overhang is more often a pose error.
 MIN_TILT_DEG = 8.0
 #: Two surfaces closer than this touch (metres): poses from a detector are a centimetre off.
 CONTACT_GAP = 0.015
@@ -83,9 +84,9 @@ MIN_OVERHANG = 0.01
 MIN_PUSH = 0.3
 #: ... and touches it at least this high above its lowest point (metres).
 MIN_RISE = 0.05
-#: The support probability a box leant on gets at least: of the findings whose probability the
-#: rule raises, the share in which removing the box found to hold the other moved it on the
-#: simulated piles the rule was tuned on (53 of 84; 53 of 84 on fresh piles too: generalisation page).
+#: The support probability a box found to hold another gets at least: of the findings whose
+#: probability the rule raises, the share in which removing that box moved the other on the
+#: simulated piles the rule was tuned on (68 of 101; 66 of 110 on fresh piles: generalisation page).
 LEAN_SUPPORT_PROBABILITY = 0.65
 
 
@@ -98,7 +99,7 @@ class Leaning:
     leaning : str
         The box that would tip over.
     supporter : str
-        The box it leans on.
+        The box it leans on or rests on.
     overhang : float
         How far its centre of mass lies outside its base (without the supporter's contacts
         when the supporter is part of the base), seen from above (metres).
