@@ -188,9 +188,10 @@ def support_probabilities(scene: Scene, model: ModelArgument = None, *, statics:
         A shipped model's name, a model file, or a loaded model; ``None``: the default
         model (loaded once per process).
     statics : bool
-        Raise the probability that a box holds up a box leaning on it, where statics says
-        the leaning box cannot stand on its base (:mod:`unstack.statics`; each raise is a
-        warning); ``False``: the model's probabilities alone.
+        Raise the probability that a box holds up another where statics says the other
+        cannot stand without it -- a box leaning on it, a box across a gap on it
+        (:mod:`unstack.statics`; each raise is a warning); ``False``: the model's
+        probabilities alone.
 
     Returns
     -------
@@ -278,8 +279,8 @@ def decide(
         that carry heights), Eq. 13's minimum for supports without heights; 0 keeps Eq. 13
         exactly.
     statics : bool
-        For a scene: raise the probability that a box holds up a box leaning on it
-        (:func:`support_probabilities`); ``False`` keeps the model's probabilities.
+        For a scene: raise the probability that a box holds up another that cannot stand
+        without it (:func:`support_probabilities`); ``False`` keeps the model's probabilities.
 
     Returns
     -------

@@ -237,7 +237,7 @@ def _cloud_under(points: np.ndarray, box: Box, bound: np.ndarray, others: Sequen
 
 
 def leaning_supports(scene: Scene, objects: Sequence[str] | None = None) -> list[Leaning]:
-    """The detected boxes that cannot stand on their base and the detected boxes they lean on.
+    """The detected boxes that cannot stand without another detected box, and those boxes.
 
     Parameters
     ----------

@@ -32,8 +32,8 @@ MODEL_HELP = (
     "paper's SVM, for the reproduction) or extended (the paper's piles with contact features)."
 )
 STATICS_HELP = (
-    "For a scene: a box that cannot stand on its base and leans on another makes that one its supporter "
-    "(P raised to at least 0.65, with a warning); --no-statics keeps the model's probabilities."
+    "For a scene: a box that cannot stand without another (leaning on it, or across a gap on it) makes that "
+    "one its supporter (P raised to at least 0.65, with a warning); --no-statics keeps the model's probabilities."
 )
 
 #: Commands whose modules load only when they run (their imports are heavy).

@@ -74,7 +74,8 @@ def scene_support_probabilities(
     boxes : sequence of str, optional
         Box ids to use instead of the scene's detected boxes (an ISet drawn from them).
     statics : bool
-        Raise ``P(X supports Y)`` where ``Y`` cannot stand on its base and leans on ``X``
+        Raise ``P(X supports Y)`` where ``Y`` cannot stand without ``X`` (it leans on it, or
+        rests across a gap on it and another)
         (:mod:`unstack.statics`; each raise is a warning and is listed in
         ``metadata["leaning"]``); ``False``: the model's probabilities alone.
 
