@@ -169,6 +169,7 @@ def part_scenes(
                 "seed": seed,
                 "seconds": decision.seconds,
                 "choice_probability": decision.choice_probability,
+                "samples": int(sum(decision.sampling["samples"])) if decision.sampling else 0,
                 "reference_samples": reference.samples,
                 "reference_max_standard_error": float(truth_errors.max()),
                 "peak_rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
@@ -181,7 +182,10 @@ def part_scenes(
 def summary(row: dict[str, Any]) -> str:
     extra = ""
     if "choice_probability" in row:
-        extra = f"  P(min) {row['choice_probability']:.3f}  reference s.e. {row['reference_max_standard_error']:.4f}"
+        extra = (
+            f"  P(min) {row['choice_probability']:.3f}  {row['samples']:,} sweeps"
+            f"  reference s.e. {row['reference_max_standard_error']:.4f}"
+        )
     return (
         f"{row['part']:6s} {row['family']:12s} n={row['n']:2d} seed={row['seed']}  "
         f"max EC error {row['max_ec_error']:.4f}  max s.e. {row['max_standard_error']:.4f}  "
