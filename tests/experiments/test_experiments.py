@@ -180,9 +180,10 @@ def test_real7_command(small_dataset: Path, tmp_path: Path) -> None:
 
 def test_unload_command_executes_every_order(small_dataset: Path, tmp_path: Path) -> None:
     result = unstack("experiment", "unload", str(small_dataset), "--out", str(tmp_path), "--configs", "2",
-                     "--time-limit", "0.1", "--closed-loop", "--jobs", "2")  # fmt: skip
+                     "--time-limit", "0.1", "--closed-loop", "--no-statics", "--jobs", "2")  # fmt: skip
     assert result.returncode == 0, result.stderr
     document = json.loads((tmp_path / "unloading.json").read_text())
+    assert document["statics"] is False
     assert document["makers"][-2:] == ["reasoner_closed_loop", "highest_closed_loop"]
     assert set(document["summary"]) == set(document["makers"])
     assert (tmp_path / "unloading.png").read_bytes()[:4] == b"\x89PNG"
@@ -227,6 +228,9 @@ def test_unloading_resumes_from_its_checkpoints(
     assert again == first
     with pytest.raises(AssertionError, match="simulated again"):  # another seed is another run
         unloading_experiment(small_dataset, model, configs=1, samples=64, seed=5, checkpoints=tmp_path)
+    assert first["statics"] is True
+    with pytest.raises(AssertionError, match="simulated again"):  # so is a run without statics
+        unloading_experiment(small_dataset, model, configs=1, samples=64, statics=False, checkpoints=tmp_path)
 
 
 def test_unloading_runs_on_a_dask_cluster(small_dataset: Path) -> None:

@@ -10,7 +10,7 @@ from rich.console import Console
 from rich.table import Table
 
 from unstack.cli.learning import FEATURES_HELP, ISETS_FROM_HELP
-from unstack.cli.main import MODEL_HELP, finite_seconds
+from unstack.cli.main import MODEL_HELP, STATICS_HELP, finite_seconds
 from unstack.cli.progress import progress_bar
 from unstack.errors import UnstackError
 from unstack.experiments.container import CONTAINER_MAKERS, CONTAINER_SAMPLES
@@ -290,6 +290,7 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
               help="Cost of unstack's decisions: load (hidden load counted), count (Eq. 11) or mass.")  # fmt: skip
 @click.option("--closed-loop", is_flag=True,
               help="Also unstack and highest-first sensing the pile again before each pick (3x slower).")  # fmt: skip
+@click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)
 @click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Piles run in parallel.")
 @click.option("--scheduler", default=None,
               help="Address of a dask.distributed scheduler (tcp://HOST:PORT): piles run on its workers.")  # fmt: skip
@@ -304,6 +305,7 @@ def unload(
     full: bool,
     cost: str,
     closed_loop: bool,
+    statics: bool,
     jobs: int,
     scheduler: str | None,
 ) -> None:
@@ -329,7 +331,8 @@ def unload(
             result = unloading_experiment(
                 data_dir, model, configs=configs, samples=None if time_limit else samples, time_limit=time_limit,
                 seed=seed, progress=report,
-                checkpoints=folder / "unloading-piles", closed_loop=closed_loop, cost=cost, n_jobs=jobs, client=client,
+                checkpoints=folder / "unloading-piles", closed_loop=closed_loop, cost=cost, statics=statics,
+                n_jobs=jobs, client=client,
             )  # fmt: skip
     finally:
         if client is not None:

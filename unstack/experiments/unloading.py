@@ -79,14 +79,21 @@ def _repeated(pick: Callable[[list[str]], str], boxes: list[str]) -> list[str]:
 
 
 def closed_loop_policies(
-    model: Any, *, seed: int, samples: int | None = None, time_limit: float | None = None, cost: str = DEFAULT_COST
+    model: Any,
+    *,
+    seed: int,
+    samples: int | None = None,
+    time_limit: float | None = None,
+    cost: str = DEFAULT_COST,
+    statics: bool = True,
 ) -> dict[str, Callable[[Any], str]]:
-    """The closed-loop decision makers: each maps the freshly sensed scene to the box to take."""
+    """The closed-loop decision makers: each maps the freshly sensed scene to the box to take
+    (``statics``: as in :func:`~unstack.learning.probabilities.scene_support_probabilities`)."""
     from unstack.learning.probabilities import scene_support_probabilities
     from unstack.reasoner.decision import decide
 
     def reasoner(scene: Any) -> str:
-        supports = scene_support_probabilities(scene, model)
+        supports = scene_support_probabilities(scene, model, statics=statics)
         decision = decide(supports, cost=cost, samples=samples, time_limit=time_limit, seed=seed, near_tie_margin=0.0)
         return str(decision.choice)
 
@@ -104,14 +111,17 @@ def unloading_orders(
     samples: int | None = None,
     time_limit: float | None = None,
     cost: str = DEFAULT_COST,
+    statics: bool = True,
 ) -> dict[str, list[str]]:
-    """The order of the scene's detected boxes for every decision maker."""
+    """The order of the scene's detected boxes for every decision maker (``statics``: as in
+    :func:`~unstack.learning.probabilities.scene_support_probabilities`; the baselines do not
+    use the probabilities except ``priors``)."""
     from unstack.experiments.decisions import free_pick
     from unstack.learning.probabilities import scene_support_probabilities
     from unstack.reasoner.decision import choose
     from unstack.reasoner.plan import unloading_plan
 
-    supports = scene_support_probabilities(scene, model)
+    supports = scene_support_probabilities(scene, model, statics=statics)
     detected = list(scene.detected)
     # Eq. 13's minimum at every step (no near ties by height): the open-loop figures of the results page
     plan = unloading_plan(supports, cost=cost, samples=samples, time_limit=time_limit, seed=seed, near_tie_margin=0.0)
@@ -133,8 +143,11 @@ def unloading_orders(
     }
 
 
-def _pile_key(path: Path, model: Any, budget: Budget, seed: int, closed_loop: bool, cost: str) -> dict[str, Any]:
-    """What a pile's result depends on: the scene file, the model, the budget, the seed, the makers."""
+def _pile_key(
+    path: Path, model: Any, budget: Budget, seed: int, closed_loop: bool, cost: str, statics: bool = True
+) -> dict[str, Any]:
+    """What a pile's result depends on: the scene file, the model, the budget, the seed, the
+    makers, the cost and statics."""
     import hashlib
     import json
 
@@ -148,6 +161,7 @@ def _pile_key(path: Path, model: Any, budget: Budget, seed: int, closed_loop: bo
         "seed": seed,
         "closed_loop": closed_loop,
         "cost": cost,
+        "statics": statics,
     }
 
 
@@ -167,18 +181,29 @@ def _finished_pile(checkpoints: Path | None, key: dict[str, Any]) -> dict[str, A
 
 
 def _run_pile(
-    path: Path, number: int, model: Any, budget: Budget, seed: int, closed_loop: bool, cost: str = DEFAULT_COST
+    path: Path,
+    number: int,
+    model: Any,
+    budget: Budget,
+    seed: int,
+    closed_loop: bool,
+    cost: str = DEFAULT_COST,
+    statics: bool = True,
 ) -> tuple[int, dict[str, Any]]:
     """Every decision maker's run on one pile (``number`` is passed back for the caller's order)."""
     from unstack.scene import load_scene
     from unstack.sim.unloading import execute_policy, execute_unloading
 
     scene = load_scene(path)
-    orders = unloading_orders(scene, model, samples=budget[0], time_limit=budget[1], seed=seed, cost=cost)
+    orders = unloading_orders(
+        scene, model, samples=budget[0], time_limit=budget[1], seed=seed, cost=cost, statics=statics
+    )
     executed = {maker: execute_unloading(scene, orders[maker]).to_dict() for maker in orders}
     policies = {}
     if closed_loop:
-        policies = closed_loop_policies(model, samples=budget[0], time_limit=budget[1], seed=seed, cost=cost)
+        policies = closed_loop_policies(
+            model, samples=budget[0], time_limit=budget[1], seed=seed, cost=cost, statics=statics
+        )
     for maker, policy in policies.items():
         executed[maker] = execute_policy(scene, policy, scene.detected).to_dict()
     return number, {"scene": path.name, "boxes": len(scene.boxes), "detected": len(scene.detected), "runs": executed}
@@ -196,6 +221,7 @@ def unloading_experiment(
     checkpoints: str | os.PathLike[str] | None = None,
     closed_loop: bool = False,
     cost: str = DEFAULT_COST,
+    statics: bool = True,
     n_jobs: int = 1,
     client: Any = None,
 ) -> dict[str, Any]:
@@ -209,6 +235,8 @@ def unloading_experiment(
     them (resumable). Results do not depend on resuming: each pile has its own seed.
     ``closed_loop``: also run the :data:`CLOSED_LOOP_MAKERS` (about three times slower).
     ``cost``: the cost of unstack's decisions (:data:`unstack.reasoner.costs.COSTS`).
+    ``statics``: let a box that cannot stand without another make it its supporter
+    (:mod:`unstack.statics`, the default pipeline); ``False``: the model's probabilities alone.
     ``n_jobs``: piles run in parallel processes; ``client``: on the workers of a
     ``distributed.Client`` instead (the results do not depend on either).
     """
@@ -224,12 +252,14 @@ def unloading_experiment(
     folder = None if checkpoints is None else Path(checkpoints)
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
-    keys = [_pile_key(path, model, budget, seed + number, closed_loop, cost) for number, path in enumerate(files)]
+    keys = [
+        _pile_key(path, model, budget, seed + number, closed_loop, cost, statics) for number, path in enumerate(files)
+    ]
     piles: list[dict[str, Any] | None] = [_finished_pile(folder, key) for key in keys]
     todo = [number for number, pile in enumerate(piles) if pile is None]
     if progress is not None:
         progress(len(files) - len(todo), len(files))
-    arguments = [(files[number], number, model, budget, seed + number, closed_loop, cost) for number in todo]
+    arguments = [(files[number], number, model, budget, seed + number, closed_loop, cost, statics) for number in todo]
     results = run_unordered(_run_pile, arguments, n_jobs=n_jobs, client=client)
     for number, pile in results:
         piles[number] = pile
@@ -268,6 +298,7 @@ def unloading_experiment(
         "time_limit": time_limit,
         "seed": seed,
         "cost": cost,
+        "statics": statics,
         "makers": list(makers),
         "summary": summary,
         "against_reasoner": against_reasoner,
