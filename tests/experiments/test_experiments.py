@@ -108,6 +108,7 @@ def test_experiment_commands(small_dataset: Path, tmp_path: Path) -> None:
     assert result.returncode == 0, result.stderr
     assert (tmp_path / "fig4.png").read_bytes()[:4] == b"\x89PNG"
     assert json.loads((tmp_path / "decisions.json").read_text())["isets"] == 6
+    assert json.loads((tmp_path / "decisions.json").read_text())["statics"] is True
     first = tmp_path / "first.json"
     (tmp_path / "decisions.json").rename(first)
     common = ("experiment", "decisions", str(small_dataset), "--out", str(tmp_path), "--r", "4", "--isets", "6")
@@ -115,6 +116,10 @@ def test_experiment_commands(small_dataset: Path, tmp_path: Path) -> None:
     assert result.returncode == 0, result.stderr
     assert f"this run minus {first}:" in result.stdout
     assert json.loads((tmp_path / "decisions.json").read_text())["against_earlier_run"]["file"] == str(first)
+    result = unstack(*common, "--no-statics", "--pair-with", str(first))  # the same ISets: they pair
+    assert result.returncode == 0, result.stderr
+    without = json.loads((tmp_path / "decisions.json").read_text())
+    assert without["statics"] is False and without["against_earlier_run"]["file"] == str(first)
     result = unstack(*common, "--seed", "5", "--pair-with", str(first))
     assert result.returncode == 2 and result.stderr.strip().endswith(
         "drew their ISets differently (seed): nothing to pair"

@@ -184,6 +184,7 @@ def fig5a(
 @click.option("--pair-with", "pair_with", type=click.Path(dir_okay=False), default=None,
               help="decisions.json of an earlier run on the same ISets (another model, say): "
                    "prints unstack's boxes moved, this run minus that one, paired.")  # fmt: skip
+@click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)
 def decisions(
     data_dir: str,
     out: str,
@@ -194,6 +195,7 @@ def decisions(
     seed: int,
     full: bool,
     pair_with: str | None,
+    statics: bool,
 ) -> None:
     """Fig. 4 and beyond: MSE(cost), first pick right and physical disturbance of every decision maker."""
     from unstack.cli.main import load_model_option
@@ -210,7 +212,9 @@ def decisions(
     model, name = load_model_option(model_path)
     folder = _out(out)
     with progress_bar("ISets") as report:
-        result = evaluate_decisions(data_dir, model, r=r, isets=isets, seed=seed, progress=report, draw=draw)
+        result = evaluate_decisions(
+            data_dir, model, r=r, isets=isets, seed=seed, progress=report, draw=draw, statics=statics
+        )
     result["model"] = name
     if earlier is not None:
         try:

@@ -148,14 +148,18 @@ def free_pick(boxes: list[Any]) -> int:
     return max(candidates, key=lambda i: heights[i])
 
 
-def iset_outcome(scene: Any, ids: list[str], model: Any) -> IsetOutcome:
-    """Decide one ISet of a simulated scene with ``model`` and every decision maker; score the picks."""
+def iset_outcome(scene: Any, ids: list[str], model: Any, *, statics: bool = True) -> IsetOutcome:
+    """Decide one ISet of a simulated scene with ``model`` and every decision maker; score the picks.
+
+    ``statics``: as in :func:`~unstack.learning.probabilities.scene_support_probabilities` (the
+    default pipeline); the scores compare the picks with the simulator's ground truth either way.
+    """
     from unstack.height_veto import hybrid_choice
     from unstack.learning.metrics import classification_report
     from unstack.learning.probabilities import scene_support_probabilities
     from unstack.reasoner.decision import NEAR_TIE_MARGIN, choose, decide
 
-    supports = scene_support_probabilities(scene, model, boxes=ids)
+    supports = scene_support_probabilities(scene, model, boxes=ids, statics=statics)
     index = [scene.box_ids.index(box_id) for box_id in ids]
     truth = scene.ground_truth[np.ix_(index, index)]
     costs = truth.sum(axis=1).astype(np.float64)
@@ -249,10 +253,14 @@ def evaluate_decisions(
     seed: int = 0,
     progress: Callable[[int, int], None] | None = None,
     draw: str = "random",
+    statics: bool = True,
 ) -> dict[str, Any]:
     """Draw ``isets`` test ISets of ``r`` boxes from the data set's scenes and score every decision maker.
 
     ``draw``: how the ISets are drawn (see :data:`unstack.learning.training_data.ISET_DRAWS`).
+    ``statics``: let a box that cannot stand without another make it its supporter
+    (:mod:`unstack.statics`, the default); ``False``: the model's probabilities alone. It does
+    not change which ISets are drawn, so runs with and without it pair ISet by ISet.
     """
     from unstack.datasets import require_configurations
     from unstack.learning.training_data import detected_positions, sample_isets
@@ -275,7 +283,7 @@ def evaluate_decisions(
             positions=detected_positions(scene),
         )
         for ids in drawn:
-            results.append(iset_outcome(scene, list(ids), model))
+            results.append(iset_outcome(scene, list(ids), model, statics=statics))
             if progress is not None:
                 progress(len(results), isets)
     scores = {maker: decision_scores(results, maker) for maker in DECISION_MAKERS}
@@ -302,6 +310,7 @@ def evaluate_decisions(
         "isets": len(results),
         "seed": seed,
         "draw": draw,
+        "statics": statics,
         "summary": summary,
         "against_reasoner": against_reasoner,
         "bins": _binned(results, scores),
