@@ -74,6 +74,15 @@ def insertion_row_marginals(world: np.ndarray, probabilities: np.ndarray, box: i
     InvalidArgument
         Shapes that do not match, a box out of range, or a world that is not transitive
         once ``box`` is removed.
+
+    Examples
+    --------
+    Two boxes that support each other: putting a third box under one puts it under both.
+
+    >>> p = np.array([[0.0, 0.6, 0.6], [0.0, 0.0, 0.5], [0.0, 0.5, 0.0]])
+    >>> world = np.zeros((3, 3), dtype=bool); world[1, 2] = world[2, 1] = True
+    >>> insertion_row_marginals(world, p, 0).round(4).tolist()
+    [0.0, 0.6923, 0.6923]
     """
     p = check_matrix(probabilities)
     n = p.shape[0]
