@@ -163,17 +163,16 @@ class _Insertion:
             left &= ~component
         return found
 
-    def extreme(self, mask: int, later: list[int]) -> int:
-        """A box of ``mask`` with no box of ``mask`` strictly after it (``later``: the
-        successors for a sink, the predecessors for a source), the one with the most
-        boxes of ``mask`` equivalent or before it."""
+    def extreme(self, mask: int, later: list[int], earlier: list[int]) -> int:
+        """A box of ``mask`` with no box of ``mask`` strictly after it, the one with the most
+        boxes of ``mask`` before it (a sink: ``later`` the successors, ``earlier`` the
+        predecessors; a source: the other way round)."""
         best, reach = -1, -1
         for y in _bits(mask):
             strictly_later = later[y] & mask & ~(self.successors[y] & self.predecessors[y])
-            if strictly_later == 0:
-                earlier = (self.predecessors[y] if later is self.successors else self.successors[y]) & mask
-                if bin(earlier).count("1") > reach:
-                    best, reach = y, bin(earlier).count("1")
+            before = (earlier[y] & mask).bit_count()
+            if strictly_later == 0 and before > reach:
+                best, reach = y, before
         return best
 
     def row(self, allowed: int) -> _Sum:
@@ -187,7 +186,7 @@ class _Insertion:
         if len(parts) > 1:
             result = _combine([self.row(part) for part in parts], self.n)
         else:
-            y = self.extreme(allowed, self.predecessors)
+            y = self.extreme(allowed, self.predecessors, self.successors)
             taken = self.closure[y] & allowed
             equivalent = taken & self.co_closure[y]
             inside = self.product(self.present_row, taken)
@@ -216,7 +215,7 @@ class _Insertion:
         if len(parts) > 1:
             result = float(np.prod([self.column(part) for part in parts]))
         else:
-            y = self.extreme(candidates, self.successors)
+            y = self.extreme(candidates, self.successors, self.predecessors)
             taken = self.co_closure[y] & candidates
             equivalent = taken & self.closure[y]
             result = self.product(self.present_column, taken) * self.column(candidates & ~taken) + self.product(
@@ -235,7 +234,7 @@ class _Insertion:
         key = (candidates, allowed)
         if key in self.joint_sums:
             return self.joint_sums[key]
-        y = self.extreme(candidates, self.successors)
+        y = self.extreme(candidates, self.successors, self.predecessors)
         taken = self.co_closure[y] & candidates
         equivalent = taken & self.closure[y]
         inside = self.product(self.present_column, taken)
