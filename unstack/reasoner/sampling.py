@@ -109,6 +109,9 @@ MOVES = 8
 RARE_SWEEPS = 30
 #: Sweeps per chain discarded before recording.
 DEFAULT_BURN_IN = 64
+#: The pilot run that picks the boxes whose insertion is summed takes this share of the
+#: budget (one eighth: its sweeps are not kept).
+PILOT_SHARE = 8
 #: Sweeps per chain in one round of the anytime loop (one call of the compiled kernel).
 _ROUND_SWEEPS = 16
 #: Batches kept per chain; when full, neighbours merge (batch length doubles).
@@ -150,6 +153,9 @@ class SampledMarginals:
     final_worlds : numpy.ndarray, shape (chains, n) or (chains, n, words), int64, optional
         Last state of every chain (bit masks of the boxes each box supports, in the layout
         of :mod:`unstack.reasoner.world_masks`): a warm start for a related scene.
+    summed_boxes : numpy.ndarray, int64, optional
+        The boxes whose rows were recorded by summing their insertion
+        (:mod:`unstack.reasoner.summed_insertions`).
     """
 
     marginals: np.ndarray
@@ -165,6 +171,7 @@ class SampledMarginals:
     final_worlds: np.ndarray | None = None
     block_of: np.ndarray | None = None
     link_rates: np.ndarray | None = None
+    summed_boxes: np.ndarray | None = None
 
     def errors_of(self, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Estimate and covariance of ``marginals @ weights`` (the expected costs).
@@ -364,12 +371,26 @@ class _Chains:
         self.moves = _moves(n)
         self.cursors = np.zeros(chains, dtype=np.int64)
         self.moves_done = 0
+        self.sum_insertions(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64))
         if start is None:
             self.advance(1, scatter=True)
         else:
             self.successors[:] = start
             self.predecessors[:] = _transposed(start, n, wide=self.wide)
         self.advance(burn_in)
+
+    def sum_insertions(self, boxes: np.ndarray, free_sets: np.ndarray, *, slots: int = 1) -> None:
+        """Record the rows of ``boxes`` by summing their insertion inside ``free_sets`` (bit
+        masks; one-word kernels only; :mod:`unstack.reasoner._insertion_sum_kernels`)."""
+        from unstack.reasoner._insertion_sum_kernels import chain_workspaces
+
+        n = self.probabilities.shape[0]
+        self.summed_boxes = np.asarray(boxes, dtype=np.int64)
+        self.free_sets = np.asarray(free_sets, dtype=np.int64)
+        self.summed_rows = np.zeros(n, dtype=np.bool_)
+        self.summed_rows[self.summed_boxes] = True
+        self.workspaces = chain_workspaces(len(self.rng), n, slots)
+        self.sum_stats = np.zeros((len(self.rng), 3), dtype=np.int64)
 
     def advance(self, sweeps: int, *, record: bool = False, scatter: bool = False) -> None:
         """Run every chain ``sweeps`` sweeps; with ``record`` the conditionals go to ``sums``.
@@ -381,8 +402,16 @@ class _Chains:
         self.moves_done += len(self.rng) * sweeps * moves
         blocks = self.blocks
         weights: tuple[np.ndarray, ...] = (blocks.log_weights,)
+        summing: tuple[Any, ...] = (
+            self.summed_boxes,
+            self.free_sets,
+            self.summed_rows,
+            self.workspaces,
+            self.sum_stats,
+        )
         if self.wide:
             weights = (blocks.log_weights, self.linear_weights)
+            summing = ()
         with PARALLEL_KERNELS:
             self._run(
                 self.probabilities,
@@ -407,6 +436,7 @@ class _Chains:
                 blocks.block_of,
                 moves,
                 self.cursors,
+                *summing,
             )
 
 
@@ -421,6 +451,7 @@ def sampled_marginals(
     tries: int = DEFAULT_TRIES,
     blocks: bool = True,
     wide: bool | None = None,
+    insertion_sums: bool = False,
 ) -> SampledMarginals:
     """Estimate the conditional marginals of the consistent worlds by MCMC.
 
@@ -451,6 +482,11 @@ def sampled_marginals(
         Run the word-array kernels (any number of boxes) even for 63 boxes or fewer, where
         they give the same numbers as the default one-word kernels, only more slowly; by
         default they run for groups of 64 boxes and more.
+    insertion_sums : bool
+        In groups of 9-63 boxes, record the rows of the noisiest boxes by summing their
+        insertion exactly (:mod:`unstack.reasoner.summed_insertions`; a pilot run of an eighth
+        of the budget, not kept, chooses them). Off by default: on classifier piles it has not
+        yet beaten the pair record in the same time (docs page "Benchmarks").
 
     Returns
     -------
@@ -475,6 +511,7 @@ def sampled_marginals(
         start=start,
         blocks=blocks,
         wide=wide,
+        insertion_sums=insertion_sums,
     )
 
 
@@ -505,6 +542,7 @@ def _sampled_marginals(
     blocks: bool = True,
     warm: np.ndarray | None = None,
     wide: bool | None = None,
+    insertion_sums: bool = False,
 ) -> SampledMarginals:
     """:func:`sampled_marginals` on checked arguments; ``warm``: consistent starting worlds,
     one per chain (skips the scattering sweep)."""
@@ -515,6 +553,11 @@ def _sampled_marginals(
     deadline = None if time_limit is None else start + time_limit
     per_chain = None if samples is None else -(-samples // chains)
     state = _Chains(p, chains=chains, seed=seed, burn_in=burn_in, tries=tries, blocks=blocks, start=warm, wide=wide)
+    if insertion_sums and not state.wide and n > MOVES:
+        pilot_deadline = (
+            None if deadline is None else time.perf_counter() + (deadline - time.perf_counter()) / PILOT_SHARE
+        )
+        _sum_noisiest_insertions(state, None if per_chain is None else per_chain // PILOT_SHARE, pilot_deadline)
 
     batches = np.zeros((chains, _MAX_BATCHES, n, n))
     batch_length = _ROUND_SWEEPS  # sweeps per chain in one batch
@@ -577,7 +620,59 @@ def _sampled_marginals(
         final_worlds=state.successors.copy(),
         block_of=block_of,
         link_rates=link_rates,
+        summed_boxes=state.summed_boxes.copy(),
     )
+
+
+def _sum_noisiest_insertions(state: _Chains, sweeps: int | None, deadline: float | None) -> None:
+    """A pilot run (``sweeps`` per chain, or until ``deadline``; at least two rounds, not
+    kept), then the boxes whose rows the chains record by summing their insertion
+    (:mod:`unstack.reasoner.summed_insertions`)."""
+    from unstack.reasoner import summed_insertions
+    from unstack.reasoner._insertion_sum_kernels import insertion_row, workspace
+
+    sum_row: Callable[..., bool] = insertion_row
+    from unstack.reasoner._sampler_kernels import SUM_STRIDE
+
+    n = state.probabilities.shape[0]
+    chains = len(state.rng)
+    state.sums[:] = 0.0
+    done = 0
+    while True:
+        state.advance(_ROUND_SWEEPS, record=True)
+        done += _ROUND_SWEEPS
+        if done >= 2 * _ROUND_SWEEPS and (
+            (sweeps is not None and done >= sweeps) or (deadline is not None and time.perf_counter() >= deadline)
+        ):
+            break
+    per_chain = state.sums / done
+    marginals = per_chain.mean(axis=0)
+    costs_of_chains = per_chain.sum(axis=2)  # (chains, n): each chain's EC of every box, unit weights
+    variances = costs_of_chains.var(axis=0, ddof=1) / chains
+    eligible = state.blocks.block_of < 0
+    free = summed_insertions.free_sets(marginals, np.arange(n))
+    costs = np.full(n, np.inf)
+    scratch = workspace(n)
+    row = np.zeros(n)
+    for box in np.argsort(-variances)[: 2 * MOVES]:
+        slots = []
+        for chain in range(min(chains, 4)):
+            scratch[3][1] = 0
+            inside = sum_row(
+                int(box),
+                free[box],
+                state.probabilities,
+                state.successors[chain],
+                state.predecessors[chain],
+                *scratch,
+                row,
+            )
+            if inside or scratch[3][1] > 0:
+                slots.append(scratch[3][1])
+        if slots and max(slots) < scratch[4].shape[0]:  # sweeps per recorded sweep
+            costs[box] = float(np.mean(slots)) / (summed_insertions.SLOTS_PER_BOX_SWEEP * n * SUM_STRIDE)
+    boxes = summed_insertions.choose(variances, costs, eligible & np.isfinite(costs))
+    state.sum_insertions(boxes, free[boxes], slots=scratch[4].shape[0])
 
 
 def sample_worlds(
