@@ -18,10 +18,19 @@ and the time of one insertion sum against the core-time of one recorded sweep of
 (from a 1-s run of it, which also gives the number of boxes whose EC has a standard error
 above 0.008).
 
+With ``--free-thresholds`` it measures instead the compiled sum the sampler records
+(:mod:`unstack.reasoner.summed_insertions`): for each threshold, the box's free set (boxes
+linked either way with a marginal of the chain at least the threshold), ``variance *
+autocorrelation time`` of the cell average (the world's own row where the insertion leaves
+the free set) recorded every sweep and every fourth sweep (times four: the same sweeps),
+the share of worlds inside the cell, the slots of the dynamic programme and the time of one
+sum.
+
 Usage::
 
     unstack simulate --configs 8 --seed 7 --jobs 2 --out scenes40
     python benchmarks/insertion_variance.py scenes40 --worlds 1000 --boxes 3
+    python benchmarks/insertion_variance.py scenes40 --worlds 1000 --boxes 3 --free-thresholds 0.01,0.03
 """
 
 from __future__ import annotations
@@ -68,13 +77,67 @@ def effort(series: np.ndarray) -> float:
     return float(series.var() * autocorrelation_time(series))
 
 
+def compiled_sums(dataset: Path, worlds_per_pile: int, boxes: int, seed: int, thresholds: str) -> int:
+    """The ``--free-thresholds`` measurement (see the module docstring)."""
+    from unstack.reasoner._insertion_sum_kernels import insertion_row, workspace
+    from unstack.reasoner.summed_insertions import SUM_SLOTS, free_sets
+
+    model = load_model(default_model_path())
+    levels = [float(value) for value in thresholds.split(",")]
+    empty = np.zeros(2, dtype=np.int64)
+    insertion_row(0, np.int64(2), np.full((2, 2), 0.5), empty, empty, *workspace(2, 4), np.zeros(2))  # compile
+    print(
+        f"python benchmarks/insertion_variance.py {dataset} --worlds {worlds_per_pile} --boxes {boxes} "
+        f"--free-thresholds {thresholds}"
+    )
+    for path in sorted(dataset.glob("config-*.json")):
+        scene = load_scene(path)
+        p = scene_support_probabilities(scene, model, boxes=list(scene.box_ids)).probabilities
+        n = len(p)
+        worlds = sample_worlds(p, worlds_per_pile, seed=seed)
+        marginals = worlds.mean(axis=0)
+        bits = np.left_shift(np.int64(1), np.arange(n, dtype=np.int64))
+        successors = [np.array([bits[world[y] & (np.arange(n) != y)].sum() for y in range(n)]) for world in worlds]
+        predecessors = [np.array([bits[world[:, y] & (np.arange(n) != y)].sum() for y in range(n)]) for world in worlds]
+        recorded = np.array([pair_conditionals(world, p).sum(axis=1) for world in worlds])
+        scratch = workspace(n, SUM_SLOTS)
+        row = np.zeros(n)
+        for box in sorted(range(n), key=lambda b: -effort(recorded[:, b]))[:boxes]:
+            line = f"{path.stem} ({n} boxes) {scene.box_ids[box]}: pair {effort(recorded[:, box]):.1f}"
+            for level in levels:
+                free = free_sets(marginals, np.array([box]), threshold=level)[0]
+                values, inside, slots = [], 0, []
+                started = time.perf_counter()
+                for world, succ, pred in zip(worlds, successors, predecessors, strict=True):
+                    if insertion_row(box, free, p, succ, pred, *scratch, row):
+                        values.append(row.sum())
+                        inside += 1
+                        slots.append(scratch[3][1])
+                    else:
+                        values.append(float(world[box].sum() - world[box, box]))
+                seconds = (time.perf_counter() - started) / len(worlds)
+                series = np.array(values)
+                line += (
+                    f" | {level}: {int(free).bit_count()} free, every sweep {effort(series):.2f}, every 4th "
+                    f"{4 * effort(series[::4]):.2f}, inside {inside / len(worlds):.2f}, "
+                    f"{np.mean(slots) if slots else 0:.0f} slots, {seconds * 1e6:.0f} us"
+                )
+            print(line, flush=True)
+    return 0
+
+
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("dataset", type=Path)
     parser.add_argument("--worlds", type=int, default=1000, help="sweeps of the chain")
     parser.add_argument("--boxes", type=int, default=3, help="noisiest boxes per pile")
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument(
+        "--free-thresholds", default=None, help="comma-separated: measure the compiled sum over free sets instead"
+    )
     args = parser.parse_args(argv)
+    if args.free_thresholds is not None:
+        return compiled_sums(args.dataset, args.worlds, args.boxes, args.seed, args.free_thresholds)
     model = load_model(default_model_path())
     print(f"python benchmarks/insertion_variance.py {args.dataset} --worlds {args.worlds} --boxes {args.boxes}")
     reductions, worst = [], []

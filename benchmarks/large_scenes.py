@@ -32,6 +32,10 @@ import json
 import resource
 import sys
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from functools import partial
+from itertools import product
 from pathlib import Path
 from typing import Any
 
@@ -149,8 +153,27 @@ def scene_matrices(dataset: Path) -> dict[str, np.ndarray]:
     return matrices
 
 
+@contextmanager
+def summing_insertions(on: bool) -> Iterator[None]:
+    """Run the decisions inside with ``insertion_sums=on`` (the sampler's option; ``decide`` does
+    not take it, so the benchmark sets it on the function the decision calls)."""
+    from unstack.reasoner import sampling
+
+    plain = sampling._sampled_marginals
+    sampling._sampled_marginals = partial(plain, insertion_sums=on)  # type: ignore[assignment]
+    try:
+        yield
+    finally:
+        sampling._sampled_marginals = plain  # type: ignore[assignment]
+
+
 def part_scenes(
-    dataset: Path, seeds: int, time_limit: float, reference_seconds: float, limit: int
+    dataset: Path,
+    seeds: int,
+    time_limit: float,
+    reference_seconds: float,
+    limit: int,
+    settings: tuple[bool, ...] = (False,),
 ) -> list[dict[str, Any]]:
     rows = []
     for name, p in list(scene_matrices(dataset).items())[:limit]:
@@ -158,12 +181,13 @@ def part_scenes(
         reference = sampled_marginals(p, time_limit=reference_seconds, seed=10_000)
         truth, truth_covariance = reference.errors_of(np.ones(n))
         truth_errors = np.sqrt(np.diag(truth_covariance))
-        for seed in range(seeds):
-            decision = decide(Supports(ids(n), p), method="approx", time_limit=time_limit, seed=seed)
+        for seed, summed in product(range(seeds), settings):
+            with summing_insertions(summed):
+                decision = decide(Supports(ids(n), p), method="approx", time_limit=time_limit, seed=seed)
             assert decision.expected_cost_errors is not None
             row = scores(decision.expected_costs, decision.expected_cost_errors, truth, truth_errors)
             row |= {
-                "part": "scenes",
+                "part": "scenes" if not summed else "scenes, insertion sums",
                 "family": name,
                 "n": n,
                 "seed": seed,
@@ -172,6 +196,7 @@ def part_scenes(
                 "samples": int(sum(decision.sampling["samples"])) if decision.sampling else 0,
                 "reference_samples": reference.samples,
                 "reference_max_standard_error": float(truth_errors.max()),
+                "summed_boxes": sum((decision.sampling or {}).get("insertion_sums", [0])),
                 "peak_rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
             }
             rows.append(row)
@@ -184,7 +209,7 @@ def summary(row: dict[str, Any]) -> str:
     if "choice_probability" in row:
         extra = (
             f"  P(min) {row['choice_probability']:.3f}  {row['samples']:,} sweeps"
-            f"  reference s.e. {row['reference_max_standard_error']:.4f}"
+            f"  reference s.e. {row['reference_max_standard_error']:.4f}  summed boxes {row['summed_boxes']}"
         )
     return (
         f"{row['part']:6s} {row['family']:12s} n={row['n']:2d} seed={row['seed']}  "
@@ -196,7 +221,7 @@ def summary(row: dict[str, Any]) -> str:
 
 def totals(rows: list[dict[str, Any]]) -> list[str]:
     lines = []
-    for part in ("exact", "blocks", "scenes"):
+    for part in ("exact", "blocks", "scenes", "scenes, insertion sums"):
         chosen = [row for row in rows if row["part"] == part]
         if not chosen:
             continue
@@ -210,7 +235,9 @@ def totals(rows: list[dict[str, Any]]) -> list[str]:
         if part == "exact":
             marginal_cover = sum(r["marginals_covered"] for r in chosen) / sum(r["marginals"] for r in chosen)
             line += f", marginal coverage {marginal_cover:.3f}"
-        if part == "scenes":
+        if part.startswith("scenes"):
+            line += f", within 0.02 {sum(r['max_ec_error'] <= 0.02 for r in chosen)}/{len(chosen)}"
+            line += f", sweeps {min(r['samples'] for r in chosen):,}-{max(r['samples'] for r in chosen):,}"
             line += f", peak RSS {max(r['peak_rss_mib'] for r in chosen):.0f} MiB"
         lines.append(line)
     return lines
@@ -225,8 +252,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--scene-limit", type=int, default=8, help="configurations used from --scenes")
     parser.add_argument("--reference-seconds", type=float, default=60.0, help="length of the reference run")
     parser.add_argument("--parts", default="exact,blocks,scenes")
+    parser.add_argument(
+        "--insertion-sums",
+        choices=("off", "on", "both"),
+        default="off",
+        help="the sampler's summed insertions in the scenes part (both: each seed with and without)",
+    )
     parser.add_argument("--json", type=Path, default=None)
     args = parser.parse_args(argv)
+    settings = {"off": (False,), "on": (True,), "both": (False, True)}[args.insertion_sums]
     parts = args.parts.split(",")
     start = time.perf_counter()
     rows: list[dict[str, Any]] = []
@@ -235,7 +269,9 @@ def main(argv: list[str] | None = None) -> int:
     if "blocks" in parts:
         rows += part_blocks([10, 20, 30, 40], args.seeds, args.time_limit)
     if "scenes" in parts and args.scenes is not None:
-        rows += part_scenes(args.scenes, args.seeds, args.time_limit, args.reference_seconds, args.scene_limit)
+        rows += part_scenes(
+            args.scenes, args.seeds, args.time_limit, args.reference_seconds, args.scene_limit, settings
+        )
     print(f"\ncommand: python benchmarks/large_scenes.py {' '.join(argv if argv is not None else sys.argv[1:])}")
     for line in totals(rows):
         print(line)

@@ -110,7 +110,7 @@ RARE_SWEEPS = 30
 #: Sweeps per chain discarded before recording.
 DEFAULT_BURN_IN = 64
 #: The pilot run that picks the boxes whose insertion is summed takes this share of the
-#: budget (one eighth: its sweeps are not kept).
+#: budget (one eighth; its sweeps are kept only when no box is chosen).
 PILOT_SHARE = 8
 #: Sweeps per chain in one round of the anytime loop (one call of the compiled kernel).
 _ROUND_SWEEPS = 16
@@ -553,11 +553,9 @@ def _sampled_marginals(
     deadline = None if time_limit is None else start + time_limit
     per_chain = None if samples is None else -(-samples // chains)
     state = _Chains(p, chains=chains, seed=seed, burn_in=burn_in, tries=tries, blocks=blocks, start=warm, wide=wide)
-    if insertion_sums and not state.wide and n > MOVES:
-        pilot_deadline = (
-            None if deadline is None else time.perf_counter() + (deadline - time.perf_counter()) / PILOT_SHARE
-        )
-        _sum_noisiest_insertions(state, None if per_chain is None else per_chain // PILOT_SHARE, pilot_deadline)
+    choosing = insertion_sums and not state.wide and n > MOVES  # the pilot: the first part of the run
+    pilot_sweeps = None if per_chain is None else max(2 * _ROUND_SWEEPS, per_chain // PILOT_SHARE)
+    pilot_deadline = None if deadline is None else time.perf_counter() + (deadline - time.perf_counter()) / PILOT_SHARE
 
     batches = np.zeros((chains, _MAX_BATCHES, n, n))
     batch_length = _ROUND_SWEEPS  # sweeps per chain in one batch
@@ -581,6 +579,19 @@ def _sampled_marginals(
                 batches[:, _MAX_BATCHES // 2 :] = 0.0
                 filled = _MAX_BATCHES // 2
                 batch_length *= 2
+        if (
+            choosing
+            and filled >= 2
+            and (
+                (pilot_sweeps is not None and recorded >= pilot_sweeps)
+                or (pilot_deadline is not None and time.perf_counter() >= pilot_deadline)
+            )
+        ):
+            choosing = False
+            if _sum_noisiest_insertions(state, batches[:, :filled] / batch_length):
+                batches[:] = 0.0  # the pilot's records are not kept: the summed rows start afresh
+                batch_length, filled, partial, recorded = _ROUND_SWEEPS, 0, 0, 0
+                continue
         if per_chain is not None and recorded >= per_chain:
             break
         if deadline is not None and time.perf_counter() + round_seconds >= deadline and filled >= 2:
@@ -624,39 +635,28 @@ def _sampled_marginals(
     )
 
 
-def _sum_noisiest_insertions(state: _Chains, sweeps: int | None, deadline: float | None) -> None:
-    """A pilot run (``sweeps`` per chain, or until ``deadline``; at least two rounds, not
-    kept), then the boxes whose rows the chains record by summing their insertion
-    (:mod:`unstack.reasoner.summed_insertions`)."""
+def _sum_noisiest_insertions(state: _Chains, pilot: np.ndarray) -> bool:
+    """Choose the boxes whose rows the chains record from now on by summing their insertion
+    (:mod:`unstack.reasoner.summed_insertions`) from ``pilot``, the complete batch means so far
+    (``(chains, batches, n, n)``); whether any was chosen."""
     from unstack.reasoner import summed_insertions
     from unstack.reasoner._insertion_sum_kernels import insertion_row, workspace
-
-    sum_row: Callable[..., bool] = insertion_row
     from unstack.reasoner._sampler_kernels import SUM_STRIDE
 
+    sum_row: Callable[..., bool] = insertion_row
     n = state.probabilities.shape[0]
     chains = len(state.rng)
-    state.sums[:] = 0.0
-    done = 0
-    while True:
-        state.advance(_ROUND_SWEEPS, record=True)
-        done += _ROUND_SWEEPS
-        if done >= 2 * _ROUND_SWEEPS and (
-            (sweeps is not None and done >= sweeps) or (deadline is not None and time.perf_counter() >= deadline)
-        ):
-            break
-    per_chain = state.sums / done
-    marginals = per_chain.mean(axis=0)
-    costs_of_chains = per_chain.sum(axis=2)  # (chains, n): each chain's EC of every box, unit weights
-    variances = costs_of_chains.var(axis=0, ddof=1) / chains
+    batch_means = pilot.reshape(-1, n, n)
+    marginals = batch_means.mean(axis=0)
+    variances = batch_means.sum(axis=2).var(axis=0, ddof=1) / len(batch_means)  # each box's EC, unit weights
     eligible = state.blocks.block_of < 0
     free = summed_insertions.free_sets(marginals, np.arange(n))
     costs = np.full(n, np.inf)
-    scratch = workspace(n)
+    scratch = workspace(n, summed_insertions.SUM_SLOTS)
     row = np.zeros(n)
-    for box in np.argsort(-variances)[: 2 * MOVES]:
+    for box in np.argsort(-variances)[: 2 * MOVES]:  # the cost of a sum on every chain's world
         slots = []
-        for chain in range(min(chains, 4)):
+        for chain in range(chains):
             scratch[3][1] = 0
             inside = sum_row(
                 int(box),
@@ -667,12 +667,14 @@ def _sum_noisiest_insertions(state: _Chains, sweeps: int | None, deadline: float
                 *scratch,
                 row,
             )
-            if inside or scratch[3][1] > 0:
-                slots.append(scratch[3][1])
-        if slots and max(slots) < scratch[4].shape[0]:  # sweeps per recorded sweep
+            if inside or scratch[3][1] > 0:  # outgrown sums count at the workspace's size
+                slots.append(scratch[3][1] if inside else summed_insertions.SUM_SLOTS)
+        if slots and np.mean(np.array(slots) >= summed_insertions.SUM_SLOTS) <= 0.25:  # sweeps per recorded sweep
             costs[box] = float(np.mean(slots)) / (summed_insertions.SLOTS_PER_BOX_SWEEP * n * SUM_STRIDE)
     boxes = summed_insertions.choose(variances, costs, eligible & np.isfinite(costs))
-    state.sum_insertions(boxes, free[boxes], slots=scratch[4].shape[0])
+    if len(boxes):
+        state.sum_insertions(boxes, free[boxes], slots=summed_insertions.SUM_SLOTS)
+    return len(boxes) > 0
 
 
 def sample_worlds(

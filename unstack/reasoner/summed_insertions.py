@@ -17,8 +17,8 @@ against how much spread it removes. Measured on eight 31-40-box piles of ``scene
 takes 5-25 times off the box's ``variance * autocorrelation time`` and costs 15-300 us (one
 to a few sweeps of the sampler).
 
-Which boxes: a pilot run gives each box's EC standard error and, from one sum per box on
-the chains' states, the cost of its sum (slots of the dynamic programme, a count that does
+Which boxes: a pilot run gives each box's EC standard error (from its batch means) and,
+from one sum per box on every chain's state, the cost of its sum (slots of the dynamic programme, a count that does
 not depend on the machine). The noisiest boxes are summed, as many as give the smallest
 largest predicted variance, predicting :data:`ASSUMED_REDUCTION` times less variance for a
 summed box and charging every box the longer sweeps; the sums may at most double a sweep.
@@ -35,7 +35,15 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["ASSUMED_REDUCTION", "FREE_THRESHOLD", "MAX_EXTRA_COST", "SLOTS_PER_BOX_SWEEP", "choose", "free_sets"]
+__all__ = [
+    "ASSUMED_REDUCTION",
+    "FREE_THRESHOLD",
+    "MAX_EXTRA_COST",
+    "SLOTS_PER_BOX_SWEEP",
+    "SUM_SLOTS",
+    "choose",
+    "free_sets",
+]
 
 #: A box joins the free set of another when a pilot marginal between them reaches this.
 FREE_THRESHOLD = 0.01
@@ -45,9 +53,12 @@ FREE_THRESHOLD = 0.01
 ASSUMED_REDUCTION = 4.0
 #: Sums cost at most this many sweeps per recorded sweep.
 MAX_EXTRA_COST = 1.0
-#: Slots of the dynamic programme that cost about one sweep, per box of the group (a sweep
-#: of a 40-box pile took 21-32 us of core time, a slot about 0.25 us).
-SLOTS_PER_BOX_SWEEP = 6.0
+#: States a sum may store before it is abandoned (the world's own row is recorded instead):
+#: about 100 us, three sweeps, at the most.
+SUM_SLOTS = 1024
+#: Slots of the dynamic programme that cost about one sweep, per box of the group (measured on
+#: two 39-40-box piles: a chain's sweep 29-32 us of core time, a slot 0.094-0.098 us).
+SLOTS_PER_BOX_SWEEP = 8.0
 
 
 def free_sets(marginals: np.ndarray, boxes: np.ndarray, *, threshold: float = FREE_THRESHOLD) -> np.ndarray:
