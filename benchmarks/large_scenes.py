@@ -154,13 +154,14 @@ def scene_matrices(dataset: Path) -> dict[str, np.ndarray]:
 
 
 @contextmanager
-def summing_insertions(on: bool) -> Iterator[None]:
-    """Run the decisions inside with ``insertion_sums=on`` (the sampler's option; ``decide`` does
-    not take it, so the benchmark sets it on the function the decision calls)."""
+def sampler_options(options: dict[str, bool]) -> Iterator[None]:
+    """Run the decisions inside with these options of the sampler (``insertion_sums``,
+    ``revisits``; ``decide`` does not take them, so the benchmark sets them on the function the
+    decision calls)."""
     from unstack.reasoner import sampling
 
     plain = sampling._sampled_marginals
-    sampling._sampled_marginals = partial(plain, insertion_sums=on)  # type: ignore[assignment]
+    sampling._sampled_marginals = partial(plain, **options)  # type: ignore[assignment]
     try:
         yield
     finally:
@@ -173,7 +174,7 @@ def part_scenes(
     time_limit: float,
     reference_seconds: float,
     limit: int,
-    settings: tuple[bool, ...] = (False,),
+    settings: tuple[dict[str, bool], ...] = ({},),
 ) -> list[dict[str, Any]]:
     rows = []
     for name, p in list(scene_matrices(dataset).items())[:limit]:
@@ -181,13 +182,13 @@ def part_scenes(
         reference = sampled_marginals(p, time_limit=reference_seconds, seed=10_000)
         truth, truth_covariance = reference.errors_of(np.ones(n))
         truth_errors = np.sqrt(np.diag(truth_covariance))
-        for seed, summed in product(range(seeds), settings):
-            with summing_insertions(summed):
+        for seed, options in product(range(seeds), settings):
+            with sampler_options(options):
                 decision = decide(Supports(ids(n), p), method="approx", time_limit=time_limit, seed=seed)
             assert decision.expected_cost_errors is not None
             row = scores(decision.expected_costs, decision.expected_cost_errors, truth, truth_errors)
             row |= {
-                "part": "scenes" if not summed else "scenes, insertion sums",
+                "part": "scenes" + "".join(f", {key}={value}" for key, value in options.items()),
                 "family": name,
                 "n": n,
                 "seed": seed,
@@ -221,7 +222,8 @@ def summary(row: dict[str, Any]) -> str:
 
 def totals(rows: list[dict[str, Any]]) -> list[str]:
     lines = []
-    for part in ("exact", "blocks", "scenes", "scenes, insertion sums"):
+    parts = ["exact", "blocks", *sorted({row["part"] for row in rows if row["part"].startswith("scenes")})]
+    for part in parts:
         chosen = [row for row in rows if row["part"] == part]
         if not chosen:
             continue
@@ -253,14 +255,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--reference-seconds", type=float, default=60.0, help="length of the reference run")
     parser.add_argument("--parts", default="exact,blocks,scenes")
     parser.add_argument(
-        "--insertion-sums",
-        choices=("off", "on", "both"),
-        default="off",
-        help="the sampler's summed insertions in the scenes part (both: each seed with and without)",
+        "--compare",
+        choices=("insertion_sums", "revisits"),
+        default=None,
+        help="in the scenes part, run each seed with this option of the sampler off and on",
     )
     parser.add_argument("--json", type=Path, default=None)
     args = parser.parse_args(argv)
-    settings = {"off": (False,), "on": (True,), "both": (False, True)}[args.insertion_sums]
+    settings: tuple[dict[str, bool], ...] = (
+        ({},) if args.compare is None else ({args.compare: False}, {args.compare: True})
+    )
     parts = args.parts.split(",")
     start = time.perf_counter()
     rows: list[dict[str, Any]] = []

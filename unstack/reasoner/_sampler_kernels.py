@@ -613,6 +613,7 @@ def _run_chain(
     block_of: np.ndarray,
     moves: int,
     cursors: np.ndarray,
+    schedule: np.ndarray,
     summed_boxes: np.ndarray,
     free_sets: np.ndarray,
     summed_rows: np.ndarray,
@@ -621,8 +622,9 @@ def _run_chain(
 ) -> int:
     """Run ``sweeps`` sweeps of one chain; add the estimates when ``record``.
 
-    A sweep re-inserts ``moves`` boxes, the next ones in turn from ``cursors[chain]`` (every
-    box when ``moves == n``). The rows of ``summed_boxes`` are recorded every
+    A sweep re-inserts ``moves`` boxes, the next ones of ``schedule`` (each box once, in
+    order, unless some are visited more often) in turn from ``cursors[chain]`` (every box
+    when ``moves == n`` and the schedule is every box once). The rows of ``summed_boxes`` are recorded every
     :data:`SUM_STRIDE` sweeps (from the first) by summing their insertion inside ``free_sets``
     (:func:`_add_insertion_row`, one workspace per chain)."""
     n = probabilities.shape[0]
@@ -637,8 +639,8 @@ def _run_chain(
     for sweep in range(sweeps):
         _flip_pairs(probabilities, successors, predecessors, rng, chain)
         for _ in range(moves):
-            x = cursors[chain]
-            cursors[chain] = (x + 1) % n
+            x = schedule[cursors[chain]]
+            cursors[chain] = (cursors[chain] + 1) % schedule.shape[0]
             if _reinsert(
                 x,
                 probabilities,
@@ -751,6 +753,7 @@ def run_chains(
     block_of: np.ndarray,
     moves: int,
     cursors: np.ndarray,
+    schedule: np.ndarray,
     summed_boxes: np.ndarray,
     free_sets: np.ndarray,
     summed_rows: np.ndarray,
@@ -768,7 +771,8 @@ def run_chains(
     ``accepted``: ``(chains,)`` counts of moves that changed the state;
     ``block_*``: the blocks redrawn exactly after every sweep
     (:class:`~unstack.reasoner.block_gibbs.BlockTables`; no blocks: zero rows);
-    a sweep re-inserts ``moves`` boxes, in turn from ``cursors`` (``(chains,)``, updated);
+    a sweep re-inserts ``moves`` boxes, the next ones of ``schedule`` in turn from ``cursors``
+    (``(chains,)`` positions in it, updated);
     ``summed_boxes``/``free_sets``: the boxes whose rows are recorded by their insertion sum
     and its free set (``summed_rows``: the same boxes as a boolean per box),
     ``workspaces``: the arrays of :func:`~unstack.reasoner._insertion_sum_kernels.workspace`
@@ -799,6 +803,7 @@ def run_chains(
             block_of,
             moves,
             cursors,
+            schedule,
             summed_boxes,
             free_sets,
             summed_rows,

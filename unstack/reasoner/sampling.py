@@ -18,8 +18,9 @@ marginals are estimated by Markov chain Monte Carlo over the consistent worlds t
   re-insertion proposal is far less probable than the current world (dense matrices of
   20 boxes and more, where re-insertion alone stalled at an acceptance of 0);
 * a sweep is one pair pass, :data:`MOVES` re-insertions (the next boxes in turn; every box
-  in a group of up to 8) and, after it, the record: each pair contributes the probability of its
-  relation *given all the other relations*: the pair's own ``p`` whenever both values
+  in a group of up to 8; in groups of 9-63 boxes the noisiest boxes of a pilot run come round
+  more often, :mod:`unstack.reasoner.revisits`) and, after it, the record: each pair
+  contributes the probability of its relation *given all the other relations*: the pair's own ``p`` whenever both values
   keep the world transitive, else the value transitivity leaves. This Rao-Blackwellisation
   removes the noise of the many pairs that transitivity does not touch (measured: it beats
   averaging the moved box's candidate relations, which was tried and dropped);
@@ -156,6 +157,9 @@ class SampledMarginals:
     summed_boxes : numpy.ndarray, int64, optional
         The boxes whose rows were recorded by summing their insertion
         (:mod:`unstack.reasoner.summed_insertions`).
+    schedule : numpy.ndarray, int64, optional
+        The order in which the boxes were re-inserted at the end (every box once, unless the
+        noisiest were visited more often: :mod:`unstack.reasoner.revisits`).
     """
 
     marginals: np.ndarray
@@ -172,6 +176,7 @@ class SampledMarginals:
     block_of: np.ndarray | None = None
     link_rates: np.ndarray | None = None
     summed_boxes: np.ndarray | None = None
+    schedule: np.ndarray | None = None
 
     def errors_of(self, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Estimate and covariance of ``marginals @ weights`` (the expected costs).
@@ -370,6 +375,7 @@ class _Chains:
         self.linear_weights = np.exp(self.blocks.log_weights)
         self.moves = _moves(n)
         self.cursors = np.zeros(chains, dtype=np.int64)
+        self.schedule = np.arange(n, dtype=np.int64)  # one-word kernels: the order of the re-insertions
         self.moves_done = 0
         self.sum_insertions(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64))
         if start is None:
@@ -403,6 +409,7 @@ class _Chains:
         blocks = self.blocks
         weights: tuple[np.ndarray, ...] = (blocks.log_weights,)
         summing: tuple[Any, ...] = (
+            self.schedule,
             self.summed_boxes,
             self.free_sets,
             self.summed_rows,
@@ -452,6 +459,7 @@ def sampled_marginals(
     blocks: bool = True,
     wide: bool | None = None,
     insertion_sums: bool = False,
+    revisits: bool = True,
 ) -> SampledMarginals:
     """Estimate the conditional marginals of the consistent worlds by MCMC.
 
@@ -487,6 +495,10 @@ def sampled_marginals(
         insertion exactly (:mod:`unstack.reasoner.summed_insertions`; a pilot run of an eighth
         of the budget, not kept, chooses them). Off by default: on classifier piles it has not
         yet beaten the pair record in the same time (docs page "Benchmarks").
+    revisits : bool
+        In groups of 9-63 boxes, re-insert the noisiest boxes more often than the others, by
+        the standard errors of a pilot run (the first eighth of the budget, kept;
+        :mod:`unstack.reasoner.revisits`); ``False``: every box in turn.
 
     Returns
     -------
@@ -512,6 +524,7 @@ def sampled_marginals(
         blocks=blocks,
         wide=wide,
         insertion_sums=insertion_sums,
+        revisits=revisits,
     )
 
 
@@ -543,6 +556,7 @@ def _sampled_marginals(
     warm: np.ndarray | None = None,
     wide: bool | None = None,
     insertion_sums: bool = False,
+    revisits: bool = True,
 ) -> SampledMarginals:
     """:func:`sampled_marginals` on checked arguments; ``warm``: consistent starting worlds,
     one per chain (skips the scattering sweep)."""
@@ -553,7 +567,7 @@ def _sampled_marginals(
     deadline = None if time_limit is None else start + time_limit
     per_chain = None if samples is None else -(-samples // chains)
     state = _Chains(p, chains=chains, seed=seed, burn_in=burn_in, tries=tries, blocks=blocks, start=warm, wide=wide)
-    choosing = insertion_sums and not state.wide and n > MOVES  # the pilot: the first part of the run
+    choosing = (insertion_sums or revisits) and not state.wide and n > MOVES  # the pilot: the first part of the run
     pilot_sweeps = None if per_chain is None else max(2 * _ROUND_SWEEPS, per_chain // PILOT_SHARE)
     pilot_deadline = None if deadline is None else time.perf_counter() + (deadline - time.perf_counter()) / PILOT_SHARE
 
@@ -588,7 +602,10 @@ def _sampled_marginals(
             )
         ):
             choosing = False
-            if _sum_noisiest_insertions(state, batches[:, :filled] / batch_length):
+            pilot = batches[:, :filled] / batch_length
+            if revisits:
+                _revisit_noisiest(state, pilot)
+            if insertion_sums and _sum_noisiest_insertions(state, pilot):
                 batches[:] = 0.0  # the pilot's records are not kept: the summed rows start afresh
                 batch_length, filled, partial, recorded = _ROUND_SWEEPS, 0, 0, 0
                 continue
@@ -632,7 +649,20 @@ def _sampled_marginals(
         block_of=block_of,
         link_rates=link_rates,
         summed_boxes=state.summed_boxes.copy(),
+        schedule=None if state.wide else state.schedule.copy(),
     )
+
+
+def _revisit_noisiest(state: _Chains, pilot: np.ndarray) -> None:
+    """Re-insert the boxes from now on by :func:`unstack.reasoner.revisits.schedule` of the
+    standard errors of their ECs (unit weights) in ``pilot``, the complete batch means so far
+    (``(chains, batches, n, n)``)."""
+    from unstack.reasoner.revisits import schedule
+
+    n = state.probabilities.shape[0]
+    costs = pilot.reshape(-1, n, n).sum(axis=2)
+    state.schedule = schedule(costs.std(axis=0, ddof=1) / np.sqrt(len(costs)))
+    state.cursors[:] = 0
 
 
 def _sum_noisiest_insertions(state: _Chains, pilot: np.ndarray) -> bool:
