@@ -52,8 +52,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--samples", type=int, default=50_000)
     args = parser.parse_args(argv)
     print(
-        f"python benchmarks/revisits.py {args.dataset} --piles {args.piles} --runs {args.runs} "
-        f"--samples {args.samples}"
+        f"python benchmarks/revisits.py {args.dataset} --piles {args.piles} --runs {args.runs} --samples {args.samples}"
     )
     model = load_model(default_model_path())
     for path in sorted(args.dataset.glob("config-*.json"))[: args.piles]:
