@@ -516,11 +516,13 @@ def _run_chain(
     block_of: np.ndarray,
     moves: int,
     cursors: np.ndarray,
+    schedule: np.ndarray,
 ) -> int:
     """Run ``sweeps`` sweeps of one chain; add the estimates when ``record``.
 
-    A sweep re-inserts ``moves`` boxes, the next ones in turn from ``cursors[chain]`` (all
-    boxes, in order, when ``moves == n``: the sweep of the one-word kernels)."""
+    A sweep re-inserts ``moves`` boxes, the next ones of ``schedule`` in turn from
+    ``cursors[chain]`` (all boxes, in order, when ``moves == n`` and the schedule is every box
+    once: the sweep of the one-word kernels)."""
     n = probabilities.shape[0]
     words = successors.shape[1]
     pair_sums = np.zeros(_STRIDE * _STRIDE)
@@ -536,8 +538,8 @@ def _run_chain(
     for _ in range(sweeps):
         _flip_pairs(probabilities, successors, predecessors, rng, chain)
         for _ in range(moves):
-            x = cursors[chain]
-            cursors[chain] = (x + 1) % n
+            x = schedule[cursors[chain]]
+            cursors[chain] = (cursors[chain] + 1) % schedule.shape[0]
             if _reinsert(
                 x, probabilities, log_present, log_absent, successors, predecessors, order, rng, chain, tries,
                 candidates_supported, candidates_supporters, log_ratios, scatter, scratch,
@@ -580,12 +582,15 @@ def run_chains(
     block_of: np.ndarray,
     moves: int,
     cursors: np.ndarray,
+    schedule: np.ndarray,
 ) -> None:
     """:func:`unstack.reasoner._sampler_kernels.run_chains` with ``(chains, n, words)`` states;
-    a sweep re-inserts ``moves`` boxes, in turn from ``cursors`` (``(chains,)``, updated)."""
+    a sweep re-inserts ``moves`` boxes, the next ones of ``schedule`` in turn from ``cursors``
+    (``(chains,)`` positions in it, updated)."""
     for c in prange(successors.shape[0]):
         accepted[c] += _run_chain(
             c, probabilities, log_present, log_absent, successors[c], predecessors[c], rng, sweeps, tries, record,
             sums[c], scatter, block_members, block_sizes, block_counts, block_masks, block_log_weights,
             block_linear_weights, block_cumulative, block_marginals, block_pairs, block_of, moves, cursors,
+            schedule,
         )  # fmt: skip

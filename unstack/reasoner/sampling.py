@@ -18,10 +18,11 @@ marginals are estimated by Markov chain Monte Carlo over the consistent worlds t
   re-insertion proposal is far less probable than the current world (dense matrices of
   20 boxes and more, where re-insertion alone stalled at an acceptance of 0);
 * a sweep is one pair pass, :data:`MOVES` re-insertions (the next boxes in turn; every box
-  in a group of up to 8; in groups of 9-63 boxes the noisiest boxes of a pilot run come round
-  more often, :mod:`unstack.reasoner.revisits`) and, after it, the record: each pair
-  contributes the probability of its relation *given all the other relations*: the pair's own ``p`` whenever both values
-  keep the world transitive, else the value transitivity leaves. This Rao-Blackwellisation
+  in a group of up to 8; in groups of more than 8 boxes the noisiest boxes of a pilot run
+  come round more often, :mod:`unstack.reasoner.revisits`) and, after it, the record: each
+  pair contributes the probability of its relation *given all the other relations*: the
+  pair's own ``p`` whenever both values keep the world transitive, else the value
+  transitivity leaves. This Rao-Blackwellisation
   removes the noise of the many pairs that transitivity does not touch (measured: it beats
   averaging the moved box's candidate relations, which was tried and dropped);
 * several chains run in parallel, each from its own random world (one sweep that takes
@@ -375,7 +376,7 @@ class _Chains:
         self.linear_weights = np.exp(self.blocks.log_weights)
         self.moves = _moves(n)
         self.cursors = np.zeros(chains, dtype=np.int64)
-        self.schedule = np.arange(n, dtype=np.int64)  # one-word kernels: the order of the re-insertions
+        self.schedule = np.arange(n, dtype=np.int64)  # the order of the re-insertions
         self.moves_done = 0
         self.sum_insertions(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64))
         if start is None:
@@ -418,7 +419,7 @@ class _Chains:
         )
         if self.wide:
             weights = (blocks.log_weights, self.linear_weights)
-            summing = ()
+            summing = (self.schedule,)
         with PARALLEL_KERNELS:
             self._run(
                 self.probabilities,
@@ -496,7 +497,7 @@ def sampled_marginals(
         of the budget, not kept, chooses them). Off by default: on classifier piles it has not
         yet beaten the pair record in the same time (docs page "Benchmarks").
     revisits : bool
-        In groups of 9-63 boxes, re-insert the noisiest boxes more often than the others, by
+        In groups of more than 8 boxes, re-insert the noisiest boxes more often than the others, by
         the standard errors of a pilot run (the first eighth of the budget, kept;
         :mod:`unstack.reasoner.revisits`); ``False``: every box in turn.
 
@@ -567,7 +568,8 @@ def _sampled_marginals(
     deadline = None if time_limit is None else start + time_limit
     per_chain = None if samples is None else -(-samples // chains)
     state = _Chains(p, chains=chains, seed=seed, burn_in=burn_in, tries=tries, blocks=blocks, start=warm, wide=wide)
-    choosing = (insertion_sums or revisits) and not state.wide and n > MOVES  # the pilot: the first part of the run
+    insertion_sums = insertion_sums and not state.wide
+    choosing = (insertion_sums or revisits) and n > MOVES  # the pilot: the first part of the run
     pilot_sweeps = None if per_chain is None else max(2 * _ROUND_SWEEPS, per_chain // PILOT_SHARE)
     pilot_deadline = None if deadline is None else time.perf_counter() + (deadline - time.perf_counter()) / PILOT_SHARE
 
@@ -649,7 +651,7 @@ def _sampled_marginals(
         block_of=block_of,
         link_rates=link_rates,
         summed_boxes=state.summed_boxes.copy(),
-        schedule=None if state.wide else state.schedule.copy(),
+        schedule=state.schedule.copy(),
     )
 
 
