@@ -26,15 +26,18 @@ def is_transitive(relation: np.ndarray) -> bool:
     return {(a, b) for a, b in closure.edges if a != b} == {(a, b) for a, b in graph.edges if a != b}
 
 
-def enumerated_row(world: np.ndarray, probabilities: np.ndarray, box: int) -> np.ndarray:
-    """Every way of putting ``box`` back into ``world``, weighed and checked one by one."""
+def enumerated_row(world: np.ndarray, probabilities: np.ndarray, box: int, free: list[int] | None = None) -> np.ndarray:
+    """Every way of putting ``box`` back into ``world`` (among the boxes of ``free`` only, when
+    given; the others then stay unlinked to it), weighed and checked one by one."""
     n = len(probabilities)
-    others = [y for y in range(n) if y != box]
+    others = [y for y in range(n) if y != box] if free is None else list(free)
     base = np.array(world, dtype=bool)
     np.fill_diagonal(base, False)
+    base[box, :] = False
+    base[:, box] = False
     total, held = 0.0, np.zeros(n)
-    for row in product([False, True], repeat=n - 1):
-        for column in product([False, True], repeat=n - 1):
+    for row in product([False, True], repeat=len(others)):
+        for column in product([False, True], repeat=len(others)):
             candidate = base.copy()
             candidate[box, others] = row
             candidate[others, box] = column

@@ -166,94 +166,62 @@ def _component(mask: Mask, masks: np.ndarray) -> Mask:
 
 
 @njit(cache=True, nogil=True)
-def _row(
-    allowed: Mask, masks: np.ndarray, factors: np.ndarray, table: np.ndarray, state: np.ndarray, store: np.ndarray
-) -> Mask:
-    """``G``: the slot of the sum over the down-sets inside ``allowed`` (-1: out of slots)."""
-    if allowed == 0:
-        return np.int64(0)
-    entry = _find(table, state[0], allowed, _ROW_TAG)
-    if table[entry, 3] == state[0]:
-        return int(table[entry, 2])
-    n = masks.shape[1]
-    part = _component(allowed, masks)
-    if part != allowed:
-        first = _row(part, masks, factors, table, state, store)
-        if first < 0:
-            return _EMPTY
-        second = _row(allowed & ~part, masks, factors, table, state, store)
-        if second < 0:
-            return _EMPTY
-        slot = _new_slot(state, store)
-        if slot < 0:
-            return _EMPTY
-        _mix(store, slot, first, store[second, n], second, store[first, n])
-        store[slot, n] = store[first, n] * store[second, n]
-    else:
-        y = _extreme(allowed, masks, 1)
-        taken = masks[2, y] & allowed
-        equivalent = taken & masks[3, y]
-        inside = _product(factors, 0, taken)
-        outside = _product(factors, 1, equivalent)
-        with_y = _row(allowed & ~taken, masks, factors, table, state, store)
-        if with_y < 0:
-            return _EMPTY
-        without_y = _row(allowed & ~equivalent, masks, factors, table, state, store)
-        if without_y < 0:
-            return _EMPTY
-        slot = _new_slot(state, store)
-        if slot < 0:
-            return _EMPTY
-        _mix(store, slot, with_y, inside, without_y, outside)
-        bits = taken
-        while bits:
-            store[slot, _lowest(bits)] += inside * store[with_y, n]
-            bits &= bits - 1
-    _store(table, state, allowed, _ROW_TAG, slot)
-    return slot
-
-
-@njit(cache=True, nogil=True)
-def _column(
-    candidates: Mask,
+def _side(
+    mask: Mask,
+    side: int,
     masks: np.ndarray,
     factors: np.ndarray,
     table: np.ndarray,
     state: np.ndarray,
     store: np.ndarray,
 ) -> Mask:
-    """``H``: the slot of the total weight of the up-sets inside ``candidates``."""
-    if candidates == 0:
+    """The slot of the sum over one side alone (-1: out of slots): ``side`` 0 is ``G``, the
+    down-sets inside ``mask`` (the boxes the box supports, with the weight holding each box),
+    1 is ``H``, the up-sets inside ``mask`` (the boxes supporting it, total weight only)."""
+    if mask == 0:
         return np.int64(0)
-    entry = _find(table, state[0], candidates, _COLUMN_TAG)
+    tag = _ROW_TAG if side == 0 else _COLUMN_TAG
+    entry = _find(table, state[0], mask, tag)
     if table[entry, 3] == state[0]:
         return int(table[entry, 2])
     n = masks.shape[1]
-    part = _component(candidates, masks)
-    if part != candidates:
-        first = _column(part, masks, factors, table, state, store)
+    part = _component(mask, masks)
+    if part != mask:
+        first = _side(part, side, masks, factors, table, state, store)
         if first < 0:
             return _EMPTY
-        second = _column(candidates & ~part, masks, factors, table, state, store)
+        second = _side(mask & ~part, side, masks, factors, table, state, store)
         if second < 0:
             return _EMPTY
-        total = store[first, n] * store[second, n]
+        slot = _new_slot(state, store)
+        if slot < 0:
+            return _EMPTY
+        if side == 0:
+            _mix(store, slot, first, store[second, n], second, store[first, n])
+        store[slot, n] = store[first, n] * store[second, n]
     else:
-        y = _extreme(candidates, masks, 0)
-        taken = masks[3, y] & candidates
-        equivalent = taken & masks[2, y]
-        with_y = _column(candidates & ~taken, masks, factors, table, state, store)
+        y = _extreme(mask, masks, 1 - side)  # G: a source, H: a sink
+        taken = masks[2 + side, y] & mask  # its closure (G) or co-closure (H) joins
+        equivalent = taken & masks[3 - side, y]  # or it leaves with the boxes equivalent to it
+        inside = _product(factors, 2 * side, taken)
+        outside = _product(factors, 2 * side + 1, equivalent)
+        with_y = _side(mask & ~taken, side, masks, factors, table, state, store)
         if with_y < 0:
             return _EMPTY
-        without_y = _column(candidates & ~equivalent, masks, factors, table, state, store)
+        without_y = _side(mask & ~equivalent, side, masks, factors, table, state, store)
         if without_y < 0:
             return _EMPTY
-        total = _product(factors, 2, taken) * store[with_y, n] + _product(factors, 3, equivalent) * store[without_y, n]
-    slot = _new_slot(state, store)
-    if slot < 0:
-        return _EMPTY
-    store[slot, n] = total
-    _store(table, state, candidates, _COLUMN_TAG, slot)
+        slot = _new_slot(state, store)
+        if slot < 0:
+            return _EMPTY
+        if side == 0:
+            _mix(store, slot, with_y, inside, without_y, outside)
+            bits = taken
+            while bits:
+                store[slot, _lowest(bits)] += inside * store[with_y, n]
+                bits &= bits - 1
+        store[slot, n] = inside * store[with_y, n] + outside * store[without_y, n]
+    _store(table, state, mask, tag, slot)
     return slot
 
 
@@ -283,10 +251,10 @@ def _joint(
             break
         left &= left - 1
     if unconstrained:
-        up = _column(candidates, masks, factors, table, state, store)
+        up = _side(candidates, 1, masks, factors, table, state, store)
         if up < 0:
             return _EMPTY
-        down = _row(allowed, masks, factors, table, state, store)
+        down = _side(allowed, 0, masks, factors, table, state, store)
         if down < 0:
             return _EMPTY
         slot = _new_slot(state, store)
