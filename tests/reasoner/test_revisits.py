@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -21,6 +23,13 @@ def test_schedule_holds_every_box_its_visits_times(errors: list[float]) -> None:
     order = schedule(standard_errors)
     assert np.all((counts >= 1) & (counts <= MAX_VISITS))
     np.testing.assert_array_equal(np.bincount(order, minlength=len(errors)), counts)
+
+
+def test_a_tiny_reference_error_gives_the_most_visits_without_a_warning() -> None:
+    errors = np.array([1.0, 1e-300, 1e-300, 1e-300, 1e-300])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert visits(errors).tolist() == [MAX_VISITS, 1, 1, 1, 1]
 
 
 def test_no_error_anywhere_keeps_every_box_once_in_order() -> None:

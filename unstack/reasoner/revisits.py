@@ -54,7 +54,8 @@ def visits(standard_errors: np.ndarray) -> np.ndarray:
     reference = float(np.quantile(errors, REFERENCE_QUANTILE)) if len(errors) else 0.0
     if not reference > 0.0:
         return np.ones(len(errors), dtype=np.int64)
-    counts: np.ndarray = np.clip(np.round((errors / reference) ** 2), 1, MAX_VISITS).astype(np.int64)
+    ratios = np.minimum(errors, np.sqrt(MAX_VISITS) * reference) / reference  # no overflow for tiny references
+    counts: np.ndarray = np.clip(np.round(ratios**2), 1, MAX_VISITS).astype(np.int64)
     return counts
 
 
