@@ -111,8 +111,8 @@ MOVES = 8
 RARE_SWEEPS = 30
 #: Sweeps per chain discarded before recording.
 DEFAULT_BURN_IN = 64
-#: The pilot run that picks the boxes whose insertion is summed takes this share of the
-#: budget (one eighth; its sweeps are kept only when no box is chosen).
+#: The pilot run that chooses the revisit schedule (and the boxes whose insertion is summed)
+#: takes one this-th of the budget; its records are kept unless a box's insertion is summed.
 PILOT_SHARE = 8
 #: Sweeps per chain in one round of the anytime loop (one call of the compiled kernel).
 _ROUND_SWEEPS = 16
