@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from unstack.reasoner._insertion_sum_kernels import insertion_row
+from unstack.reasoner._insertion_sum_kernels import _lowest, insertion_row
 
 _MULTIPLIER = np.uint64(0x2545F4914F6CDD1D)
 _SHIFT_A = np.uint64(12)
@@ -624,9 +624,9 @@ def _run_chain(
 
     A sweep re-inserts ``moves`` boxes, the next ones of ``schedule`` (each box once, in
     order, unless some are visited more often) in turn from ``cursors[chain]`` (every box
-    when ``moves == n`` and the schedule is every box once). The rows of ``summed_boxes`` are recorded every
-    :data:`SUM_STRIDE` sweeps (from the first) by summing their insertion inside ``free_sets``
-    (:func:`_add_insertion_row`, one workspace per chain)."""
+    when ``moves == n`` and the schedule is every box once). The rows of ``summed_boxes``
+    are recorded every :data:`SUM_STRIDE` sweeps (from the first) by summing their insertion
+    inside ``free_sets`` (:func:`_add_insertion_row`, one workspace per chain)."""
     n = probabilities.shape[0]
     pair_sums = np.zeros(_STRIDE * _STRIDE)
     order = np.empty(n, dtype=np.int64)
@@ -719,11 +719,7 @@ def _add_insertion_row(
     else:
         bits = successors[box] & ~(np.int64(1) << box)
         while bits:
-            low = bits & -bits
-            j = 0
-            while (np.int64(1) << j) != low:
-                j += 1
-            sums[box, j] += SUM_STRIDE
+            sums[box, _lowest(bits)] += SUM_STRIDE
             bits &= bits - 1
         sum_stats[1] += 1
 

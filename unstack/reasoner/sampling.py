@@ -57,6 +57,7 @@ import numpy as np
 
 from unstack.errors import InvalidArgument
 from unstack.reasoner.arguments import check_budget, check_count, check_matrix, check_seed
+from unstack.reasoner.revisits import schedule
 from unstack.reasoner.world_masks import ONE_WORD_BOXES, mask_words, pack, unpack
 from unstack.threads import PARALLEL_KERNELS
 
@@ -604,10 +605,12 @@ def _sampled_marginals(
             )
         ):
             choosing = False
-            pilot = batches[:, :filled] / batch_length
+            pilot = (batches[:, :filled] / batch_length).reshape(-1, n, n)  # the complete batch means so far
+            variances = pilot.sum(axis=2).var(axis=0, ddof=1) / len(pilot)  # each box's EC, unit weights
             if revisits:
-                _revisit_noisiest(state, pilot)
-            if insertion_sums and _sum_noisiest_insertions(state, pilot):
+                state.schedule = schedule(np.sqrt(variances))
+                state.cursors[:] = 0
+            if insertion_sums and _sum_noisiest_insertions(state, pilot.mean(axis=0), variances):
                 batches[:] = 0.0  # the pilot's records are not kept: the summed rows start afresh
                 batch_length, filled, partial, recorded = _ROUND_SWEEPS, 0, 0, 0
                 continue
@@ -655,22 +658,10 @@ def _sampled_marginals(
     )
 
 
-def _revisit_noisiest(state: _Chains, pilot: np.ndarray) -> None:
-    """Re-insert the boxes from now on by :func:`unstack.reasoner.revisits.schedule` of the
-    standard errors of their ECs (unit weights) in ``pilot``, the complete batch means so far
-    (``(chains, batches, n, n)``)."""
-    from unstack.reasoner.revisits import schedule
-
-    n = state.probabilities.shape[0]
-    costs = pilot.reshape(-1, n, n).sum(axis=2)
-    state.schedule = schedule(costs.std(axis=0, ddof=1) / np.sqrt(len(costs)))
-    state.cursors[:] = 0
-
-
-def _sum_noisiest_insertions(state: _Chains, pilot: np.ndarray) -> bool:
+def _sum_noisiest_insertions(state: _Chains, marginals: np.ndarray, variances: np.ndarray) -> bool:
     """Choose the boxes whose rows the chains record from now on by summing their insertion
-    (:mod:`unstack.reasoner.summed_insertions`) from ``pilot``, the complete batch means so far
-    (``(chains, batches, n, n)``); whether any was chosen."""
+    (:mod:`unstack.reasoner.summed_insertions`) from a pilot's ``marginals`` and the
+    ``variances`` of its ECs; whether any was chosen."""
     from unstack.reasoner import summed_insertions
     from unstack.reasoner._insertion_sum_kernels import insertion_row, workspace
     from unstack.reasoner._sampler_kernels import SUM_STRIDE
@@ -678,9 +669,6 @@ def _sum_noisiest_insertions(state: _Chains, pilot: np.ndarray) -> bool:
     sum_row: Callable[..., bool] = insertion_row
     n = state.probabilities.shape[0]
     chains = len(state.rng)
-    batch_means = pilot.reshape(-1, n, n)
-    marginals = batch_means.mean(axis=0)
-    variances = batch_means.sum(axis=2).var(axis=0, ddof=1) / len(batch_means)  # each box's EC, unit weights
     eligible = state.blocks.block_of < 0
     free = summed_insertions.free_sets(marginals, np.arange(n))
     costs = np.full(n, np.inf)
