@@ -114,3 +114,36 @@ def test_the_shipped_extended_model_loads_and_was_split_by_pile() -> None:
     assert model.metadata["training"]["split_by"] == "configuration"
     rows = np.random.default_rng(0).normal(size=(3, 36))
     assert model.support_probability(rows).shape == (3,)
+
+
+def openmp_threads() -> list[int]:
+    from threadpoolctl import threadpool_info
+
+    return [info["num_threads"] for info in threadpool_info() if info["user_api"] == "openmp"]
+
+
+def test_a_prediction_runs_on_the_calling_thread_alone_and_restores_its_openmp_limit() -> None:
+    from sklearn.ensemble import HistGradientBoostingClassifier  # loads scikit-learn's OpenMP runtime
+    from sklearn.linear_model import LogisticRegression
+    from threadpoolctl import threadpool_limits
+
+    class ThreadRecordingClassifier(LogisticRegression):
+        """A real classifier that notes the OpenMP limits in force while it predicts."""
+
+        def predict_proba(self, features: np.ndarray) -> np.ndarray:  # type: ignore[override]
+            self.threads_seen_ = openmp_threads()
+            return super().predict_proba(features)
+
+    rng = np.random.default_rng(3)
+    features = rng.normal(size=(60, 19))
+    labels = (features[:, 0] > 0).astype(int)
+    estimator = ThreadRecordingClassifier().fit(features, labels)
+    model = SupportModel(estimator=estimator, features=FeatureSettings(), metadata={})
+    with threadpool_limits(limits=2, user_api="openmp"):  # the tests run with OMP_NUM_THREADS=1
+        before = openmp_threads()
+        probabilities = model.support_probability(features)
+        after = openmp_threads()
+    assert before == [2] * len(before) and before, f"no OpenMP runtime ({HistGradientBoostingClassifier.__name__})"
+    assert estimator.threads_seen_ == [1] * len(before)
+    assert after == before
+    assert np.array_equal(probabilities, LogisticRegression().fit(features, labels).predict_proba(features)[:, 1])

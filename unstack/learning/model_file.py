@@ -34,6 +34,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from unstack.atomic import atomic_write_bytes
 from unstack.errors import InvalidFile
@@ -45,6 +46,7 @@ __all__ = [
     "DEFAULT_MODEL",
     "DEFAULT_MODEL_NAME",
     "MODEL_FORMAT",
+    "PREDICT_OPENMP_THREADS",
     "RANGE_MARGIN",
     "InvalidModel",
     "SupportModel",
@@ -56,6 +58,13 @@ __all__ = [
 ]
 
 MODEL_FORMAT = "unstack.model/1"
+#: OpenMP threads a prediction may use. scikit-learn's gradient boosting predicts tree by tree,
+#: each tree a parallel loop over all cores: where a core is busy (a planner's other threads,
+#: another process), every loop waits for a descheduled thread. Measured on the default model,
+#: 930 pairs (a 31-box scene), 2 cores with one of them busy: 0.93-1.01 s with 2 threads, 0.004 s
+#: with 1. OpenMP limits are per thread (libgomp, libomp), so the limit covers the calling
+#: thread's prediction only and is restored after it.
+PREDICT_OPENMP_THREADS = 1
 #: File name of the model shipped with the package (``unstack/learning/models``).
 #: Models shipped with the package, by the name ``--model`` accepts: ``general`` (the
 #: default: gradient boosting on the pose-only general features, trained on five pile
@@ -159,11 +168,13 @@ class SupportModel:
         ]
 
     def support_probability(self, features: np.ndarray) -> np.ndarray:
-        """P(SUPP) for each row of ``F_XY``."""
+        """P(SUPP) for each row of ``F_XY``, on the calling thread alone (see
+        :data:`PREDICT_OPENMP_THREADS`)."""
         if len(features) == 0:
             return np.zeros(0)
         classes = list(self.estimator.classes_)
-        probability: np.ndarray = self.estimator.predict_proba(features)[:, classes.index(1)]
+        with threadpool_limits(limits=PREDICT_OPENMP_THREADS, user_api="openmp"):
+            probability: np.ndarray = self.estimator.predict_proba(features)[:, classes.index(1)]
         return probability
 
 
