@@ -1,5 +1,5 @@
 """The shipped model's prediction with 1 OpenMP thread (what unstack uses) and with every core,
-on a quiet machine and with one core kept busy by another process (a planner's other work).
+on a quiet machine and beside other work (a planner's: :mod:`neighbours`).
 
 scikit-learn's gradient boosting predicts tree by tree, each tree one OpenMP parallel loop; when
 a core is busy every loop waits for a descheduled thread. One run measures both settings on the
@@ -8,7 +8,7 @@ same feature rows (all ordered pairs of the boxes of a scene), alternating, best
 
 Usage::
 
-    python benchmarks/prediction_threads.py examples/pile5.scene.json --repeat 7
+    python benchmarks/prediction_threads.py examples/pile5.scene.json --repeat 7 --busy 0,1,2,4,omp
 
 (every box of the scene, detected or not: 37 boxes, 1,332 pairs).
 """
@@ -16,27 +16,20 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import multiprocessing
 import os
 import statistics
 import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
 
+import neighbours
 import numpy as np
 from threadpoolctl import threadpool_limits
 
 from unstack.learning.features import pair_features
 from unstack.learning.model_file import default_model_path, load_model
 from unstack.scene import load_scene
-
-
-def spin(stop: Any) -> None:
-    """Keep one core busy until ``stop`` is set."""
-    while not stop.is_set():
-        sum(range(10_000))
 
 
 def timings(
@@ -55,6 +48,12 @@ def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("scene", type=Path)
     parser.add_argument("--repeat", type=int, default=7)
+    parser.add_argument(
+        "--busy",
+        type=lambda text: text.split(","),
+        default=["0", "1", "2", "4", "omp"],
+        help="comma-separated loads beside it (benchmarks/neighbours.py)",
+    )
     args = parser.parse_args(argv)
     model = load_model(default_model_path())
     scene = load_scene(args.scene)
@@ -64,28 +63,22 @@ def main(argv: list[str]) -> int:
     predict = model.estimator.predict_proba
     predict(rows)  # warm-up
     cores = os.cpu_count() or 1
-    print(f"python benchmarks/prediction_threads.py {args.scene} --repeat {args.repeat}")
+    print(f"python benchmarks/prediction_threads.py {args.scene} --repeat {args.repeat} --busy {','.join(args.busy)}")
     print(f"{len(rows)} pairs, {cores} cores, load average {os.getloadavg()[0]:.2f}")
-    print("| other core | 1 thread: best / median | all cores: best / median | median ratio |")
+    print("| load beside it | 1 thread: best / median | all cores: best / median | median ratio |")
     print("|---|---:|---:|---:|")
-    for busy in (False, True):
-        stop = multiprocessing.Event()
-        spinner = multiprocessing.Process(target=spin, args=(stop,)) if busy else None
-        if spinner is not None:
-            spinner.start()
-            time.sleep(0.5)
+    for busy in args.busy:
+        running = neighbours.start(busy)
         try:
             one, every = [], []
             for _ in range(args.repeat):
                 one += timings(predict, rows, 1, 1)
                 every += timings(predict, rows, None, 1)
         finally:
-            if spinner is not None:
-                stop.set()
-                spinner.join()
+            neighbours.stop(*running)
         ratio = statistics.median(every) / statistics.median(one)
         print(
-            f"| {'busy' if busy else 'idle'} | {min(one) * 1e3:.1f} / {statistics.median(one) * 1e3:.1f} ms "
+            f"| {busy} | {min(one) * 1e3:.1f} / {statistics.median(one) * 1e3:.1f} ms "
             f"| {min(every) * 1e3:.1f} / {statistics.median(every) * 1e3:.1f} ms | {ratio:.1f} |"
         )
     return 0

@@ -1,8 +1,8 @@
 """Decisions from several Python threads at once equal the serial ones and never abort.
 
-numba's parallel kernels (the sampler, the DBAF and contact-feature counts) run under one
-lock (:mod:`unstack.threads`); the exact walk runs GIL-free kernels on threads of its own;
-the table path and everything in Python run concurrently.
+Every compiled kernel (the sampler's chains, the exact walk, the DBAF and contact-feature
+counts) runs GIL-free on threads of its call (:mod:`unstack.threads`); numba's threading layer
+is never started, so a decision leaves the process as it found it.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import unstack
-from unstack.threads import PARALLEL_KERNELS, map_on_threads
+from unstack.threads import even_ranges, map_on_threads
 
 pytestmark = pytest.mark.slow  # runs decisions in four threads
 
@@ -53,11 +53,67 @@ def test_four_threads_give_the_serial_answers(examples: Path) -> None:
     assert concurrent == serial * 3
 
 
-def test_the_kernel_lock_is_reentrant_and_released() -> None:
-    with PARALLEL_KERNELS, PARALLEL_KERNELS:
-        unstack.decide(_dense(7, 0), method="exact")
-    assert PARALLEL_KERNELS.acquire(blocking=False)
-    PARALLEL_KERNELS.release()
+_NUMBERS_OF_A_RUN = """
+import hashlib, sys
+import numpy as np
+import unstack
+from unstack.reasoner.sampling import sampled_marginals
+rng = np.random.default_rng(7)
+digest = hashlib.sha256()
+for n, samples in ((40, 2048), (70, 256)):  # one-word and word-array kernels
+    p = rng.uniform(0.0, 0.3, (n, n)); np.fill_diagonal(p, 0.0)
+    result = sampled_marginals(p, samples=samples, seed=3)
+    digest.update(result.marginals.tobytes()); digest.update(result.standard_errors.tobytes())
+scene = unstack.load_scene(sys.argv[1])
+digest.update(unstack.support_probabilities(scene, "extended").probabilities.tobytes())  # DBAF and contact counts
+print(digest.hexdigest())
+"""
+
+
+def test_the_numbers_do_not_depend_on_the_number_of_threads(examples: Path) -> None:
+    import os
+    import subprocess
+    import sys
+
+    digests = set()
+    for threads in ("1", "2", "3"):
+        environment = {**os.environ, "NUMBA_NUM_THREADS": threads}
+        command = [sys.executable, "-c", _NUMBERS_OF_A_RUN, str(examples / "pile5.scene.json")]
+        digests.add(subprocess.run(command, env=environment, capture_output=True, text=True, check=True).stdout)
+    assert len(digests) == 1
+
+
+def test_a_decision_starts_no_threading_layer_and_leaves_multiprocessing_alone(examples: Path) -> None:
+    import subprocess
+    import sys
+
+    program = f"""
+import multiprocessing, threading
+import numpy as np
+import unstack
+from numba.np.ufunc import parallel
+dense = np.random.default_rng(0).uniform(0.05, 0.95, (20, 20)); np.fill_diagonal(dense, 0.0)
+unstack.decide(unstack.Supports([f"b{{i}}" for i in range(20)], dense), seed=3, samples=1024)
+unstack.decide(unstack.Supports([f"b{{i}}" for i in range(7)], dense[:7, :7]), method="exact")
+unstack.decide(unstack.load_scene({str(examples / "pile5.scene.json")!r}), model="extended")
+assert not parallel._is_initialized, "numba's threading layer was started"
+assert multiprocessing.get_start_method(allow_none=True) is None, "the start method was fixed"
+multiprocessing.set_start_method("spawn")
+assert not [t.name for t in threading.enumerate() if t.name.startswith("unstack-")], "threads left running"
+print("ok")
+"""
+    result = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert result.stdout.strip() == "ok"
+
+
+def test_even_ranges_cover_every_item_once() -> None:
+    for items in range(0, 12):
+        for parts in range(1, 6):
+            ranges = even_ranges(items, parts)
+            assert [i for first, last in ranges for i in range(first, last)] == list(range(items))
+            assert len(ranges) == max(1, min(parts, items))
+            assert max(last - first for first, last in ranges) - min(last - first for first, last in ranges) <= 1
 
 
 def test_map_on_threads_keeps_the_order_and_uses_numbas_threads() -> None:

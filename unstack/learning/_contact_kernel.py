@@ -9,9 +9,9 @@ points one by one. Counts are exact (no point is dropped or counted twice).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
-from unstack.threads import PARALLEL_KERNELS
+from unstack.threads import even_ranges, map_on_threads, thread_count
 
 
 def column_index(points: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -25,7 +25,7 @@ def column_index(points: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarra
     return np.ascontiguousarray(points[order]), starts.astype(np.int64), origin, shape.astype(np.int64)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True)
 def _counts_in_boxes(
     points: np.ndarray,
     starts: np.ndarray,
@@ -34,12 +34,14 @@ def _counts_in_boxes(
     cell: float,
     low: np.ndarray,
     high: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover
-    """Points with ``low <= p <= high`` in each query box, and the highest z among them (-inf if none)."""
-    boxes = low.shape[0]
-    counts = np.zeros(boxes, dtype=np.int64)
-    top = np.full(boxes, -np.inf)
-    for q in prange(boxes):
+    first: int,
+    last: int,
+    counts: np.ndarray,
+    top: np.ndarray,
+) -> None:  # pragma: no cover
+    """Points with ``low <= p <= high`` in the query boxes ``first`` to ``last - 1``, and the highest z
+    among them (-inf if none), into ``counts`` and ``top``."""
+    for q in range(first, last):
         if low[q, 0] > high[q, 0] or low[q, 1] > high[q, 1] or low[q, 2] > high[q, 2]:
             continue
         first_x = max(int(np.floor((low[q, 0] - origin[0]) / cell)), 0)
@@ -71,7 +73,6 @@ def _counts_in_boxes(
                         highest = max(highest, z)
         counts[q] = count
         top[q] = highest
-    return counts, top
 
 
 def counts_in_boxes(
@@ -83,7 +84,14 @@ def counts_in_boxes(
     low: np.ndarray,
     high: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The compiled counts, holding :data:`unstack.threads.PARALLEL_KERNELS` (safe from any thread)."""
-    with PARALLEL_KERNELS:
-        counts, top = _counts_in_boxes(points, starts, origin, shape, cell, low, high)
+    """The compiled counts of every query box, the boxes shared out over
+    :func:`unstack.threads.thread_count` threads (each box counted whole by one thread)."""
+    boxes = low.shape[0]
+    counts = np.zeros(boxes, dtype=np.int64)
+    top = np.full(boxes, -np.inf)
+    ranges = even_ranges(boxes, thread_count())
+    map_on_threads(
+        lambda part: _counts_in_boxes(points, starts, origin, shape, cell, low, high, *ranges[part], counts, top),
+        range(len(ranges)),
+    )
     return counts, top

@@ -3,18 +3,17 @@
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
-from unstack.threads import PARALLEL_KERNELS
+from unstack.threads import even_ranges, map_on_threads, thread_count
 
 
-@njit(cache=True, parallel=True, fastmath=False)
+@njit(cache=True, nogil=True, fastmath=False)
 def _gaussian_sums(
-    points: np.ndarray, queries: np.ndarray, inverse_two_variance: float
-) -> np.ndarray:  # pragma: no cover
-    """``sum_k exp(-||q - p_k||^2 * inverse_two_variance)`` for every query point q."""
-    sums = np.zeros(queries.shape[0])
-    for q in prange(queries.shape[0]):
+    points: np.ndarray, queries: np.ndarray, inverse_two_variance: float, first: int, last: int, sums: np.ndarray
+) -> None:  # pragma: no cover
+    """``sums[q] = sum_k exp(-||q - p_k||^2 * inverse_two_variance)`` for the query points ``first`` to ``last - 1``."""
+    for q in range(first, last):
         qx, qy, qz = queries[q, 0], queries[q, 1], queries[q, 2]
         total = 0.0
         for k in range(points.shape[0]):
@@ -23,11 +22,14 @@ def _gaussian_sums(
             dz = points[k, 2] - qz
             total += np.exp(-(dx * dx + dy * dy + dz * dz) * inverse_two_variance)
         sums[q] = total
-    return sums
 
 
 def gaussian_sums(points: np.ndarray, queries: np.ndarray, inverse_two_variance: float) -> np.ndarray:
-    """The compiled sum, holding :data:`unstack.threads.PARALLEL_KERNELS` (safe from any thread)."""
-    with PARALLEL_KERNELS:
-        sums: np.ndarray = _gaussian_sums(points, queries, inverse_two_variance)
+    """The compiled sum for every query point, the queries shared out over :func:`unstack.threads.thread_count`
+    threads (each sum is computed whole by one thread: the same numbers on any number of threads)."""
+    sums = np.zeros(queries.shape[0])
+    ranges = even_ranges(queries.shape[0], thread_count())
+    map_on_threads(
+        lambda part: _gaussian_sums(points, queries, inverse_two_variance, *ranges[part], sums), range(len(ranges))
+    )
     return sums

@@ -29,7 +29,7 @@ depend on how the chains are spread over threads.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from unstack.reasoner._insertion_sum_kernels import _lowest, insertion_row
 
@@ -724,8 +724,10 @@ def _add_insertion_row(
         sum_stats[1] += 1
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@njit(cache=True, nogil=True)
 def run_chains(
+    first: int,
+    last: int,
     probabilities: np.ndarray,
     log_present: np.ndarray,
     log_absent: np.ndarray,
@@ -733,6 +735,7 @@ def run_chains(
     predecessors: np.ndarray,
     rng: np.ndarray,
     sweeps: int,
+    rounds: int,
     tries: int,
     record: bool,
     sums: np.ndarray,
@@ -756,13 +759,18 @@ def run_chains(
     workspaces: tuple[np.ndarray, ...],
     sum_stats: np.ndarray,
 ) -> None:
-    """Advance every chain by ``sweeps`` sweeps (chains run in parallel).
+    """Advance chains ``first`` to ``last - 1`` by ``sweeps`` sweeps, one after the other.
+
+    A plain ``nogil`` kernel: the caller runs ranges of chains on its own threads
+    (:func:`unstack.threads.map_on_threads`), not numba's parallel loop, whose OpenMP workers
+    spin while they wait and took 3-10 times longer when another process kept a core busy.
 
     ``log_present``/``log_absent``: ``log p`` and ``log(1 - p)`` (``-inf`` at 0);
 
     ``successors``/``predecessors``: ``(chains, n)`` bit masks, updated in place;
-    ``rng``: ``(chains,)`` uint64 states; ``sums``: ``(chains, n, n)``, the conditionals
-    of every recorded sweep are added; ``scatter``: take every first proposal (to spread
+    ``rng``: ``(chains,)`` uint64 states; ``rounds`` rounds of ``sweeps`` sweeps each; ``sums``:
+    ``(chains, rounds, n, n)``, the conditionals of every recorded sweep of round ``r`` are added to
+    ``sums[:, r]``; ``scatter``: take every first proposal (to spread
     the starting worlds of the chains);
     ``accepted``: ``(chains,)`` counts of moves that changed the state;
     ``block_*``: the blocks redrawn exactly after every sweep
@@ -774,42 +782,43 @@ def run_chains(
     ``workspaces``: the arrays of :func:`~unstack.reasoner._insertion_sum_kernels.workspace`
     plus a row, each with a leading chain axis; ``sum_stats``: ``(chains, 3)`` counts.
     """
-    for c in prange(successors.shape[0]):
-        accepted[c] += _run_chain(
-            c,
-            probabilities,
-            log_present,
-            log_absent,
-            successors[c],
-            predecessors[c],
-            rng,
-            sweeps,
-            tries,
-            record,
-            sums[c],
-            scatter,
-            block_members,
-            block_sizes,
-            block_counts,
-            block_masks,
-            block_log_weights,
-            block_cumulative,
-            block_marginals,
-            block_pairs,
-            block_of,
-            moves,
-            cursors,
-            schedule,
-            summed_boxes,
-            free_sets,
-            summed_rows,
-            (
-                workspaces[0][c],
-                workspaces[1][c],
-                workspaces[2][c],
-                workspaces[3][c],
-                workspaces[4][c],
-                workspaces[5][c],
-            ),
-            sum_stats[c],
-        )
+    for c in range(first, last):
+        for r in range(rounds):
+            accepted[c] += _run_chain(
+                c,
+                probabilities,
+                log_present,
+                log_absent,
+                successors[c],
+                predecessors[c],
+                rng,
+                sweeps,
+                tries,
+                record,
+                sums[c, r],
+                scatter,
+                block_members,
+                block_sizes,
+                block_counts,
+                block_masks,
+                block_log_weights,
+                block_cumulative,
+                block_marginals,
+                block_pairs,
+                block_of,
+                moves,
+                cursors,
+                schedule,
+                summed_boxes,
+                free_sets,
+                summed_rows,
+                (
+                    workspaces[0][c],
+                    workspaces[1][c],
+                    workspaces[2][c],
+                    workspaces[3][c],
+                    workspaces[4][c],
+                    workspaces[5][c],
+                ),
+                sum_stats[c],
+            )

@@ -15,7 +15,7 @@ word operations against ``n ** 2`` for the one-word kernels.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from unstack.reasoner._sampler_kernels import _STRIDE, _uniform
 
@@ -556,8 +556,10 @@ def _run_chain(
     return accepted
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@njit(cache=True, nogil=True)
 def run_chains(
+    first: int,
+    last: int,
     probabilities: np.ndarray,
     log_present: np.ndarray,
     log_absent: np.ndarray,
@@ -565,6 +567,7 @@ def run_chains(
     predecessors: np.ndarray,
     rng: np.ndarray,
     sweeps: int,
+    rounds: int,
     tries: int,
     record: bool,
     sums: np.ndarray,
@@ -584,13 +587,15 @@ def run_chains(
     cursors: np.ndarray,
     schedule: np.ndarray,
 ) -> None:
-    """:func:`unstack.reasoner._sampler_kernels.run_chains` with ``(chains, n, words)`` states;
+    """:func:`unstack.reasoner._sampler_kernels.run_chains` (chains ``first`` to ``last - 1``) with
+    ``(chains, n, words)`` states; ``rounds`` and ``sums`` ``(chains, rounds, n, n)`` as there;
     a sweep re-inserts ``moves`` boxes, the next ones of ``schedule`` in turn from ``cursors``
     (``(chains,)`` positions in it, updated)."""
-    for c in prange(successors.shape[0]):
-        accepted[c] += _run_chain(
-            c, probabilities, log_present, log_absent, successors[c], predecessors[c], rng, sweeps, tries, record,
-            sums[c], scatter, block_members, block_sizes, block_counts, block_masks, block_log_weights,
-            block_linear_weights, block_cumulative, block_marginals, block_pairs, block_of, moves, cursors,
-            schedule,
-        )  # fmt: skip
+    for c in range(first, last):
+        for r in range(rounds):
+            accepted[c] += _run_chain(
+                c, probabilities, log_present, log_absent, successors[c], predecessors[c], rng, sweeps, tries,
+                record, sums[c, r], scatter, block_members, block_sizes, block_counts, block_masks,
+                block_log_weights, block_linear_weights, block_cumulative, block_marginals, block_pairs, block_of,
+                moves, cursors, schedule,
+            )  # fmt: skip

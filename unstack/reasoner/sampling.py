@@ -50,6 +50,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
@@ -59,7 +60,7 @@ from unstack.errors import InvalidArgument
 from unstack.reasoner.arguments import check_budget, check_count, check_matrix, check_seed
 from unstack.reasoner.revisits import schedule
 from unstack.reasoner.world_masks import ONE_WORD_BOXES, mask_words, pack, unpack
-from unstack.threads import PARALLEL_KERNELS
+from unstack.threads import even_ranges, thread_count
 
 __all__ = [
     "DEFAULT_CHAINS",
@@ -117,6 +118,36 @@ DEFAULT_BURN_IN = 64
 PILOT_SHARE = 8
 #: Sweeps per chain in one round of the anytime loop (one call of the compiled kernel).
 _ROUND_SWEEPS = 16
+#: Rounds run by one call of the kernel on each thread (fewer hand-overs between threads), at most,
+#: and the memory their records may take.
+_MAX_ROUNDS = 8
+_ROUND_BYTES = 1 << 25
+
+
+def _rounds_to_run(
+    most: int, recorded: int, sweep_targets: list[int | None], deadlines: list[float | None], round_seconds: float
+) -> int:
+    """Rounds of :data:`_ROUND_SWEEPS` sweeps for the next call of the kernel: at most ``most``, none
+    past the next of ``sweep_targets`` (sweeps per chain: the budget, the end of the pilot), and
+    none expected to end after the next of ``deadlines`` (one round while ``round_seconds`` is
+    unknown). At least one.
+
+    Examples
+    --------
+    >>> _rounds_to_run(8, 32, [200, 64], [None, None], 0.0)  # the pilot ends after two more rounds
+    2
+    """
+    rounds = most
+    for target in sweep_targets:
+        if target is not None and target > recorded:
+            rounds = min(rounds, -(-(target - recorded) // _ROUND_SWEEPS))
+    now = time.perf_counter()
+    for deadline in deadlines:
+        if deadline is not None:
+            rounds = min(rounds, int((deadline - now) / round_seconds) if round_seconds > 0 else 1)
+    return max(1, rounds)
+
+
 #: Batches kept per chain; when full, neighbours merge (batch length doubles).
 _MAX_BATCHES = 32
 
@@ -372,20 +403,27 @@ class _Chains:
         self.rng = _chain_seeds(seed, chains)
         self.tries = tries
         self.accepted = np.zeros(chains, dtype=np.int64)
-        self.sums = np.zeros((chains, n, n))
+        self.max_rounds = max(1, min(_MAX_ROUNDS, _ROUND_BYTES // (8 * chains * n * n)))
+        self.sums = np.zeros((chains, self.max_rounds, n, n))
         self.blocks = block_tables(probabilities, strong_blocks(probabilities) if blocks else [])
         self.linear_weights = np.exp(self.blocks.log_weights)
         self.moves = _moves(n)
         self.cursors = np.zeros(chains, dtype=np.int64)
         self.schedule = np.arange(n, dtype=np.int64)  # the order of the re-insertions
         self.moves_done = 0
+        self._threads: int | None = None  # threads of the chains, chosen at the first round
+        self._pool: ThreadPoolExecutor | None = None
         self.sum_insertions(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64))
-        if start is None:
-            self.advance(1, scatter=True)
-        else:
-            self.successors[:] = start
-            self.predecessors[:] = _transposed(start, n, wide=self.wide)
-        self.advance(burn_in)
+        try:
+            if start is None:
+                self.advance(1, scatter=True)
+            else:
+                self.successors[:] = start
+                self.predecessors[:] = _transposed(start, n, wide=self.wide)
+            self.advance(burn_in)
+        except BaseException:  # an error or Ctrl-C in the burn-in: no threads left behind
+            self.close()
+            raise
 
     def sum_insertions(self, boxes: np.ndarray, free_sets: np.ndarray, *, slots: int = 1) -> None:
         """Record the rows of ``boxes`` by summing their insertion inside ``free_sets`` (bit
@@ -400,14 +438,15 @@ class _Chains:
         self.workspaces = chain_workspaces(len(self.rng), n, slots)
         self.sum_stats = np.zeros((len(self.rng), 3), dtype=np.int64)
 
-    def advance(self, sweeps: int, *, record: bool = False, scatter: bool = False) -> None:
-        """Run every chain ``sweeps`` sweeps; with ``record`` the conditionals go to ``sums``.
+    def advance(self, sweeps: int, *, record: bool = False, scatter: bool = False, rounds: int = 1) -> None:
+        """Run every chain ``rounds`` times ``sweeps`` sweeps; with ``record`` the conditionals of
+        round ``r`` go to ``sums[:, r]``.
 
         A sweep re-inserts :data:`MOVES` boxes in turn, :data:`WIDE_MOVES` in a group of more
         than 63 boxes, every box in a smaller group (the scattering sweep re-inserts every box).
         """
         moves = self.probabilities.shape[0] if scatter else self.moves
-        self.moves_done += len(self.rng) * sweeps * moves
+        self.moves_done += len(self.rng) * sweeps * rounds * moves
         blocks = self.blocks
         weights: tuple[np.ndarray, ...] = (blocks.log_weights,)
         summing: tuple[Any, ...] = (
@@ -421,32 +460,59 @@ class _Chains:
         if self.wide:
             weights = (blocks.log_weights, self.linear_weights)
             summing = (self.schedule,)
-        with PARALLEL_KERNELS:
-            self._run(
-                self.probabilities,
-                *self.log_tables,
-                self.successors,
-                self.predecessors,
-                self.rng,
-                sweeps,
-                self.tries,
-                record,
-                self.sums,
-                self.accepted,
-                scatter,
-                blocks.members,
-                blocks.sizes,
-                blocks.counts,
-                blocks.masks,
-                *weights,
-                blocks.cumulative,
-                blocks.marginals,
-                blocks.pairs,
-                blocks.block_of,
-                moves,
-                self.cursors,
-                *summing,
-            )
+        arguments = (
+            self.probabilities,
+            *self.log_tables,
+            self.successors,
+            self.predecessors,
+            self.rng,
+            sweeps,
+            rounds,
+            self.tries,
+            record,
+            self.sums,
+            self.accepted,
+            scatter,
+            blocks.members,
+            blocks.sizes,
+            blocks.counts,
+            blocks.masks,
+            *weights,
+            blocks.cumulative,
+            blocks.marginals,
+            blocks.pairs,
+            blocks.block_of,
+            moves,
+            self.cursors,
+            *summing,
+        )
+        if self._threads is None:  # the first round: the threads of this run
+            self._threads = min(thread_count(), len(self.rng))
+            if self._threads > 1:  # the calling thread runs the first range itself
+                self._pool = ThreadPoolExecutor(self._threads - 1, thread_name_prefix="unstack-chains")
+        ranges = even_ranges(len(self.rng), self._threads)
+        if self._pool is None:
+            for first, last in ranges:
+                self._run(first, last, *arguments)
+        else:
+            futures = [self._pool.submit(self._run, first, last, *arguments) for first, last in ranges[1:]]
+            try:
+                self._run(*ranges[0], *arguments)
+            finally:
+                for future in futures:
+                    future.result()
+
+    def close(self) -> None:
+        """Stop the threads of the chains (if any were started)."""
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+        self._pool = None
+
+    def __enter__(self) -> _Chains:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.close()
 
 
 def sampled_marginals(
@@ -569,93 +635,106 @@ def _sampled_marginals(
     deadline = None if time_limit is None else start + time_limit
     per_chain = None if samples is None else -(-samples // chains)
     state = _Chains(p, chains=chains, seed=seed, burn_in=burn_in, tries=tries, blocks=blocks, start=warm, wide=wide)
-    insertion_sums = insertion_sums and not state.wide
-    choosing = (insertion_sums or revisits) and n > MOVES  # the pilot: the first part of the run
-    pilot_sweeps = None if per_chain is None else max(2 * _ROUND_SWEEPS, per_chain // PILOT_SHARE)
-    pilot_deadline = None if deadline is None else time.perf_counter() + (deadline - time.perf_counter()) / PILOT_SHARE
+    try:
+        insertion_sums = insertion_sums and not state.wide
+        choosing = (insertion_sums or revisits) and n > MOVES  # the pilot: the first part of the run
+        pilot_sweeps = None if per_chain is None else max(2 * _ROUND_SWEEPS, per_chain // PILOT_SHARE)
+        pilot_deadline = (
+            None if deadline is None else time.perf_counter() + (deadline - time.perf_counter()) / PILOT_SHARE
+        )
 
-    batches = np.zeros((chains, _MAX_BATCHES, n, n))
-    batch_length = _ROUND_SWEEPS  # sweeps per chain in one batch
-    filled = 0  # complete batches per chain
-    partial = 0  # sweeps per chain in the open batch
-    recorded = 0  # sweeps per chain
-    round_seconds = 0.0
-    while True:
-        round_start = time.perf_counter()
-        state.sums[:] = 0.0
-        state.advance(_ROUND_SWEEPS, record=True)
-        round_seconds = time.perf_counter() - round_start
-        batches[:, filled] += state.sums
-        partial += _ROUND_SWEEPS
-        recorded += _ROUND_SWEEPS
-        if partial == batch_length:
-            filled += 1
-            partial = 0
-            if filled == _MAX_BATCHES:
-                batches[:, : _MAX_BATCHES // 2] = batches[:, 0::2] + batches[:, 1::2]
-                batches[:, _MAX_BATCHES // 2 :] = 0.0
-                filled = _MAX_BATCHES // 2
-                batch_length *= 2
-        if (
-            choosing
-            and filled >= 2
-            and (
-                (pilot_sweeps is not None and recorded >= pilot_sweeps)
-                or (pilot_deadline is not None and time.perf_counter() >= pilot_deadline)
+        batches = np.zeros((chains, _MAX_BATCHES, n, n))
+        batch_length = _ROUND_SWEEPS  # sweeps per chain in one batch
+        filled = 0  # complete batches per chain
+        partial = 0  # sweeps per chain in the open batch
+        recorded = 0  # sweeps per chain
+        round_seconds = 0.0
+        while True:
+            rounds = _rounds_to_run(
+                state.max_rounds,
+                recorded,
+                [per_chain, pilot_sweeps if choosing else None],
+                [deadline, pilot_deadline if choosing else None],
+                round_seconds,
             )
-        ):
-            choosing = False
-            pilot = (batches[:, :filled] / batch_length).reshape(-1, n, n)  # the complete batch means so far
-            variances = pilot.sum(axis=2).var(axis=0, ddof=1) / len(pilot)  # each box's EC, unit weights
-            if revisits:
-                state.schedule = schedule(np.sqrt(variances))
-                state.cursors[:] = 0
-            if insertion_sums and _sum_noisiest_insertions(state, pilot.mean(axis=0), variances):
-                batches[:] = 0.0  # the pilot's records are not kept: the summed rows start afresh
-                batch_length, filled, partial, recorded = _ROUND_SWEEPS, 0, 0, 0
-                continue
-        if per_chain is not None and recorded >= per_chain:
-            break
-        if deadline is not None and time.perf_counter() + round_seconds >= deadline and filled >= 2:
-            break  # the next round would end after the deadline
+            call_start = time.perf_counter()
+            state.sums[:, :rounds] = 0.0
+            state.advance(_ROUND_SWEEPS, record=True, rounds=rounds)
+            round_seconds = (time.perf_counter() - call_start) / rounds
+            for r in range(rounds):
+                batches[:, filled] += state.sums[:, r]
+                partial += _ROUND_SWEEPS
+                recorded += _ROUND_SWEEPS
+                if partial == batch_length:
+                    filled += 1
+                    partial = 0
+                    if filled == _MAX_BATCHES:
+                        batches[:, : _MAX_BATCHES // 2] = batches[:, 0::2] + batches[:, 1::2]
+                        batches[:, _MAX_BATCHES // 2 :] = 0.0
+                        filled = _MAX_BATCHES // 2
+                        batch_length *= 2
+            if (
+                choosing
+                and filled >= 2
+                and (
+                    (pilot_sweeps is not None and recorded >= pilot_sweeps)
+                    or (pilot_deadline is not None and time.perf_counter() >= pilot_deadline)
+                )
+            ):
+                choosing = False
+                pilot = (batches[:, :filled] / batch_length).reshape(-1, n, n)  # the complete batch means so far
+                variances = pilot.sum(axis=2).var(axis=0, ddof=1) / len(pilot)  # each box's EC, unit weights
+                if revisits:
+                    state.schedule = schedule(np.sqrt(variances))
+                    state.cursors[:] = 0
+                if insertion_sums and _sum_noisiest_insertions(state, pilot.mean(axis=0), variances):
+                    batches[:] = 0.0  # the pilot's records are not kept: the summed rows start afresh
+                    batch_length, filled, partial, recorded = _ROUND_SWEEPS, 0, 0, 0
+                    continue
+            if per_chain is not None and recorded >= per_chain:
+                break
+            if deadline is not None and time.perf_counter() + round_seconds >= deadline and filled >= 2:
+                break  # the next round would end after the deadline
 
-    totals = batches.sum(axis=1)  # every recorded sweep, including the open batch
-    marginals = totals.sum(axis=0) / (chains * recorded)
-    batch_marginals = batches[:, :filled].reshape(chains * filled, n, n) / batch_length
-    full_share = (filled * batch_length) / recorded
-    error_scale = float(np.sqrt(full_share / (chains * filled)))
-    spread = batch_marginals.std(axis=0, ddof=1) if len(batch_marginals) > 1 else np.zeros((n, n))
-    np.fill_diagonal(marginals, 0.0)
-    block_of = state.blocks.block_of
-    link_rates = np.array(
-        [
-            marginals[block_of == k][:, block_of != k].sum() + marginals[block_of != k][:, block_of == k].sum()
-            for k in range(len(state.blocks.sizes))
-        ]
-    )
-    standard_errors = spread * error_scale
-    for inside, scale in _rare_blocks(block_of, link_rates, chains * recorded):  # the floor of the pairs inside
-        pairs = np.ix_(inside, inside)
-        standard_errors[pairs] = np.maximum(standard_errors[pairs], scale)
-    np.fill_diagonal(standard_errors, 0.0)
-    moves = state.moves_done  # the scattering sweep, burn-in and recorded sweeps
-    return SampledMarginals(
-        marginals=marginals,
-        standard_errors=standard_errors,
-        batch_marginals=batch_marginals,
-        error_scale=error_scale,
-        chains=chains,
-        samples=chains * recorded,
-        burn_in=burn_in,
-        acceptance=float(state.accepted.sum() / moves) if moves else 1.0,
-        seed=seed,
-        seconds=time.perf_counter() - start,
-        final_worlds=state.successors.copy(),
-        block_of=block_of,
-        link_rates=link_rates,
-        summed_boxes=state.summed_boxes.copy(),
-        schedule=state.schedule.copy(),
-    )
+        totals = batches.sum(axis=1)  # every recorded sweep, including the open batch
+        marginals = totals.sum(axis=0) / (chains * recorded)
+        batch_marginals = batches[:, :filled].reshape(chains * filled, n, n) / batch_length
+        full_share = (filled * batch_length) / recorded
+        error_scale = float(np.sqrt(full_share / (chains * filled)))
+        spread = batch_marginals.std(axis=0, ddof=1) if len(batch_marginals) > 1 else np.zeros((n, n))
+        np.fill_diagonal(marginals, 0.0)
+        block_of = state.blocks.block_of
+        link_rates = np.array(
+            [
+                marginals[block_of == k][:, block_of != k].sum() + marginals[block_of != k][:, block_of == k].sum()
+                for k in range(len(state.blocks.sizes))
+            ]
+        )
+        standard_errors = spread * error_scale
+        for inside, scale in _rare_blocks(block_of, link_rates, chains * recorded):  # the floor of the pairs inside
+            pairs = np.ix_(inside, inside)
+            standard_errors[pairs] = np.maximum(standard_errors[pairs], scale)
+        np.fill_diagonal(standard_errors, 0.0)
+        moves = state.moves_done  # the scattering sweep, burn-in and recorded sweeps
+        return SampledMarginals(
+            marginals=marginals,
+            standard_errors=standard_errors,
+            batch_marginals=batch_marginals,
+            error_scale=error_scale,
+            chains=chains,
+            samples=chains * recorded,
+            burn_in=burn_in,
+            acceptance=float(state.accepted.sum() / moves) if moves else 1.0,
+            seed=seed,
+            seconds=time.perf_counter() - start,
+            final_worlds=state.successors.copy(),
+            block_of=block_of,
+            link_rates=link_rates,
+            summed_boxes=state.summed_boxes.copy(),
+            schedule=state.schedule.copy(),
+        )
+    finally:
+        state.close()
 
 
 def _sum_noisiest_insertions(state: _Chains, marginals: np.ndarray, variances: np.ndarray) -> bool:
@@ -737,9 +816,9 @@ def sample_worlds(
     check_count(thin, "thin")
     _check_sampling(None, None, seed, burn_in=burn_in, tries=tries)
     n = p.shape[0]
-    state = _Chains(p, chains=1, seed=seed, burn_in=burn_in, tries=tries)
     draws = np.zeros((worlds, n, n), dtype=bool)
-    for k in range(worlds):
-        state.advance(thin)
-        draws[k] = unpack(state.successors[0], n, wide=state.wide)
+    with _Chains(p, chains=1, seed=seed, burn_in=burn_in, tries=tries) as state:
+        for k in range(worlds):
+            state.advance(thin)
+            draws[k] = unpack(state.successors[0], n, wide=state.wide)
     return draws
