@@ -115,6 +115,17 @@ BAD_SUPPORTS = [
         supports_document(masses=[1, 2]), r"\$\.masses: expected 3 numbers, got shape \(2,\)", id="masses-length"
     ),
     pytest.param(supports_document(extra=1), r"\$: unexpected key 'extra'", id="unknown-key"),
+    pytest.param(
+        supports_document(masses=[1, 2, 1e308]), r"\$\.masses\[2\]: expected a number <= 10000, got 1e\+308", id="mass"
+    ),
+    pytest.param(
+        supports_document(heights=[0, 0.4, -5]), r"\$\.heights\[2\]: expected a number >= -1, got -5", id="height"
+    ),
+    pytest.param(
+        supports_document(hidden_load=[0, 1e6, 0]),
+        r"\$\.hidden_load\[1\]: expected a number <= 1000, got 1000000",
+        id="hidden-load",
+    ),
 ]
 
 
@@ -194,6 +205,11 @@ BAD_SCENES = [
         r"\$\.ground_truth\.support\[1\]\[1\]: expected 0 on the diagonal, got 1.0",
         id="truth-diagonal",
     ),
+    pytest.param(
+        {k: v for k, v in scene_document(points_file="cloud.txt").items() if k != "points"},
+        r"\$\.points_file: expected a \.npy or \.ply file name, got 'cloud.txt'",
+        id="points-file-suffix",
+    ),
 ]
 
 
@@ -260,3 +276,19 @@ def test_scene_round_trip_and_ground_truth(tmp_path: Path) -> None:
 def test_bundled_examples_load(examples: Path) -> None:
     for path in sorted(examples.glob("*.json")):
         assert unstack.load(path) is not None
+
+
+def test_a_key_given_twice_is_refused_not_overwritten(tmp_path: Path) -> None:
+    path = tmp_path / "twice.json"
+    text = json.dumps(supports_document())
+    path.write_text(text[:-1] + ', "objects": ["x", "y", "z"]}')
+    with pytest.raises(InvalidFile, match=rf"^{path}: \$: the key 'objects' appears twice in one JSON object$"):
+        load_supports(path)
+
+
+def test_a_complex_point_cloud_is_refused(tmp_path: Path) -> None:
+    np.save(tmp_path / "cloud.npy", np.ones((4, 3), dtype=complex))
+    document = {k: v for k, v in scene_document(points_file="cloud.npy").items() if k != "points"}
+    path = write(tmp_path, document)
+    with pytest.raises(InvalidFile, match=r"\$\.points_file: expected real numbers, got dtype complex128"):
+        load_scene(path)

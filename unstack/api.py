@@ -141,6 +141,9 @@ def load_model(name_or_path: str | os.PathLike[str] | None = None) -> SupportMod
     if isinstance(name_or_path, str) and name in model_file.BUNDLED_MODELS:
         path = model_file.bundled_model_path(name)
         return _shipped(path, f"shipped:{path.name}")
+    if isinstance(name_or_path, str) and not os.path.exists(name) and os.sep not in name and "." not in name:
+        shipped = ", ".join(model_names())
+        raise model_file.InvalidModel(name, "$", f"no shipped model and no file of that name (shipped: {shipped})")
     return _remember(model_file.load_model(name), name)
 
 

@@ -135,7 +135,12 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     'done'
     """
     target = check_output_path(path)
-    handle, name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=f".tmp{target.suffix}", dir=target.parent)
+    try:
+        handle, name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=f".tmp{target.suffix}", dir=target.parent)
+    except OSError as error:  # a folder that looks writable but is not (/proc, a full disk)
+        from unstack.errors import InvalidArgument
+
+        raise InvalidArgument(f"{path}: cannot write there: {error.strerror or error}") from None
     os.close(handle)
     temporary = Path(name)
     try:

@@ -218,8 +218,8 @@ def check_points(
             raise error(source, path, "expected an N x 3 array of numbers") from None
     if array.ndim != 2 or array.shape[1] != 3:
         raise error(source, path, f"expected an N x 3 array of points, got shape {array.shape}")
-    if not np.issubdtype(array.dtype, np.number):
-        raise error(source, path, f"expected numbers, got dtype {array.dtype}")
+    if not np.issubdtype(array.dtype, np.number) or np.issubdtype(array.dtype, np.complexfloating):
+        raise error(source, path, f"expected real numbers, got dtype {array.dtype}")
     points = np.ascontiguousarray(array, dtype=np.float64)
     bad = np.argwhere(~np.isfinite(points))
     if bad.size:

@@ -117,6 +117,22 @@ def _get(data: Any, path: list[str | int]) -> Any:
     return data
 
 
+class _DuplicateKey(Exception):
+    def __init__(self, key: str) -> None:
+        super().__init__(key)
+        self.key = key
+
+
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """A JSON object's dict; a key given twice is refused rather than the last one kept silently."""
+    data: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in data:
+            raise _DuplicateKey(key)
+        data[key] = value
+    return data
+
+
 def read_document(path: str | os.PathLike[str]) -> Document:
     """Read a JSON document from a file (``"-"`` reads standard input).
 
@@ -142,7 +158,8 @@ def read_document(path: str | os.PathLike[str]) -> Document:
         if sys.stdin is None or sys.stdin.closed:
             raise InvalidFile(source, "$", "standard input is closed; give a file name or pipe a document in")
         try:
-            text = sys.stdin.read()
+            raw = getattr(sys.stdin, "buffer", None)  # bytes, decoded as UTF-8 like a file
+            text = raw.read().decode("utf-8") if raw is not None else sys.stdin.read()
         except (OSError, ValueError, UnicodeDecodeError) as error:
             raise InvalidFile(source, "$", f"cannot read standard input: {error}") from None
     else:
@@ -157,7 +174,9 @@ def read_document(path: str | os.PathLike[str]) -> Document:
             raise InvalidFile(source, "$", f"cannot read the file: {error}") from None
         base_dir = file.resolve().parent
     try:
-        data = json.loads(text)
+        data = json.loads(text, object_pairs_hook=_unique_keys)
+    except _DuplicateKey as error:
+        raise InvalidFile(source, "$", f"the key {error.key!r} appears twice in one JSON object") from None
     except json.JSONDecodeError as error:
         raise InvalidFile(
             source, "$", f"invalid JSON at line {error.lineno} column {error.colno}: {error.msg}"
@@ -183,6 +202,10 @@ def load_schema(format_tag: str) -> dict[str, Any]:
     text = resources.files("unstack.schemas").joinpath(FORMATS[format_tag]).read_text("utf-8")
     schema: dict[str, Any] = json.loads(text)
     return schema
+
+
+#: What the schemas' string patterns ask for, in words.
+_PATTERNS = {r"\.(npy|ply)$": "a .npy or .ply file name"}
 
 
 def _describe(error: Any) -> str:
@@ -220,6 +243,9 @@ def _describe(error: Any) -> str:
         return f"expected {_short(expected)}, got {_short(instance)}"
     if validator == "enum":
         return f"expected one of {', '.join(_short(e) for e in expected)}, got {_short(instance)}"
+    if validator == "pattern":
+        wanted = _PATTERNS.get(expected, f"a string matching {expected!r}")
+        return f"expected {wanted}, got {_short(instance)}"
     if validator == "oneOf" and isinstance(instance, dict):
         options = [sorted(option.get("required", [])) for option in expected]
         return "expected exactly one of " + " or ".join("/".join(option) for option in options if option)

@@ -186,3 +186,30 @@ def test_warm_up_reports_each_kernel() -> None:
         "wide sampler",
     ]
     assert result.stdout.startswith("warm-up: done in ")
+
+
+def test_standard_input_that_is_not_utf8_is_refused_like_a_file(examples: Path) -> None:
+    document = (examples / "pile5.supports.json").read_text().replace('"top_left"', '"caf\u00e9"', 1)
+    result = subprocess.run(
+        [sys.executable, "-m", "unstack", "decide", "-"],
+        input=document.encode("latin-1"),
+        capture_output=True,
+        cwd=REPO,
+        timeout=120,
+    )
+    text = subprocess.CompletedProcess(result.args, result.returncode, result.stdout.decode(), result.stderr.decode())
+    one_line_error(text, "<stdin>: $: cannot read standard input: 'utf-8' codec can't decode")
+
+
+def test_an_unknown_model_name_lists_the_shipped_ones(examples: Path) -> None:
+    result = unstack("decide", str(examples / "pile5.scene.json"), "--model", "nosuchmodel")
+    one_line_error(
+        result, "nosuchmodel: $: no shipped model and no file of that name (shipped: general, paper, extended)"
+    )
+
+
+def test_an_output_the_system_refuses_names_the_output_not_a_temporary_file() -> None:
+    target = Path("/proc/unstack-decision.json")
+    result = unstack("decide", PILE5, "--output", str(target))
+    one_line_error(result, f"{target}: cannot write there:")
+    assert ".tmp" not in result.stderr

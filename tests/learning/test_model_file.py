@@ -147,3 +147,39 @@ def test_a_prediction_runs_on_the_calling_thread_alone_and_restores_its_openmp_l
     assert estimator.threads_seen_ == [1] * len(before)
     assert after == before
     assert np.array_equal(probabilities, LogisticRegression().fit(features, labels).predict_proba(features)[:, 1])
+
+
+def _unusable_models() -> dict[str, tuple[object, dict[str, object] | None]]:
+    """Classifiers that load but cannot give P(SUPP) for the 19 paper features (name: estimator, metadata)."""
+    from sklearn.linear_model import LogisticRegression
+
+    rng = np.random.default_rng(5)
+    rows, labels = rng.normal(size=(40, 19)), np.r_[np.zeros(20), np.ones(20)].astype(int)
+    nan_coefficients = LogisticRegression().fit(rows, labels)
+    nan_coefficients.coef_[:] = np.nan
+    return {
+        "never fitted": (LogisticRegression(), None),
+        "three features": (LogisticRegression().fit(rows[:, :3], labels), None),
+        "classes 0 and 2": (LogisticRegression().fit(rows, 2 * labels), None),
+        "predicts NaN": (nan_coefficients, None),
+        "ranges of other features": (LogisticRegression().fit(rows, labels), {"feature_ranges": {"bogus": [0, 1]}}),
+    }
+
+
+@pytest.mark.parametrize(
+    ("case", "message"),
+    [
+        ("never fitted", r"\$.estimator: expected a fitted classifier, got one that was never fitted"),
+        ("three features", r"\$.estimator: expected a classifier of the 19 paper features, got one of 3"),
+        ("classes 0 and 2", r"\$.estimator: expected the classes 0 and 1 \(1: supports\), got 0, 2"),
+        ("predicts NaN", r"\$.estimator: expected probabilities in \[0, 1\], the model gave nan"),
+        ("ranges of other features", r"\$.metadata.feature_ranges: expected a \[low, high\] range for each of: "),
+    ],
+)
+def test_a_model_that_loads_but_cannot_predict_is_refused_in_one_line(tmp_path: Path, case: str, message: str) -> None:
+    estimator, metadata = _unusable_models()[case]
+    path = tmp_path / "model.skops"
+    save_model(SupportModel(estimator, FeatureSettings(), metadata or {}), path)
+    with pytest.raises(InvalidModel, match=message) as caught:
+        load_model(path)
+    assert str(caught.value).startswith(str(path)) and "\n" not in str(caught.value)

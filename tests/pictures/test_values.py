@@ -20,7 +20,7 @@ def test_values_are_checked() -> None:
         DecisionValues(["a", "b"], [1, 2], choice="c")
     with pytest.raises(InvalidArgument, match="the order must list distinct boxes"):
         DecisionValues(["a", "b"], [1, 2], order=["a", "a"])
-    with pytest.raises(InvalidArgument, match=r"expected an 2 x 2 probability matrix, got shape \(3, 3\)"):
+    with pytest.raises(InvalidArgument, match=r"expected a 2 x 2 probability matrix, got shape \(3, 3\)"):
         DecisionValues(["a", "b"], [1, 2], probabilities=np.zeros((3, 3)))
 
 

@@ -32,6 +32,18 @@ def test_bad_time_limits_are_refused(call: Callable[..., Any], budget: Any) -> N
         call(PAIR, time_limit=budget)
 
 
+@pytest.mark.parametrize("call", [decide, unloading_plan])
+def test_a_time_limit_beyond_a_day_is_refused(call: Callable[..., Any]) -> None:
+    with pytest.raises(InvalidArgument, match=r"time_limit must be at most 86,400 seconds \(a day\), got 100,000"):
+        call(PAIR, time_limit=1e5)
+
+
+@pytest.mark.parametrize("samples", [10**8 + 1, 10**20])
+def test_more_samples_than_the_largest_budget_are_refused_at_once(samples: int) -> None:
+    with pytest.raises(InvalidArgument, match=r"samples must be at most 100,000,000 .* give a time limit"):
+        decide(PAIR, samples=samples)
+
+
 @pytest.mark.parametrize("samples", [0, -5, 2.5, float("nan"), True])
 def test_bad_sample_counts_are_refused(samples: Any) -> None:
     with pytest.raises(InvalidArgument, match="samples must be"):
@@ -86,9 +98,12 @@ def test_sample_worlds_and_choose_check_their_arguments() -> None:
 
 @settings(deadline=None, max_examples=60)
 @given(st.floats(allow_nan=True, allow_infinity=True) | st.integers(-(2**70), 2**70))
-def test_a_budget_is_used_exactly_when_positive_and_finite(budget: float) -> None:
-    if math.isfinite(budget) and budget > 0:
+def test_a_budget_is_used_exactly_when_positive_finite_and_at_most_a_day(budget: float) -> None:
+    if math.isfinite(budget) and 0 < budget <= 86_400:
         assert decide(PAIR, method="approx", time_limit=budget, samples=64, seed=0).choice == "a"
+    elif math.isfinite(budget) and budget > 0:
+        with pytest.raises(InvalidArgument, match="time_limit must be at most 86,400 seconds"):
+            decide(PAIR, time_limit=budget)
     else:
         with pytest.raises(InvalidArgument, match="time_limit must be a positive, finite number"):
             decide(PAIR, time_limit=budget)

@@ -161,5 +161,7 @@ def test_a_short_run_on_a_real_pile_warns_that_chains_disagree(repo: Path) -> No
     short = decide(supports, samples=500, seed=0)
     assert short.sampling is not None and short.sampling["rhat_max"] > 1.1
     assert "the chains disagree" in short.sampling["warning"]
+    assert short.sampling["warning"] in short.warnings  # with the decision's warnings, printed by the CLI
     longer = decide(supports, samples=8_000, seed=0)
     assert longer.sampling is not None and "warning" not in longer.sampling
+    assert not any("chains disagree" in warning for warning in longer.warnings)

@@ -103,7 +103,8 @@ def table1(out: str, max_n: int, full: bool) -> None:
               help="pairs: the paper's split of the relations; configuration: whole piles on one side.")  # fmt: skip
 @click.option("--features", "feature_set", type=click.Choice(list(FEATURE_SETS)), default="paper",
               show_default=True, help=FEATURES_HELP)  # fmt: skip
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets, split and folds.")
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Seed of the ISets, split and folds.")  # fmt: skip
 @click.option("--cv", type=int, default=10, show_default=True, help="Cross-validation folds.")
 @click.option("--jobs", type=int, default=1, show_default=True, help="Parallel processes.")
 @click.option("--full", is_flag=True, help="Insist on the paper's size: at least 200 configurations, 10 folds.")
@@ -179,7 +180,7 @@ def fig5a(
 @click.option("--isets", type=int, default=50, show_default=True, help="Test ISets (the paper: 493).")
 @click.option("--isets-from", "draw", type=click.Choice(list(ISET_DRAWS)), default="random",
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets.")
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Seed of the ISets.")
 @click.option("--full", is_flag=True, help="The paper's size: 493 test ISets (overrides --isets).")
 @click.option("--pair-with", "pair_with", type=click.Path(dir_okay=False), default=None,
               help="decisions.json of an earlier run on the same ISets (another model, say): "

@@ -117,7 +117,8 @@ def _examples(
               help="Show each ISet its cloud as another sensor might: sparser, noisier, with holes.")  # fmt: skip
 @click.option("--pose-noise", type=click.FloatRange(0.0, 0.1), default=0.0, show_default=True,
               help="Show each ISet its boxes as a detector reports them: errors of this many metres.")  # fmt: skip
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the ISets, the split and the folds.")
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Seed of the ISets, the split and the folds.")  # fmt: skip
 @click.option("--split-by", type=click.Choice(list(SPLITS)), default="pairs", show_default=True,
               help="pairs: the paper's split of the relations; configuration: whole piles on one side.")  # fmt: skip
 @click.option("--cv", type=int, default=10, show_default=True, help="Cross-validation folds on the training part.")
@@ -207,7 +208,7 @@ def train(
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
 @click.option("--pose-noise", type=click.FloatRange(0.0, 0.1), default=0.0, show_default=True,
               help="Score on boxes as a detector reports them: errors of this many metres.")  # fmt: skip
-@click.option("--seed", type=int, default=1, show_default=True, help="Seed of the ISets.")
+@click.option("--seed", type=click.IntRange(min=0), default=1, show_default=True, help="Seed of the ISets.")
 @click.option("--jobs", type=int, default=1, show_default=True, help="Parallel processes.")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
 @click.option("--reliability", type=click.Path(dir_okay=False), default=None, help="Write a reliability diagram PNG.")

@@ -38,7 +38,7 @@ def parse_box_range(text: str) -> tuple[int, int]:
 @click.option("--boxes", default=None, help="Boxes per configuration: COUNT or LOW-HIGH (default: the family's).")
 @click.option("--sizes", type=click.Choice(list(SIZE_SETS)), default=None,
               help="Box size set (default: the family's).")  # fmt: skip
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the data set.")
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Seed of the data set.")
 @click.option("--out", "out", required=True, type=click.Path(), help="Folder of the data set (created; resumable).")
 @click.option("--jobs", type=int, default=1, show_default=True, help="Worker processes on this machine.")
 @click.option("--scheduler", default=None, help="Address of a dask.distributed scheduler to run the tasks on.")

@@ -104,11 +104,14 @@ class SupportModel:
     metadata : dict
         ``learner``, ``best_params``, ``cv_score``, ``validation`` metrics, ``training``
         (data set fingerprint, seed, r, ISets) and versions.
+    source : str
+        Where it was read from, for the messages of :class:`InvalidModel`.
     """
 
     estimator: Any
     features: FeatureSettings
     metadata: dict[str, Any]
+    source: str = "the model"
 
     @classmethod
     def from_classifier(
@@ -173,8 +176,14 @@ class SupportModel:
         if len(features) == 0:
             return np.zeros(0)
         classes = list(self.estimator.classes_)
-        with threadpool_limits(limits=PREDICT_OPENMP_THREADS, user_api="openmp"):
-            probability: np.ndarray = self.estimator.predict_proba(features)[:, classes.index(1)]
+        try:
+            with threadpool_limits(limits=PREDICT_OPENMP_THREADS, user_api="openmp"):
+                probability: np.ndarray = self.estimator.predict_proba(features)[:, classes.index(1)]
+        except (ValueError, TypeError, AttributeError, IndexError) as error:  # not a model of these features
+            raise InvalidModel(self.source, "$.estimator", f"cannot predict P(SUPP): {error}") from error
+        if not np.all((probability >= 0.0) & (probability <= 1.0)):  # NaN fails too
+            bad = probability[~((probability >= 0.0) & (probability <= 1.0))][0]
+            raise InvalidModel(self.source, "$.estimator", f"expected probabilities in [0, 1], the model gave {bad}")
         return probability
 
 
@@ -254,7 +263,46 @@ def load_model(path: str | os.PathLike[str]) -> SupportModel:
         raise InvalidModel(source, "$.metadata", f"expected the model's metadata and estimator: {error}") from error
     if not hasattr(estimator, "predict_proba"):
         raise InvalidModel(source, "$.estimator", "expected a fitted classifier with predict_proba")
-    return SupportModel(estimator, features, metadata)
+    model = SupportModel(estimator, features, metadata, source=source)
+    _check_usable(model)
+    return model
+
+
+def _check_usable(model: SupportModel) -> None:
+    """Refuse, in one line, a model that loads but cannot give P(SUPP) for this feature set: never
+    fitted, without the class 1, made for another number of features, with feature ranges of
+    other features, or predicting something other than probabilities (one row at the middle
+    of the feature ranges, or zeros)."""
+    from unstack.learning.features import feature_names
+
+    source, estimator = model.source, model.estimator
+    names = feature_names(model.features)
+    classes = getattr(estimator, "classes_", None)
+    if classes is None:
+        raise InvalidModel(source, "$.estimator", "expected a fitted classifier, got one that was never fitted")
+    if 1 not in [int(label) for label in classes if isinstance(label, int | np.integer | bool | np.bool_)]:
+        labels = ", ".join(str(label) for label in classes)
+        raise InvalidModel(source, "$.estimator", f"expected the classes 0 and 1 (1: supports), got {labels}")
+    width = getattr(estimator, "n_features_in_", None)
+    if width is not None and int(width) != len(names):
+        raise InvalidModel(
+            source,
+            "$.estimator",
+            f"expected a classifier of the {len(names)} {model.features.feature_set} features, got one of {width}",
+        )
+    ranges = model.metadata.get("feature_ranges")
+    if ranges is not None:
+        if not isinstance(ranges, dict) or sorted(ranges) != sorted(names):
+            raise InvalidModel(
+                source, "$.metadata.feature_ranges", f"expected a [low, high] range for each of: {', '.join(names)}"
+            )
+        try:
+            middle = np.array([[(float(ranges[name][0]) + float(ranges[name][1])) / 2 for name in names]])
+        except (TypeError, ValueError, IndexError) as error:
+            raise InvalidModel(source, "$.metadata.feature_ranges", f"expected [low, high] numbers: {error}") from error
+    else:
+        middle = np.zeros((1, len(names)))
+    model.support_probability(middle)
 
 
 def default_model_path() -> Path:

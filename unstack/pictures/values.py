@@ -101,7 +101,7 @@ class DecisionValues:
         if probabilities is not None:
             matrix = np.asarray(probabilities, dtype=np.float64)
             if matrix.shape != (n, n):
-                raise InvalidArgument(f"{source}: expected an {n} x {n} probability matrix, got shape {matrix.shape}")
+                raise InvalidArgument(f"{source}: expected a {n} x {n} probability matrix, got shape {matrix.shape}")
         known = set(ids)
         if choice is not None and choice not in known:
             raise InvalidArgument(f"{source}: the choice {choice!r} is not one of the boxes")
@@ -236,7 +236,7 @@ def read_decision_values(path: str | os.PathLike[str]) -> DecisionValues:
             )
     marginals = data["marginals"]
     if len(marginals) != n or any(len(row) != n for row in marginals):
-        raise InvalidFile(document.source, "$.marginals", f"expected an {n} x {n} matrix")
+        raise InvalidFile(document.source, "$.marginals", f"expected a {n} x {n} matrix")
     if data["choice"] not in objects:
         raise InvalidFile(document.source, "$.choice", f"expected one of the objects, got {data['choice']!r}")
     return DecisionValues(

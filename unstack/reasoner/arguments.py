@@ -23,7 +23,23 @@ import numpy as np
 
 from unstack.errors import InvalidArgument, InvalidFile
 
-__all__ = ["check_budget", "check_choice", "check_count", "check_margin", "check_matrix", "check_seed"]
+__all__ = [
+    "MAX_SAMPLES",
+    "MAX_SECONDS",
+    "check_budget",
+    "check_choice",
+    "check_count",
+    "check_margin",
+    "check_matrix",
+    "check_samples",
+    "check_seed",
+]
+
+#: The largest number of recorded sweeps accepted: more is a typing error more often than a plan
+#: (10**8 sweeps of 40 boxes take about a quarter of an hour on 2 cores).
+MAX_SAMPLES = 100_000_000
+#: The longest time limit accepted, in seconds (a day).
+MAX_SECONDS = 86_400.0
 
 
 def check_budget(value: Any, name: str) -> float:
@@ -50,7 +66,26 @@ def check_budget(value: Any, name: str) -> float:
     seconds = float(value)
     if not (math.isfinite(seconds) and seconds > 0):
         raise InvalidArgument(f"{name} must be a positive, finite number of seconds, got {seconds}")
+    if seconds > MAX_SECONDS:
+        raise InvalidArgument(f"{name} must be at most {MAX_SECONDS:,.0f} seconds (a day), got {seconds:,.0f}")
     return seconds
+
+
+def check_samples(value: Any) -> int:
+    """A number of recorded sweeps: an integer from 1 to :data:`MAX_SAMPLES`.
+
+    Examples
+    --------
+    >>> check_samples(4096)
+    4096
+    """
+    samples = check_count(value, "samples")
+    if samples > MAX_SAMPLES:
+        raise InvalidArgument(
+            f"samples must be at most {MAX_SAMPLES:,} (about a quarter of an hour for 40 boxes on 2 cores), "
+            f"got {samples:,}; give a time limit for a longer run"
+        )
+    return samples
 
 
 def check_margin(value: Any, name: str) -> float:

@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 
 from unstack.errors import InvalidArgument, NoConsistentWorld
-from unstack.reasoner.arguments import check_budget, check_choice, check_count, check_margin, check_seed
+from unstack.reasoner.arguments import check_budget, check_choice, check_count, check_margin, check_samples, check_seed
 from unstack.reasoner.components import support_components
 from unstack.reasoner.confidence import choice_probability
 from unstack.reasoner.costs import COSTS, DEFAULT_COST, cost_weights, expected_costs, own_costs
@@ -532,7 +532,7 @@ def decide(
     if time_limit is not None:
         time_limit = check_budget(time_limit, "time_limit")
     if samples is not None:
-        samples = check_count(samples, "samples")
+        samples = check_samples(samples)
     seed = check_seed(seed)
     margin = _near_tie_margin(supports, near_tie_margin)
     n = supports.n_objects
@@ -566,6 +566,7 @@ def decide(
     costs = expected_costs(marginals, weights, own_costs(supports, cost))
     choice, ties = choose(supports.objects, costs, heights=supports.heights, margin=margin)
     largest = int(np.argmax([len(group) for group in groups]))
+    sampling = _sampling_summary(results, seed)
     return Decision(
         objects=supports.objects,
         choice=choice,
@@ -578,14 +579,14 @@ def decide(
         choice_probability=choice_probability(
             costs, covariance, supports.objects.index(choice), seed=seed, margin=margin
         ),
-        sampling=_sampling_summary(results, seed),
+        sampling=sampling,
         method=methods[largest],
         cost=cost,
         consistent_worlds=worlds,
         ties=ties,
         evidence=evidence,
         seconds=time.perf_counter() - start,
-        warnings=_model_warnings(supports),
+        warnings=_model_warnings(supports) + ((sampling["warning"],) if sampling and "warning" in sampling else ()),
         sampling_seconds=sum(result.sampled.seconds for result in results if result.sampled is not None),
         near_tie_margin=margin,
     )

@@ -57,7 +57,7 @@ from typing import Any
 import numpy as np
 
 from unstack.errors import InvalidArgument
-from unstack.reasoner.arguments import check_budget, check_count, check_matrix, check_seed
+from unstack.reasoner.arguments import MAX_SAMPLES, check_budget, check_count, check_matrix, check_samples, check_seed
 from unstack.reasoner.revisits import schedule
 from unstack.reasoner.world_masks import ONE_WORD_BOXES, mask_words, pack, unpack
 from unstack.threads import even_ranges, thread_count
@@ -66,6 +66,7 @@ __all__ = [
     "DEFAULT_CHAINS",
     "DEFAULT_SAMPLES",
     "DEFAULT_TRIES",
+    "MAX_SAMPLES",
     "MOVES",
     "RARE_SWEEPS",
     "WIDE_MOVES",
@@ -601,7 +602,7 @@ def _check_sampling(
 ) -> None:
     """Raise :class:`InvalidArgument` for a budget, seed or count out of its domain."""
     if samples is not None:
-        check_count(samples, "samples")
+        check_samples(samples)
     if time_limit is not None:
         check_budget(time_limit, "time_limit")
     check_seed(seed)
