@@ -47,6 +47,23 @@ def test_a_small_overlap_a_floating_box_and_an_empty_cloud_are_warned_about() ->
     assert any("the point cloud is empty" in line for line in warnings)
 
 
+@pytest.mark.parametrize(
+    ("centre_z", "message"),
+    [
+        (0.05, "box 'a' reaches 0.15 m into the floor (z = 0); check its pose and the frame"),
+        (-1.0, "box 'a' lies wholly below the floor (z = 0); check its pose and the frame"),
+    ],
+)
+def test_a_box_in_or_under_the_floor_is_warned_about(centre_z: float, message: str) -> None:
+    boxes = [Box("a", [0.4, 0.4, 0.4], [1.0, 0.0, centre_z])]
+    assert f"s.json: {message}" in scene_warnings(Scene(boxes, [[1.0, 0.0, 0.25]], ["a"], source="s.json"))
+
+
+def test_a_box_a_centimetre_into_the_floor_is_not_warned_about() -> None:
+    boxes = [Box("a", [0.4, 0.4, 0.4], [1.0, 0.0, 0.19])]  # simulated and measured poses sink a little
+    assert not [line for line in scene_warnings(Scene(boxes, [[1.0, 0.0, 0.4]], ["a"])) if "floor (z = 0)" in line]
+
+
 def test_a_box_resting_on_another_does_not_float() -> None:
     boxes = [Box("a", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2]), Box("b", [0.3, 0.3, 0.3], [1.0, 0.0, 0.551])]
     assert scene_warnings(Scene(boxes, [[0.8, 0.0, 0.3]], ["a", "b"])) == []

@@ -8,9 +8,10 @@ metres, coordinates within :data:`MAX_COORDINATE` metres of the origin, and no t
 sharing more than :data:`REFUSED_OVERLAP` of the smaller one's volume.
 
 :func:`scene_warnings` lists what is doubtful but possible, one line each: boxes that
-overlap by more than :data:`WARNED_OVERLAP` of the smaller volume, detected boxes that
-float (nothing under them within :data:`FLOAT_GAP`: no box, no floor, no point of the
-cloud), and a cloud that is empty or lies far from the boxes.
+overlap by more than :data:`WARNED_OVERLAP` of the smaller volume, boxes that reach
+more than :data:`BELOW_FLOOR` into the floor, detected boxes that float (nothing under them
+within :data:`FLOAT_GAP`: no box, no floor, no point of the cloud), and a cloud that is empty or
+lies far from the boxes.
 
 Examples
 --------
@@ -33,6 +34,7 @@ if TYPE_CHECKING:
     from unstack.scene import Box, Scene
 
 __all__ = [
+    "BELOW_FLOOR",
     "FLOAT_GAP",
     "MAX_BOX_EDGE",
     "MAX_COORDINATE",
@@ -57,6 +59,8 @@ REFUSED_OVERLAP = 0.5
 WARNED_OVERLAP = 0.05
 #: A detected box whose bottom has nothing under it within this gap floats (metres).
 FLOAT_GAP = 0.05
+#: A box reaching deeper than this below the floor (z = 0) is warned about (metres).
+BELOW_FLOOR = 0.02
 #: A cloud whose points are mostly farther than this from every box is "far" (metres).
 FAR_CLOUD = 0.5
 #: Grid steps per axis when measuring the overlap of two boxes.
@@ -141,6 +145,10 @@ def scene_warnings(scene: Scene) -> list[str]:
         for i, j, share in overlapping_pairs(scene.boxes, WARNED_OVERLAP)
     ]
     bounds = bounding_boxes(scene.boxes)
+    for box, low in zip(scene.boxes, bounds[:, 2], strict=True):
+        if low < -BELOW_FLOOR:
+            where = "lies wholly below" if box_corners(box)[:, 2].max() < 0 else f"reaches {-low:.2f} m into"
+            warnings.append(f"{source}: box {box.id!r} {where} the floor (z = 0); check its pose and the frame")
     index = {box.id: k for k, box in enumerate(scene.boxes)}
     for box_id in scene.detected:
         height = _floating(scene, bounds, index[box_id])

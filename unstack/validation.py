@@ -32,11 +32,14 @@ class Validated:
         Its ``format`` tag, such as ``unstack.scene/1``.
     detail : str
         What it holds, such as ``5 objects``.
+    warnings : tuple of str
+        What is doubtful about a valid scene (:func:`unstack.plausibility.scene_warnings`).
     """
 
     source: str
     format: str
     detail: str
+    warnings: tuple[str, ...] = ()
 
 
 def validate(path: str | os.PathLike[str]) -> Validated:
@@ -76,10 +79,12 @@ def validate(path: str | os.PathLike[str]) -> Validated:
         _propagate(supports)
         detail = f"{supports.n_objects} objects"
     elif tag == "unstack.scene/1":
+        from unstack.plausibility import scene_warnings
         from unstack.scene import Scene
 
         scene = Scene.from_document(document)
         detail = f"{len(scene.boxes)} boxes, {len(scene.detected)} detected, {len(scene.points):,} points"
+        return Validated(document.source, tag, detail, tuple(scene_warnings(scene)))
     elif tag == "unstack.plan/1":
         detail = f"{len(document.data['order'])} boxes in order"
     elif tag == "unstack.dataset/1":

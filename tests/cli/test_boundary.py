@@ -213,3 +213,19 @@ def test_an_output_the_system_refuses_names_the_output_not_a_temporary_file() ->
     result = unstack("decide", PILE5, "--output", str(target))
     one_line_error(result, f"{target}: cannot write there:")
     assert ".tmp" not in result.stderr
+
+
+def test_validate_and_render_warn_about_a_box_in_the_floor_as_decide_does(tmp_path: Path, examples: Path) -> None:
+    document = json.loads((examples / "scene3.json").read_text())
+    document["boxes"][0]["position"][2] = 0.05  # 0.15 m of a 0.4 m box below z = 0
+    document["points_file"] = str(examples / document["points_file"])
+    sunk = tmp_path / "sunk.json"
+    sunk.write_text(json.dumps(document))
+    expected = f"unstack: warning: {sunk}: box 'floor_a' reaches 0.15 m into the floor (z = 0)"
+    validated = unstack("validate", str(sunk))
+    assert validated.returncode == 0 and "1 valid, 0 invalid" in validated.stdout
+    rendered = unstack("render", str(sunk), "-o", str(tmp_path / "sunk.png"), "--colour", "none")
+    assert rendered.returncode == 0, rendered.stderr
+    decided = unstack("decide", str(sunk))
+    for result in (validated, rendered, decided):
+        assert expected in result.stderr, result.stderr

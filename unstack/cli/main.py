@@ -318,6 +318,7 @@ def validate(files: tuple[str, ...]) -> None:
             click.echo(f"unstack: error: {printable(str(error))}", err=True)
             continue
         click.echo(f"{printable(result.source)}: valid {result.format} ({printable(result.detail)})")
+        _print_warnings(result.warnings)
     valid = len(files) - invalid
     click.echo(f"{len(files)} file{'s' if len(files) != 1 else ''}: {valid} valid, {invalid} invalid")
     if invalid:

@@ -11,7 +11,7 @@ from typing import Any
 
 import click
 
-from unstack.cli.main import MODEL_HELP
+from unstack.cli.main import MODEL_HELP, _warn
 from unstack.errors import UnstackError
 from unstack.pictures.render import COLOURINGS
 
@@ -80,7 +80,12 @@ def _load(file: str) -> tuple[Any, Path]:
 
     document = read_document(file)
     if validate_document(document, ["unstack.supports/1", "unstack.scene/1"]) == "unstack.scene/1":
-        return Scene.from_document(document), document.base_dir
+        from unstack.plausibility import scene_warnings
+
+        scene = Scene.from_document(document)
+        for warning in scene_warnings(scene):  # what decide would say about the scene
+            _warn(warning)
+        return scene, document.base_dir
     return Supports.from_document(document), document.base_dir
 
 
