@@ -84,3 +84,31 @@ def test_a_scene_in_millimetres_is_one_line_and_exit_code_2(tmp_path: Path) -> N
         f"unstack: error: {file}: $.boxes[0].size[0]: expected a box edge between 0.02 and 5 m "
         "(unstack works in metres), got 600"
     ]
+
+
+@pytest.mark.parametrize(("shift", "share"), [(0.18, 0.55), (0.22, 0.45), (0.2, 0.5), (0.4, 0.0)])
+def test_the_overlap_of_parallel_boxes_is_exact(shift: float, share: float) -> None:
+    from unstack.plausibility import overlap_share
+
+    turned = [0.0, 0.0, np.sin(np.pi / 4), np.cos(np.pi / 4)]  # a quarter turn about z: axes still parallel
+    first = Box("a", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2])
+    second = Box("b", [0.4, 0.4, 0.4], [1.0 + shift, 0.0, 0.2], turned)
+    assert overlap_share(first, second) == pytest.approx(share, abs=1e-9)
+
+
+def test_boxes_sharing_55_percent_are_refused_and_45_percent_warned_about() -> None:
+    boxes = [Box("a", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2]), Box("b", [0.4, 0.4, 0.4], [1.18, 0.0, 0.2])]
+    with pytest.raises(InvalidScene, match=r"box 'b' shares 55 % of the smaller one's volume"):
+        Scene(boxes, np.zeros((0, 3)), ["a"])
+    boxes[1] = Box("b", [0.4, 0.4, 0.4], [1.22, 0.0, 0.2])
+    assert any("overlap by 45 %" in line for line in scene_warnings(Scene(boxes, [[1.0, 0.0, 0.5]], ["a"])))
+
+
+def test_the_overlap_of_a_turned_box_is_estimated_on_a_grid() -> None:
+    from unstack.plausibility import overlap_share
+
+    eighth = [0.0, 0.0, np.sin(np.pi / 8), np.cos(np.pi / 8)]  # 45 degrees about z, same centre
+    share = overlap_share(
+        Box("a", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2]), Box("b", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2], eighth)
+    )
+    assert share == pytest.approx(2 * (np.sqrt(2) - 1), abs=0.03)  # the regular octagon inside the square
