@@ -108,7 +108,10 @@ def test_decide_on_a_scene_with_a_given_model(model: Path) -> None:
             ["train", "examples", "-o", "{tmp}/m.skops"],
             "examples: expected a data set folder with config-NNNN.json scene files",
         ),
-        (["train", "examples", "-o", "{tmp}/m.skops", "--r", "1"], "expected --r >= 2"),
+        (
+            ["train", "examples", "-o", "{tmp}/m.skops", "--r", "1"],
+            "Invalid value for '--r': 1 is not in the range x>=2",
+        ),
         (["evaluate", "nope.skops", "examples"], "nope.skops: $: cannot read the model file"),
     ],
 )

@@ -93,7 +93,7 @@ def table1(out: str, max_n: int, full: bool) -> None:
 @experiment.command()
 @click.argument("data_dir", type=click.Path(file_okay=False))
 @click.option("--out", required=True, type=click.Path(), help="Folder for fig5a.json.")
-@click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
+@click.option("--r", "r", type=click.IntRange(min=2), default=5, show_default=True, help="Boxes per ISet.")
 @click.option("--isets", type=int, default=1, show_default=True, help="ISets per configuration.")
 @click.option("--isets-from", "draw", type=click.Choice(list(ISET_DRAWS)), default="random",
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
@@ -106,7 +106,7 @@ def table1(out: str, max_n: int, full: bool) -> None:
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of the ISets, split and folds.")  # fmt: skip
 @click.option("--cv", type=int, default=10, show_default=True, help="Cross-validation folds.")
-@click.option("--jobs", type=int, default=1, show_default=True, help="Parallel processes.")
+@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Parallel processes.")
 @click.option("--full", is_flag=True, help="Insist on the paper's size: at least 200 configurations, 10 folds.")
 def fig5a(
     data_dir: str,
@@ -176,7 +176,7 @@ def fig5a(
 @click.argument("data_dir", type=click.Path(file_okay=False))
 @click.option("--out", required=True, type=click.Path(), help="Folder for decisions.json and fig4.png.")
 @click.option("--model", "model_path", default=None, help=MODEL_HELP)
-@click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
+@click.option("--r", "r", type=click.IntRange(min=2), default=5, show_default=True, help="Boxes per ISet.")
 @click.option("--isets", type=int, default=50, show_default=True, help="Test ISets (the paper: 493).")
 @click.option("--isets-from", "draw", type=click.Choice(list(ISET_DRAWS)), default="random",
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip

@@ -109,8 +109,8 @@ def _examples(
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Model file to write.")
 @click.option("--learner", type=click.Choice(list(LEARNERS)), default="svm",
               show_default=True, help="svm: RBF SVM with LIBSVM probabilities (the paper).")  # fmt: skip
-@click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
-@click.option("--isets", type=int, default=3, show_default=True, help="ISets drawn per configuration.")
+@click.option("--r", "r", type=click.IntRange(min=2), default=5, show_default=True, help="Boxes per ISet.")
+@click.option("--isets", type=click.IntRange(min=1), default=3, show_default=True, help="ISets per configuration.")
 @click.option("--isets-from", "draw", type=click.Choice(list(ISET_DRAWS)), default="random",
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
 @click.option("--vary-clouds/--same-clouds", default=False, show_default=True,
@@ -127,7 +127,7 @@ def _examples(
               show_default=True, help=FEATURES_HELP)  # fmt: skip
 @click.option("--offset", type=float, default=1.0, show_default=True, help="d: interest-point offset (m).")
 @click.option("--sigma", type=float, default=0.5, show_default=True, help="Width of the DBAF's Gaussian (m).")
-@click.option("--jobs", type=int, default=1, show_default=True, help="Parallel processes.")
+@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Parallel processes.")
 @click.option("--json", "as_json", is_flag=True, help="Print the training report as JSON.")
 def train(
     data_dirs: tuple[str, ...],
@@ -202,14 +202,14 @@ def train(
 @click.command()
 @click.argument("model_file", type=str)
 @click.argument("data_dir", type=click.Path(file_okay=False))
-@click.option("--r", "r", type=int, default=5, show_default=True, help="Boxes per ISet.")
-@click.option("--isets", type=int, default=3, show_default=True, help="ISets drawn per configuration.")
+@click.option("--r", "r", type=click.IntRange(min=2), default=5, show_default=True, help="Boxes per ISet.")
+@click.option("--isets", type=click.IntRange(min=1), default=3, show_default=True, help="ISets per configuration.")
 @click.option("--isets-from", "draw", type=click.Choice(list(ISET_DRAWS)), default="random",
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
 @click.option("--pose-noise", type=click.FloatRange(0.0, 0.1), default=0.0, show_default=True,
               help="Score on boxes as a detector reports them: errors of this many metres.")  # fmt: skip
 @click.option("--seed", type=click.IntRange(min=0), default=1, show_default=True, help="Seed of the ISets.")
-@click.option("--jobs", type=int, default=1, show_default=True, help="Parallel processes.")
+@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Parallel processes.")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
 @click.option("--reliability", type=click.Path(dir_okay=False), default=None, help="Write a reliability diagram PNG.")
 def evaluate(
