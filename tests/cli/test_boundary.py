@@ -229,3 +229,13 @@ def test_validate_and_render_warn_about_a_box_in_the_floor_as_decide_does(tmp_pa
     decided = unstack("decide", str(sunk))
     for result in (validated, rendered, decided):
         assert expected in result.stderr, result.stderr
+
+
+def test_chains_that_have_not_mixed_are_warned_about_once_on_stderr_and_in_the_json() -> None:
+    text = unstack("decide", "examples/pile31.supports.json", "--samples", "500", "--seed", "0")
+    assert text.returncode == 0, text.stderr
+    assert text.stderr.count("the chains disagree") == 1 and "chains disagree" not in text.stdout
+    as_json = unstack("decide", "examples/pile31.supports.json", "--samples", "500", "--seed", "0", "--json")
+    document = json.loads(as_json.stdout)
+    assert document["sampling"]["warning"] in document["warnings"]
+    assert as_json.stderr.startswith("unstack: warning: the chains disagree")

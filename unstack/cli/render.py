@@ -79,8 +79,6 @@ def decision_view(decision: Decision) -> Group:
             f"group, seed {decision.sampling['seed']}, largest R-hat {decision.sampling['rhat_max']}; errors are "
             "standard errors (about 95 % of true values lie within 2 of them)"
         )
-        if "warning" in decision.sampling:
-            footer.append(f"\nwarning: {decision.sampling['warning']}", style="bold yellow")
     headline = Text.assemble(("Unload first: ", "bold"), (printable(decision.choice), "bold green"))
     near = decision.near_tie_margin
     if decision.choice_probability < 1.0 or decision.sampling is not None:
