@@ -78,7 +78,7 @@ __all__ = [
     "sampled_marginals",
 ]
 
-#: Independent chains (they run on all cores).
+#: Independent chains (a range of them per thread of the call: every core by default, :mod:`unstack.threads`).
 DEFAULT_CHAINS = 8
 #: Recorded sweeps (over all chains) when neither ``samples`` nor ``time_limit`` is given and a
 #: sweep re-inserts every box: reproducible for a seed (:func:`default_samples` scales it for
