@@ -82,9 +82,8 @@ def overlap_share(first: Box, second: Box) -> float:
     small, large = (first, second) if np.prod(first.size) <= np.prod(second.size) else (second, first)
     to_large = rotation_matrix(large.orientation_xyzw)
     relative = to_large.T @ rotation_matrix(small.orientation_xyzw)  # the small box's axes in the large one's frame
-    axes = np.round(np.abs(relative))
-    parallel = np.allclose(np.abs(relative), axes, atol=1e-6) and np.all(axes.sum(axis=0) == 1)
-    if parallel and np.all(axes.sum(axis=1) == 1):
+    axes = np.round(np.abs(relative))  # a rotation whose entries are 0 or +-1 permutes the axes
+    if np.allclose(np.abs(relative), axes, atol=1e-6):
         centre = to_large.T @ (np.asarray(small.position) - large.position)
         half = axes @ (np.asarray(small.size) / 2.0)
         low = np.maximum(centre - half, -np.asarray(large.size) / 2.0)
@@ -158,9 +157,9 @@ def scene_warnings(scene: Scene) -> list[str]:
         for i, j, share in overlapping_pairs(scene.boxes, WARNED_OVERLAP)
     ]
     bounds = bounding_boxes(scene.boxes)
-    for box, low in zip(scene.boxes, bounds[:, 2], strict=True):
+    for box, (low, high) in zip(scene.boxes, bounds[:, [2, 5]], strict=True):
         if low < -BELOW_FLOOR:
-            where = "lies wholly below" if box_corners(box)[:, 2].max() < 0 else f"reaches {-low:.2f} m into"
+            where = "lies wholly below" if high < 0 else f"reaches {-low:.2f} m into"
             warnings.append(f"{source}: box {box.id!r} {where} the floor (z = 0); check its pose and the frame")
     index = {box.id: k for k, box in enumerate(scene.boxes)}
     for box_id in scene.detected:

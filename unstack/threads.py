@@ -19,6 +19,10 @@ Examples
 [0, 1, 4, 9]
 >>> even_ranges(10, 3)
 [(0, 3), (3, 6), (6, 10)]
+>>> squares = [0] * 5
+>>> run_in_ranges(lambda first, last: squares.__setitem__(slice(first, last), [i * i for i in range(first, last)]), 5)
+>>> squares
+[0, 1, 4, 9, 16]
 """
 
 from __future__ import annotations
@@ -27,7 +31,7 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from typing import TypeVar
 
-__all__ = ["even_ranges", "map_on_threads", "thread_count"]
+__all__ = ["even_ranges", "map_on_threads", "run_in_ranges", "thread_count"]
 
 _Result = TypeVar("_Result")
 
@@ -42,7 +46,7 @@ def thread_count() -> int:
     import numba
     from numba.np.ufunc import parallel
 
-    if parallel._is_initialized:
+    if getattr(parallel, "_is_initialized", False):  # numba's own flag: the host started the layer
         return int(numba.get_num_threads())
     return int(numba.config.NUMBA_NUM_THREADS)  # type: ignore[attr-defined]
 
@@ -72,3 +76,10 @@ def map_on_threads(function: Callable[[int], _Result], items: Sequence[int]) -> 
         return [future.result() for future in futures]
     finally:  # an error or Ctrl-C: the items not started are dropped, not run to the end
         pool.shutdown(wait=True, cancel_futures=True)
+
+
+def run_in_ranges(kernel: Callable[[int, int], object], items: int) -> None:
+    """``kernel(first, last)`` for :func:`even_ranges` of ``items``, one range per thread of
+    :func:`thread_count` (for ``nogil`` kernels that write each item's result in place)."""
+    ranges = even_ranges(items, thread_count())
+    map_on_threads(lambda part: kernel(*ranges[part]), range(len(ranges)))

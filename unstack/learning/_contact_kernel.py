@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from unstack.threads import even_ranges, map_on_threads, thread_count
+from unstack.threads import run_in_ranges
 
 
 def column_index(points: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -89,9 +89,8 @@ def counts_in_boxes(
     boxes = low.shape[0]
     counts = np.zeros(boxes, dtype=np.int64)
     top = np.full(boxes, -np.inf)
-    ranges = even_ranges(boxes, thread_count())
-    map_on_threads(
-        lambda part: _counts_in_boxes(points, starts, origin, shape, cell, low, high, *ranges[part], counts, top),
-        range(len(ranges)),
+    run_in_ranges(
+        lambda first, last: _counts_in_boxes(points, starts, origin, shape, cell, low, high, first, last, counts, top),
+        boxes,
     )
     return counts, top

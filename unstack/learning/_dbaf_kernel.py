@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from unstack.threads import even_ranges, map_on_threads, thread_count
+from unstack.threads import run_in_ranges
 
 
 @njit(cache=True, nogil=True, fastmath=False)
@@ -28,8 +28,7 @@ def gaussian_sums(points: np.ndarray, queries: np.ndarray, inverse_two_variance:
     """The compiled sum for every query point, the queries shared out over :func:`unstack.threads.thread_count`
     threads (each sum is computed whole by one thread: the same numbers on any number of threads)."""
     sums = np.zeros(queries.shape[0])
-    ranges = even_ranges(queries.shape[0], thread_count())
-    map_on_threads(
-        lambda part: _gaussian_sums(points, queries, inverse_two_variance, *ranges[part], sums), range(len(ranges))
+    run_in_ranges(
+        lambda first, last: _gaussian_sums(points, queries, inverse_two_variance, first, last, sums), len(sums)
     )
     return sums

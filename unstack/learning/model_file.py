@@ -181,8 +181,9 @@ class SupportModel:
                 probability: np.ndarray = self.estimator.predict_proba(features)[:, classes.index(1)]
         except (ValueError, TypeError, AttributeError, IndexError) as error:  # not a model of these features
             raise InvalidModel(self.source, "$.estimator", f"cannot predict P(SUPP): {error}") from error
-        if not np.all((probability >= 0.0) & (probability <= 1.0)):  # NaN fails too
-            bad = probability[~((probability >= 0.0) & (probability <= 1.0))][0]
+        valid = (probability >= 0.0) & (probability <= 1.0)  # NaN fails too
+        if not valid.all():
+            bad = probability[~valid][0]
             raise InvalidModel(self.source, "$.estimator", f"expected probabilities in [0, 1], the model gave {bad}")
         return probability
 
@@ -280,7 +281,7 @@ def _check_usable(model: SupportModel) -> None:
     classes = getattr(estimator, "classes_", None)
     if classes is None:
         raise InvalidModel(source, "$.estimator", "expected a fitted classifier, got one that was never fitted")
-    if 1 not in [int(label) for label in classes if isinstance(label, int | np.integer | bool | np.bool_)]:
+    if 1 not in list(classes):  # what support_probability looks up
         labels = ", ".join(str(label) for label in classes)
         raise InvalidModel(source, "$.estimator", f"expected the classes 0 and 1 (1: supports), got {labels}")
     width = getattr(estimator, "n_features_in_", None)

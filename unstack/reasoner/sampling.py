@@ -57,7 +57,7 @@ from typing import Any
 import numpy as np
 
 from unstack.errors import InvalidArgument
-from unstack.reasoner.arguments import MAX_SAMPLES, check_budget, check_count, check_matrix, check_samples, check_seed
+from unstack.reasoner.arguments import check_budget, check_count, check_matrix, check_samples, check_seed
 from unstack.reasoner.revisits import schedule
 from unstack.reasoner.world_masks import ONE_WORD_BOXES, mask_words, pack, unpack
 from unstack.threads import even_ranges, thread_count
@@ -66,7 +66,6 @@ __all__ = [
     "DEFAULT_CHAINS",
     "DEFAULT_SAMPLES",
     "DEFAULT_TRIES",
-    "MAX_SAMPLES",
     "MOVES",
     "RARE_SWEEPS",
     "WIDE_MOVES",
@@ -635,8 +634,9 @@ def _sampled_marginals(
         samples = default_samples(n)
     deadline = None if time_limit is None else start + time_limit
     per_chain = None if samples is None else -(-samples // chains)
-    state = _Chains(p, chains=chains, seed=seed, burn_in=burn_in, tries=tries, blocks=blocks, start=warm, wide=wide)
-    try:
+    with _Chains(
+        p, chains=chains, seed=seed, burn_in=burn_in, tries=tries, blocks=blocks, start=warm, wide=wide
+    ) as state:
         insertion_sums = insertion_sums and not state.wide
         choosing = (insertion_sums or revisits) and n > MOVES  # the pilot: the first part of the run
         pilot_sweeps = None if per_chain is None else max(2 * _ROUND_SWEEPS, per_chain // PILOT_SHARE)
@@ -734,8 +734,6 @@ def _sampled_marginals(
             summed_boxes=state.summed_boxes.copy(),
             schedule=state.schedule.copy(),
         )
-    finally:
-        state.close()
 
 
 def _sum_noisiest_insertions(state: _Chains, marginals: np.ndarray, variances: np.ndarray) -> bool:
