@@ -21,7 +21,7 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "unstack"
 MIDDLE = ("reasoner", "learning", "sim", "pictures")
-API = {"unstack", "unstack.api", "unstack.validation", "unstack.warmup"}
+API = {"unstack", "unstack.api", "unstack.moves", "unstack.validation", "unstack.warmup"}
 
 
 @dataclass(frozen=True)

@@ -253,6 +253,7 @@ def decide(
     time_limit: float | None = None,
     near_tie_margin: float | None = None,
     statics: bool = True,
+    disturbance: Any = None,
 ) -> Decision:
     """Which box to unload first: from a scene (through a model) or from support probabilities.
 
@@ -264,9 +265,11 @@ def decide(
         For a scene only (an error with support probabilities); ``None``: the default model.
     method : {"auto", "exact", "sat", "approx"}
         See :func:`unstack.reasoner.decision.decide`.
-    cost : {"load", "count", "mass"}
+    cost : {"load", "count", "mass", "moves"}
         ``load`` (the default): Eq. 11 with every box counted together with the undetected
-        load the cloud shows on it; ``count``: Eq. 11 exactly; ``mass``: their total mass.
+        load the cloud shows on it; ``count``: Eq. 11 exactly; ``mass``: their total mass;
+        ``moves`` (a scene only): the boxes the pick is expected to move, from the learned
+        disturbance model (:mod:`unstack.moves`).
     seed : int, optional
         Seed of the sampler: with it (and no ``time_limit``) the numbers are identical on
         every run, whatever the machine's load.
@@ -284,6 +287,8 @@ def decide(
     statics : bool
         For a scene: raise the probability that a box holds up another that cannot stand
         without it (:func:`support_probabilities`); ``False`` keeps the model's probabilities.
+    disturbance : path-like or DisturbanceModel, optional
+        With ``cost="moves"``: the disturbance model (default: the shipped one).
 
     Returns
     -------
@@ -310,6 +315,27 @@ def decide(
     from unstack.reasoner.decision import decide as decide_supports
 
     supports = _supports(scene_or_supports, model, statics)
+    if cost == "moves":
+        if not isinstance(scene_or_supports, Scene):
+            raise InvalidArgument(
+                f"{supports.source}: the moves cost reads the scene's poses and cloud; support probabilities "
+                "alone are decided on load, count or mass"
+            )
+        from unstack.moves import decide_on_moves
+
+        decision: Decision = decide_on_moves(
+            scene_or_supports,
+            supports,
+            disturbance=disturbance,
+            near_tie_margin=near_tie_margin,
+            method=method,
+            seed=seed,
+            samples=samples,
+            time_limit=time_limit,
+        )
+        return decision
+    if disturbance is not None:
+        raise InvalidArgument("a disturbance model is used by the moves cost only; pass cost='moves'")
     return decide_supports(
         supports,
         method=method,
@@ -366,6 +392,11 @@ def plan(
     """
     from unstack.reasoner.plan import unloading_plan
 
+    if cost == "moves":
+        raise InvalidArgument(
+            "the moves cost decides the next pick on a scene as sensed now (a robot senses again after each "
+            "pick); a plan is made on load, count or mass"
+        )
     supports = _supports(scene_or_supports, model, statics)
     return unloading_plan(
         supports,

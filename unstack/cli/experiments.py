@@ -395,6 +395,8 @@ def unload(
 @click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Piles run in parallel.")
 @click.option("--scheduler", default=None,
               help="Address of a dask.distributed scheduler (tcp://HOST:PORT): piles run on its workers.")  # fmt: skip
+@click.option("--disturbance", "disturbance_path", type=click.Path(dir_okay=False, exists=True), default=None,
+              help="Disturbance model file of the moves maker (default: the shipped one).")  # fmt: skip
 def container(
     data_dir: str,
     out: str,
@@ -409,6 +411,7 @@ def container(
     seed: int,
     jobs: int,
     scheduler: str | None,
+    disturbance_path: str | None,
 ) -> None:
     """Empty whole containers as a robot does: scan and detect again before every pick.
 
@@ -434,7 +437,7 @@ def container(
                 data_dir, model, piles=piles, makers=chosen, detector_noise=detector_noise,
                 detector_misses=detector_misses, reach=reach,
                 max_picks=max_picks, samples=samples, seed=seed, progress=report,
-                checkpoints=folder / "container-piles", n_jobs=jobs, client=client,
+                checkpoints=folder / "container-piles", n_jobs=jobs, client=client, disturbance=disturbance_path,
             )  # fmt: skip
     finally:
         if client is not None:
@@ -521,3 +524,80 @@ def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int
     console.print(f"right first pick {picks}/{len(results)}; within every bound {right}/{len(results)}")
     for key, problems in physics_problems.items():
         console.print(f"physics disagrees with the labels of {key}: {'; '.join(problems)}")
+
+
+@experiment.command("pick-responses")
+@click.argument("data_dirs", nargs=-1, required=True, type=click.Path(file_okay=False))
+@click.option("--out", required=True, type=click.Path(), help="Folder of the collected states (resumable).")
+@click.option("--piles", type=click.IntRange(min=1), default=None, help="The first N piles of each data set.")
+@click.option("--max-picks", type=click.IntRange(min=1), default=None, help="Stop each pile after this many picks.")
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True)
+@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Piles run in parallel.")
+@click.option("--scheduler", default=None,
+              help="Address of a dask.distributed scheduler (tcp://HOST:PORT): piles run on its workers.")  # fmt: skip
+def pick_responses(
+    data_dirs: tuple[str, ...], out: str, piles: int | None, max_picks: int | None, seed: int, jobs: int,
+    scheduler: str | None,
+) -> None:  # fmt: skip
+    """Empty piles with a physics probe of every candidate before each pick; save every state.
+
+    The training data of the disturbance model: each state holds the boxes, the cloud, the
+    reachable candidates and what each candidate's removal moves (tried in the engine and
+    undone). Which candidate is then taken is drawn: the probe's best, the highest, a random one.
+    """
+    from unstack.experiments.pick_responses import collect_pick_responses
+    from unstack.sim.dataset import connect_scheduler
+
+    client = connect_scheduler(scheduler) if scheduler else None
+    try:
+        with progress_bar("piles") as report:
+            summaries = collect_pick_responses(
+                list(data_dirs), out, piles=piles, seed=seed, max_picks=max_picks, n_jobs=jobs, client=client,
+                progress=report,
+            )  # fmt: skip
+    finally:
+        if client is not None:
+            client.close()
+    states = sum(summary["states"] for summary in summaries)
+    click.echo(f"{len(summaries)} piles, {states} states in {out}")
+
+
+@experiment.command("train-disturbance")
+@click.argument("states", type=click.Path(file_okay=False, exists=True))
+@click.option("--out", required=True, type=click.Path(), help="Folder for disturbance.skops and disturbance.json.")
+@click.option("--model", "model_path", default=None, help=MODEL_HELP)
+@click.option("--folds", type=click.IntRange(min=2), default=5, show_default=True,
+              help="Grouped folds (piles held out together) of the held-out figures.")  # fmt: skip
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True)
+@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Piles in parallel.")
+def train_disturbance_command(states: str, out: str, model_path: str | None, folds: int, seed: int, jobs: int) -> None:
+    """Fit the disturbance model (what a pick moves) on collected states; report it held out.
+
+    Every state is seen with every reachable box detected and with a detector missing half of
+    them; the held-out report gives calibration (Spearman, means per predicted bin) and what
+    the held-out picks moved beside highest first, the load cost and the look-ahead.
+    """
+    from unstack.cli.main import load_model_option
+    from unstack.experiments.disturbance_training import train_disturbance
+    from unstack.experiments.pick_responses import pick_table
+    from unstack.learning.disturbance import save_disturbance_model
+
+    model, name = load_model_option(model_path)
+    folder = _out(out)
+    with progress_bar("piles") as report:
+        records = pick_table(states, model, seed=seed, n_jobs=jobs, progress=report)
+    if not records:
+        raise click.UsageError(f"{states}: no collected states (unstack experiment pick-responses writes them)")
+    disturbance, result = train_disturbance(records, random_state=seed, folds=folds)
+    disturbance.metadata["training"] = {"states": str(states), "support_model": name, "seed": seed}
+    save_disturbance_model(disturbance, folder / "disturbance.skops")
+    _write_json(folder / "disturbance.json", result)
+    table = Table(title=f"Boxes the next pick moved, held out ({result['piles']} piles, {result['records']} views)")
+    for column in ("family / view", "states", "highest", "load cost", "moves", "look-ahead"):
+        table.add_column(column, justify="right")
+    for key, row in result["pick_scores"].items():
+        scores = (f"{row[policy]:.3f}" for policy in ("highest", "load", "moves", "lookahead"))
+        table.add_row(key, str(row["states"]), *scores)
+    Console().print(table)
+    click.echo(f"Spearman's rank correlation, predicted against actual: {result['calibration']['spearman']:.3f}")
+    click.echo(f"model in {folder / 'disturbance.skops'}, report in {folder / 'disturbance.json'}")

@@ -155,11 +155,12 @@ def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
         ),
         click.option(
             "--cost",
-            type=click.Choice(list(COSTS)),
+            type=click.Choice([*COSTS, "moves"]),
             default=DEFAULT_COST,
             show_default=True,
             help="load: supported boxes, each with the undetected load on it; count: number of supported "
-            "boxes (Eq. 11); mass: their total mass (needs masses).",
+            "boxes (Eq. 11); mass: their total mass (needs masses); moves (a scene, decide only): the boxes "
+            "taking the box out is expected to move, from the learned disturbance model.",
         ),
         click.option(
             "--samples",

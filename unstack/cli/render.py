@@ -37,12 +37,13 @@ def decision_view(decision: Decision) -> Group:
         "mass": "EC: expected kg supported (Eq. 13)",
         "count": "EC: detected boxes supported (Eq. 11)",
         "load": "EC: boxes supported, hidden load too",
+        "moves": "Expected boxes moved by taking the box out (learned disturbance model)",
     }
     order = sorted(range(len(decision.objects)), key=lambda i: (decision.expected_costs[i], decision.objects[i]))
     costs = Table(title=titles.get(decision.cost, "EC (Eq. 13)"), title_justify="left")
     costs.add_column("rank", justify="right")
     costs.add_column("box")
-    costs.add_column("EC", justify="right")
+    costs.add_column("moved" if decision.cost == "moves" else "EC", justify="right")
     sampled = decision.sampling is not None and decision.expected_cost_errors is not None
     if sampled:
         costs.add_column("± s.e.", justify="right")
@@ -88,7 +89,27 @@ def decision_view(decision: Decision) -> Group:
         others = ", ".join(printable(t) for t in decision.ties if t != decision.choice)
         rule = f"EC within {near:g} of the lowest; the box resting highest wins" if near else "smallest id wins"
         headline.append(f"  (tied with {others}: {rule})")
+    if decision.reasons:
+        return Group(headline, _why(decision), costs, matrix, footer)
     return Group(headline, costs, matrix, footer)
+
+
+def _why(decision: Decision) -> Text:
+    """Why the pick and the runner-up cost what they cost: what each is expected to move and
+    the relations that drive it."""
+    by_box = {reason["box"]: reason for reason in decision.reasons}
+    ranked = sorted(decision.objects, key=lambda box: (box != decision.choice, by_box[box]["expected_moves"], box))
+    text = Text()
+    for label, box in zip(("pick", "runner-up"), ranked[:2], strict=False):
+        reason = by_box[box]
+        drivers = [f"{printable(box)} holds up {printable(other)}: P {p:.2f}" for other, p in reason["holds_up"]]
+        if reason["hidden_load"] >= 0.05:
+            drivers.append(f"the cloud shows {reason['hidden_load']:.2f} undetected boxes on it")
+        if reason["held_by"] is not None and reason["held_by"][1] >= 0.5:
+            drivers.append(f"it rests on {printable(reason['held_by'][0])}: P {reason['held_by'][1]:.2f}")
+        because = "; ".join(drivers) if drivers else "it holds up no detected box and the cloud shows no load on it"
+        text.append(f"{label} {printable(box)}: expected to move {reason['expected_moves']:.2f} boxes ({because})\n")
+    return text
 
 
 def payoff_view(table: PayoffMatrix, limit: int) -> Group:

@@ -28,8 +28,12 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
 ``random``
     a seeded random candidate.
 ``lookahead``
-    knows the true pile: tries every candidate's removal in the physics engine and takes the
-    one that moves the fewest boxes (the floor no policy can pass; slow).
+    knows the true pile: tries every candidate's removal in the physics engine (in the world
+    itself, undone after each try: :func:`unstack.sim.unloading.probe_removals`) and takes the
+    one that moves the fewest boxes, ties to the box resting highest (the floor no policy can pass; slow).
+``moves``
+    the learned cost of what a pick moves (:mod:`unstack.moves`): the default model's
+    probabilities and the reasoner's marginals through the disturbance model.
 
 Metrics per pile and per maker: boxes moved more than 2 cm, boxes fallen (dropped more than
 0.2 m or tipped more than 45 degrees), the share of picks that move nothing, and paired
@@ -58,7 +62,10 @@ __all__ = ["CONTAINER_MAKERS", "CONTAINER_SAMPLES", "container_experiment", "con
 
 CONTAINER_MAKERS = (
     "unstack", "min_cost", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random", "lookahead",
+    "moves",
 )  # fmt: skip
+#: Makers whose policy is told what every candidate's removal does in the engine (the true pile).
+PROBING_MAKERS = ("lookahead",)
 #: Recorded sweeps per sampled group in each decision: 512 when a sweep re-inserted every box,
 #: 3 times that since it re-inserts :data:`~unstack.reasoner.sampling.MOVES` (as the default
 #: budget, :func:`~unstack.reasoner.sampling.default_samples`). On the first 10 wall piles with
@@ -77,9 +84,15 @@ def _free(scene: Scene, candidates: Sequence[str]) -> list[str]:
 
 
 def container_policies(
-    model: Any, *, seed: int, samples: int = CONTAINER_SAMPLES, makers: Sequence[str] = CONTAINER_MAKERS
-) -> dict[str, Callable[[Scene], str]]:
-    """The decision makers: each maps the freshly sensed scene to one of its ``detected`` boxes."""
+    model: Any,
+    *,
+    seed: int,
+    samples: int = CONTAINER_SAMPLES,
+    makers: Sequence[str] = CONTAINER_MAKERS,
+    disturbance: Any = None,
+) -> dict[str, Callable[..., str]]:
+    """The decision makers: each maps the freshly sensed scene to one of its ``detected`` boxes
+    (those of :data:`PROBING_MAKERS` take the probe's outcomes as well)."""
     from unstack.experiments.decisions import free_pick
 
     rng = np.random.default_rng(seed)
@@ -119,13 +132,26 @@ def container_policies(
     def random(scene: Scene) -> str:
         return str(rng.choice(sorted(scene.detected)))
 
-    def lookahead(scene: Scene) -> str:
-        from unstack.sim.unloading import execute_unloading
+    def lookahead(scene: Scene, outcomes: dict[str, Any]) -> str:
+        from unstack.geometry import bounding_boxes
 
-        moved = {box_id: execute_unloading(scene, [box_id]).boxes_moved for box_id in scene.detected}
-        return min(scene.detected, key=lambda box_id: (moved[box_id], -height(scene, box_id), box_id))
+        resting = {box_id: float(bounding_boxes([scene.box(box_id)])[0, 2]) for box_id in scene.detected}
+        return min(scene.detected, key=lambda box_id: (outcomes[box_id].boxes_moved, -resting[box_id], box_id))
 
-    every = {
+    loaded: list[Any] = []
+
+    def moves(scene: Scene) -> str:
+        from unstack.learning.disturbance import load_disturbance_model
+        from unstack.learning.probabilities import scene_support_probabilities
+        from unstack.moves import decide_on_moves
+
+        if not loaded:  # once per set of policies, at the first pick
+            given = disturbance
+            loaded.append(load_disturbance_model(given) if isinstance(given, str | os.PathLike | None) else given)
+        supports = scene_support_probabilities(scene, model)
+        return str(decide_on_moves(scene, supports, disturbance=loaded[0], samples=samples, seed=seed).choice)
+
+    every: dict[str, Callable[..., str]] = {
         "unstack": deciding("load"),
         "min_cost": deciding("load", 0.0),
         "unstack_count": deciding("count", 0.0),
@@ -135,6 +161,7 @@ def container_policies(
         "nearest_door": nearest_door,
         "random": random,
         "lookahead": lookahead,
+        "moves": moves,
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:
@@ -153,11 +180,14 @@ def _run_pile(
 
     scene = load_scene(path)
     runs = {}
-    policies = container_policies(model, seed=options["seed"], samples=options["samples"], makers=makers)
+    policies = container_policies(
+        model, seed=options["seed"], samples=options["samples"], makers=makers, disturbance=options["disturbance"]
+    )
     for maker, policy in policies.items():
         run = unload_container(
             scene, policy, detector_noise=options["detector_noise"], detector_misses=options["detector_misses"],
             reach=options["reach"], max_picks=options["max_picks"], seed=options["seed"],
+            probe=maker in PROBING_MAKERS,
         )  # fmt: skip
         runs[maker] = run.to_dict()
     return number, {"scene": path.name, "boxes": len(scene.boxes), "runs": runs}
@@ -189,6 +219,7 @@ def container_experiment(
     checkpoints: str | os.PathLike[str] | None = None,
     n_jobs: int = 1,
     client: Any = None,
+    disturbance: Any = None,
 ) -> dict[str, Any]:
     """Empty the first ``piles`` piles of a data set with every decision maker; compare them.
 
@@ -198,6 +229,7 @@ def container_experiment(
     ``checkpoints``: a folder keeping each pile's result; a run started again with the same
     settings reuses them. ``n_jobs``: piles run in parallel processes; ``client``: on the
     workers of a ``distributed.Client`` instead (the results depend on neither).
+    ``disturbance``: the disturbance model of the ``moves`` maker (default: the shipped one).
     """
     import hashlib
     import json
@@ -207,6 +239,13 @@ def container_experiment(
     from unstack.experiments.decisions import paired_difference
 
     container_policies(model, seed=seed, makers=makers)  # unknown makers fail before any work
+    if disturbance is not None and not isinstance(disturbance, str | os.PathLike):
+        disturbance = disturbance.source  # sent to the workers by path
+    if "moves" in makers:
+        from unstack.learning.disturbance import default_disturbance_path
+
+        disturbance_path = Path(default_disturbance_path() if disturbance is None else disturbance)
+        disturbance_digest = hashlib.sha256(disturbance_path.read_bytes()).hexdigest()
     files = require_configurations(data_dir)[:piles]
     model_digest = hashlib.sha256(json.dumps(model.metadata, sort_keys=True, default=str).encode()).hexdigest()
     folder = None if checkpoints is None else Path(checkpoints)
@@ -219,6 +258,8 @@ def container_experiment(
         digest = hashlib.sha256(path.read_bytes()).hexdigest()
         # detector_misses joins the key only when set: runs made before it keep their checkpoints
         kept = {name: value for name, value in settings.items() if name != "detector_misses" or value}
+        if "moves" in makers:  # the disturbance model joins the key only where it is used
+            kept["disturbance_sha256"] = disturbance_digest
         return {"scene_sha256": digest, "model_sha256": model_digest, "makers": list(makers),
                 **kept, "seed": seed + number}  # fmt: skip
 
@@ -236,7 +277,8 @@ def container_experiment(
     todo = [number for number, result in enumerate(results) if result is None]
     if progress is not None:
         progress(len(files) - len(todo), len(files))
-    arguments = [(files[number], number, model, makers, {**settings, "seed": seed + number}) for number in todo]
+    options = {**settings, "disturbance": None if disturbance is None else str(disturbance)}
+    arguments = [(files[number], number, model, makers, {**options, "seed": seed + number}) for number in todo]
     running: Iterator[tuple[int, dict[str, Any]]] = run_unordered(_run_pile, arguments, n_jobs=n_jobs, client=client)
     for number, pile in running:
         results[number] = pile

@@ -54,6 +54,7 @@ __all__ = [
     "default_model_path",
     "feature_ranges",
     "load_model",
+    "read_payload",
     "save_model",
 ]
 
@@ -227,6 +228,32 @@ def load_model(path: str | os.PathLike[str]) -> SupportModel:
         Not a readable file, not a skops file, types skops does not trust, not an
         ``unstack.model/1`` payload, or a model of another version.
     """
+    source = str(path)
+    payload = read_payload(path, MODEL_FORMAT)
+    try:
+        metadata = json.loads(payload["metadata"])
+        features = FeatureSettings(**metadata.pop("features"))
+        estimator = payload["estimator"]
+    except (KeyError, TypeError, ValueError) as error:
+        raise InvalidModel(source, "$.metadata", f"expected the model's metadata and estimator: {error}") from error
+    if not hasattr(estimator, "predict_proba"):
+        raise InvalidModel(source, "$.estimator", "expected a fitted classifier with predict_proba")
+    model = SupportModel(estimator, features, metadata, source=source)
+    _check_usable(model)
+    return model
+
+
+def read_payload(path: str | os.PathLike[str], expected_format: str) -> dict[str, Any]:
+    """The dict a skops model file holds, after refusing anything that could run code.
+
+    Every type in the file must be one skops trusts by default or one of
+    :data:`EXTRA_TRUSTED_TYPES`; the dict's ``"format"`` must be ``expected_format``.
+
+    Raises
+    ------
+    InvalidModel
+        Not a readable file, not a skops file, untrusted types, another format.
+    """
     import skops.io
 
     source = str(path)
@@ -252,21 +279,11 @@ def load_model(path: str | os.PathLike[str]) -> SupportModel:
         raise InvalidModel(source, "$", f"the skops file does not load: {error}") from error
     if not isinstance(payload, dict) or "format" not in payload:
         raise InvalidModel(source, "$", "expected an unstack model (a dict with 'format'), got another skops object")
-    if payload["format"] != MODEL_FORMAT:
+    if payload["format"] != expected_format:
         raise InvalidModel(
-            source, "$.format", f"unsupported model format {payload['format']!r}; expected {MODEL_FORMAT}"
+            source, "$.format", f"unsupported model format {payload['format']!r}; expected {expected_format}"
         )
-    try:
-        metadata = json.loads(payload["metadata"])
-        features = FeatureSettings(**metadata.pop("features"))
-        estimator = payload["estimator"]
-    except (KeyError, TypeError, ValueError) as error:
-        raise InvalidModel(source, "$.metadata", f"expected the model's metadata and estimator: {error}") from error
-    if not hasattr(estimator, "predict_proba"):
-        raise InvalidModel(source, "$.estimator", "expected a fitted classifier with predict_proba")
-    model = SupportModel(estimator, features, metadata, source=source)
-    _check_usable(model)
-    return model
+    return payload
 
 
 def _check_usable(model: SupportModel) -> None:

@@ -136,6 +136,11 @@ class Decision:
         Wall time of the sampled groups (0 when none was sampled).
     near_tie_margin : float
         The near-tie margin the choice was made with (0: Eq. 13's minimum).
+    reasons : tuple of dict
+        With the ``moves`` cost (:mod:`unstack.moves`): per box, its expected boxes moved and
+        what drives it (the boxes it holds up with their conditional P, its hidden load).
+    disturbance_model : str
+        With the ``moves`` cost: the disturbance model file the expected moves came from.
 
     Examples
     --------
@@ -164,6 +169,8 @@ class Decision:
     warnings: tuple[str, ...] = ()
     sampling_seconds: float = 0.0
     near_tie_margin: float = 0.0
+    reasons: tuple[dict[str, Any], ...] = ()
+    disturbance_model: str = ""
 
     def ranking(self) -> list[tuple[str, float, float]]:
         """Every box with its expected cost and that cost's standard error, best first.
@@ -231,7 +238,10 @@ class Decision:
         if self.expected_cost_errors is not None and self.marginal_errors is not None:
             data["expected_cost_errors"] = self.expected_cost_errors.tolist()
             data["marginal_errors"] = self.marginal_errors.tolist()
-        data["choice_probability"] = self.choice_probability
+            data["choice_probability"] = self.choice_probability
+        if self.reasons:
+            data["reasons"] = [dict(reason) for reason in self.reasons]
+            data["disturbance_model"] = self.disturbance_model
         if self.sampling is not None:
             data["sampling"] = self.sampling
         data["evidence"] = {

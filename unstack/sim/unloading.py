@@ -33,9 +33,11 @@ __all__ = [
     "REACH_RULES",
     "UnloadRun",
     "UnloadStep",
+    "detector_misses_draw",
     "execute_policy",
     "execute_unloading",
     "fallen_boxes",
+    "probe_removals",
     "reachable_boxes",
     "unload_container",
 ]
@@ -242,7 +244,7 @@ def reachable_boxes(boxes: Sequence[Any], candidates: Sequence[str], rule: str =
     return result
 
 
-def _detector_misses(candidates: list[str], share: float, seed: np.random.SeedSequence) -> list[str]:
+def detector_misses_draw(candidates: list[str], share: float, seed: np.random.SeedSequence) -> list[str]:
     """The candidates a detector that misses ``share`` of the boxes finds (at least one)."""
     rng = np.random.default_rng(seed)
     while True:
@@ -253,13 +255,14 @@ def _detector_misses(candidates: list[str], share: float, seed: np.random.SeedSe
 
 def unload_container(
     scene: Scene,
-    policy: Callable[[Scene], str],
+    policy: Callable[..., str],
     *,
     detector_noise: float = 0.0,
     detector_misses: float = 0.0,
     reach: str = "door",
     max_picks: int | None = None,
     seed: int = 0,
+    probe: bool = False,
 ) -> UnloadRun:
     """Unload the container as a robot does: scan, detect, pick, and again, until it is empty.
 
@@ -289,6 +292,10 @@ def unload_container(
     max_picks : int, optional
     seed : int
         Seeds the scans' depth noise and the detector errors, step by step.
+    probe : bool
+        Before every pick, try each candidate's removal in the engine (:func:`probe_removals`,
+        the true pile) and call ``policy(current_scene, outcomes)`` with what each would move:
+        the physics look-ahead, and the source of the pick-disturbance training data.
 
     Returns
     -------
@@ -323,14 +330,17 @@ def unload_container(
             return None
         if detector_misses:
             misses_seed = np.random.SeedSequence(seed, spawn_key=(number, 1))
-            candidates = _detector_misses(candidates, detector_misses, misses_seed)
+            candidates = detector_misses_draw(candidates, detector_misses, misses_seed)
         reported = (
             detector_poses(true_boxes, detector_noise, np.random.default_rng(step_seed))
             if detector_noise
             else true_boxes
         )
         current = Scene(reported, scan.points, candidates, metadata=scene.metadata, source=scene.source)
-        choice = policy(current)
+        if probe:
+            choice = policy(current, probe_removals(scene, world, in_place, candidates, number))
+        else:
+            choice = policy(current)
         if choice not in candidates:
             raise UnstackError(f"{scene.source}: the policy picked {choice!r}, not one of the reachable detected boxes")
         return choice
@@ -357,8 +367,6 @@ def _execute(scene: Scene, next_box: Callable[[int, Any, list[str]], str | None]
     Boxes that leave the container (:data:`LOST_BELOW_FLOOR`) leave ``in_place`` with the step
     that lost them (``UnloadStep.lost``).
     """
-    from unstack.geometry import rotation_angles_deg
-    from unstack.sim.ground_truth import PARKING, run_horizon
     from unstack.sim.world import PhysicsWorld
 
     settings = _scene_settings(scene)
@@ -381,31 +389,83 @@ def _execute(scene: Scene, next_box: Callable[[int, Any, list[str]], str | None]
                 break
             order.append(box_id)
             in_place.remove(box_id)
-            watched = [bodies[other] for other in in_place]
-            before, before_turn = world.poses(watched)
-            parking = PARKING + np.array([10.0 * number, 0.0, 0.0])
-            world.client.resetBasePositionAndOrientation(bodies[box_id], parking.tolist(), [0.0, 0.0, 0.0, 1.0])
-            world.client.resetBaseVelocity(bodies[box_id], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
-            run_horizon(world, truth, watched)
-            after, after_turn = world.poses(watched)
-            moved = np.linalg.norm(after - before, axis=1)
-            disturbed = (moved > truth.displacement_threshold) | (
-                rotation_angles_deg(before_turn, after_turn) > truth.rotation_threshold_deg
-            )
-            fallen = fallen_boxes(before, before_turn, after, after_turn)
-            lost = tuple(in_place[k] for k in np.flatnonzero(after[:, 2] < -LOST_BELOW_FLOOR))
-            steps.append(
-                UnloadStep(
-                    box_id,
-                    tuple(in_place[k] for k in np.flatnonzero(disturbed)),
-                    float(moved[disturbed].sum()),
-                    float(moved.max(initial=0.0)),
-                    tuple(in_place[k] for k in np.flatnonzero(fallen)),
-                    lost,
-                )
-            )
-            in_place = [other for other in in_place if other not in lost]
+            step = _remove_and_measure(world, bodies, in_place, box_id, number, truth)
+            steps.append(step)
+            in_place = [other for other in in_place if other not in step.lost]
     return UnloadRun(tuple(order), tuple(steps), drift)
+
+
+def _remove_and_measure(
+    world: Any, bodies: dict[str, int], in_place: list[str], box_id: str, number: int, truth: Any
+) -> UnloadStep:
+    """Take ``box_id`` out of ``world`` (parked in slot ``number``), run the horizon and measure
+    the boxes of ``in_place`` (which must not hold ``box_id``)."""
+    from unstack.geometry import rotation_angles_deg
+    from unstack.sim.ground_truth import PARKING, run_horizon
+
+    watched = [bodies[other] for other in in_place]
+    before, before_turn = world.poses(watched)
+    parking = PARKING + np.array([10.0 * number, 0.0, 0.0])
+    world.client.resetBasePositionAndOrientation(bodies[box_id], parking.tolist(), [0.0, 0.0, 0.0, 1.0])
+    world.client.resetBaseVelocity(bodies[box_id], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    run_horizon(world, truth, watched)
+    after, after_turn = world.poses(watched)
+    moved = np.linalg.norm(after - before, axis=1)
+    disturbed = (moved > truth.displacement_threshold) | (
+        rotation_angles_deg(before_turn, after_turn) > truth.rotation_threshold_deg
+    )
+    fallen = fallen_boxes(before, before_turn, after, after_turn)
+    return UnloadStep(
+        box_id,
+        tuple(in_place[k] for k in np.flatnonzero(disturbed)),
+        float(moved[disturbed].sum()),
+        float(moved.max(initial=0.0)),
+        tuple(in_place[k] for k in np.flatnonzero(fallen)),
+        tuple(in_place[k] for k in np.flatnonzero(after[:, 2] < -LOST_BELOW_FLOOR)),
+    )
+
+
+def probe_removals(
+    scene: Scene, world: Any, in_place: Sequence[str], candidates: Sequence[str], number: int = 0
+) -> dict[str, UnloadStep]:
+    """What taking out each candidate would do, tried in ``world`` itself and undone.
+
+    The world's state is saved, each candidate removed and measured as an unloading step
+    would be (:data:`RESETTLE_SECONDS` aside: the same horizon, thresholds and parking), and
+    the state restored after each try, so the world is left as it was and each outcome is
+    what choosing that candidate next would do (the same boxes move; restoring a state keeps
+    poses and velocities, not the contact solver's warm start, so distances differ slightly). This
+    is the physics look-ahead of the container experiment: it knows the true pile.
+
+    Parameters
+    ----------
+    scene : Scene
+        The simulated scene whose pile ``world`` holds (``world.boxes`` in its box order).
+    world : PhysicsWorld
+    in_place : sequence of str
+        The boxes still in the container.
+    candidates : sequence of str
+        Boxes of ``in_place`` to try.
+    number : int
+        Parking slot of the removed box (the step number).
+
+    Returns
+    -------
+    dict of str to UnloadStep
+    """
+    truth = _scene_settings(scene).ground_truth
+    bodies = dict(zip(scene.box_ids, world.boxes, strict=True))
+    state = world.client.saveState()
+    outcomes = {}
+    try:
+        for box_id in candidates:
+            others = [other for other in in_place if other != box_id]
+            outcomes[box_id] = _remove_and_measure(world, bodies, others, box_id, number, truth)
+            world.client.restoreState(stateId=state)
+    finally:
+        world.client.restoreState(stateId=state)
+        world.client.removeState(state)
+    return outcomes
 
 
 def fallen_boxes(before: np.ndarray, before_turn: np.ndarray, after: np.ndarray, after_turn: np.ndarray) -> np.ndarray:

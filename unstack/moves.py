@@ -1,0 +1,165 @@
+"""The cost a robot pays: the boxes a pick is expected to move, and the decision on it.
+
+The reasoner's expected cost (Eq. 13) counts the boxes a pick holds up. What a robot pays
+is every box that moves when the pick is taken out. :func:`decide_on_moves` computes the
+reasoner's decision (the ``load`` cost, its marginals), turns each detected box's situation
+into the features of :mod:`unstack.learning.pick_features`, asks the disturbance model
+(:mod:`unstack.learning.disturbance`) how many boxes each pick moves, and takes the box of
+fewest expected moves -- near ties (:data:`MOVES_NEAR_TIE_MARGIN`) to the box resting highest,
+one layer by the fewest moves, as :func:`unstack.reasoner.decision.choose` does. Each box gets
+its reasons (:func:`pick_reasons`): the relations and the load that drive its cost.
+
+Needs a scene (a cloud and poses): a supports file has neither, and is decided on ``load``.
+
+Examples
+--------
+>>> import unstack
+>>> decision = unstack.decide(unstack.load("examples/pile5.scene.json"), cost="moves", seed=0)
+>>> decision.cost, decision.choice in decision.objects
+('moves', True)
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+
+from unstack.scene import Scene
+from unstack.supports import Supports
+
+__all__ = [
+    "MOVES_EXACT_MAX_BOXES",
+    "MOVES_NEAR_TIE_MARGIN",
+    "REASON_MIN_PROBABILITY",
+    "decide_on_moves",
+    "pick_reasons",
+]
+
+#: Picks whose expected boxes moved lie within this of the fewest count as tied (the box
+#: resting highest of them is taken).
+MOVES_NEAR_TIE_MARGIN = 0.05
+#: Groups of linked boxes up to this size get exact marginals, larger ones are sampled: the
+#: compiled walk of 8 boxes takes about a second, sampling them 30 ms, and the disturbance
+#: model reads marginals as features, not as the cost itself.
+MOVES_EXACT_MAX_BOXES = 7
+#: Support relations below this conditional probability are not named as a reason.
+REASON_MIN_PROBABILITY = 0.2
+#: At most this many relations are named per box.
+REASONS_PER_BOX = 3
+
+
+def pick_reasons(supports: Supports, marginals: np.ndarray, moves: np.ndarray) -> list[dict[str, Any]]:
+    """What drives each box's cost: the boxes it holds up (conditional P), its hidden load.
+
+    Returns, per object: ``box``, ``expected_moves``, ``holds_up`` (up to
+    :data:`REASONS_PER_BOX` ``[box, P]`` pairs with P at least :data:`REASON_MIN_PROBABILITY`,
+    largest first), ``hidden_load`` and ``held_by`` (the box most likely holding it up, with P).
+
+    Examples
+    --------
+    >>> supports = Supports(["a", "b"], [[0, 0.8], [0.1, 0]], hidden_load=[0.0, 0.5])
+    >>> pick_reasons(supports, np.array([[0, 0.8], [0.1, 0]]), np.array([1.2, 0.4]))[0]["holds_up"]
+    [['b', 0.8]]
+    """
+    objects = supports.objects
+    hidden = np.zeros(len(objects)) if supports.hidden_load is None else np.asarray(supports.hidden_load)
+    reasons = []
+    for k, box_id in enumerate(objects):
+        row = [(objects[j], float(marginals[k, j])) for j in range(len(objects)) if j != k]
+        held = [(objects[j], float(marginals[j, k])) for j in range(len(objects)) if j != k]
+        strongest = sorted((pair for pair in row if pair[1] >= REASON_MIN_PROBABILITY), key=lambda pair: -pair[1])
+        holder = max(held, key=lambda pair: pair[1], default=None)
+        reasons.append(
+            {
+                "box": box_id,
+                "expected_moves": round(float(moves[k]), 4),
+                "holds_up": [[other, round(p, 3)] for other, p in strongest[:REASONS_PER_BOX]],
+                "hidden_load": round(float(hidden[k]), 3),
+                "held_by": None if holder is None else [holder[0], round(holder[1], 3)],
+            }
+        )
+    return reasons
+
+
+def decide_on_moves(
+    scene: Scene,
+    supports: Supports,
+    *,
+    disturbance: Any = None,
+    near_tie_margin: float | None = None,
+    **reasoning: Any,
+) -> Any:
+    """The box whose removal is expected to move the fewest boxes.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene ``supports`` was computed from (its detected boxes and cloud are read).
+    supports : Supports
+        Its support probabilities (:func:`unstack.support_probabilities`).
+    disturbance : DisturbanceModel, optional
+        Default: the shipped model (:func:`unstack.learning.disturbance.load_disturbance_model`).
+    near_tie_margin : float, optional
+        Expected moves within this of the fewest count as tied (default
+        :data:`MOVES_NEAR_TIE_MARGIN`; 0: the plain minimum).
+    **reasoning
+        ``method``, ``seed``, ``samples``, ``time_limit``, ``max_boxes`` (default
+        :data:`MOVES_EXACT_MAX_BOXES`) of the reasoner's decision.
+
+    Returns
+    -------
+    Decision
+        ``cost == "moves"``; ``expected_costs`` are the expected boxes moved; ``marginals``
+        the reasoner's; ``reasons`` per box (:func:`pick_reasons`).
+    """
+    from unstack.learning.disturbance import load_disturbance_model
+    from unstack.learning.pick_features import pick_features
+    from unstack.reasoner.arguments import check_margin
+    from unstack.reasoner.decision import choose, decide
+
+    model = _disturbance(disturbance) if disturbance is not None else _shipped(load_disturbance_model)
+    margin = MOVES_NEAR_TIE_MARGIN if near_tie_margin is None else check_margin(near_tie_margin, "near_tie_margin")
+    reasoning.setdefault("max_boxes", MOVES_EXACT_MAX_BOXES)
+    base = decide(supports, cost="load", **reasoning)
+    features = pick_features(scene, supports, base.marginals, base.expected_costs)
+    moves = model.expected_moves(features)
+    choice, ties = choose(supports.objects, moves, heights=supports.heights, margin=margin)
+    return dataclasses.replace(
+        base,
+        choice=choice,
+        ties=ties,
+        expected_costs=moves,
+        expected_cost_errors=None,
+        cost="moves",
+        choice_probability=1.0,
+        near_tie_margin=margin,
+        reasons=tuple(pick_reasons(supports, base.marginals, moves)),
+        disturbance_model=model.source,
+    )
+
+
+_SHIPPED: dict[str, Any] = {}
+
+
+def _shipped(loader: Any) -> Any:
+    """The shipped disturbance model, loaded once per process."""
+    if "model" not in _SHIPPED:
+        _SHIPPED["model"] = loader()
+    return _SHIPPED["model"]
+
+
+def _disturbance(model: Any) -> Any:
+    import os
+
+    from unstack.errors import InvalidArgument
+    from unstack.learning.disturbance import load_disturbance_model
+
+    if isinstance(model, str | os.PathLike):
+        return load_disturbance_model(model)
+    if not hasattr(model, "expected_moves"):
+        raise InvalidArgument(
+            f"disturbance must be a model file path or a DisturbanceModel, got {type(model).__name__}"
+        )
+    return model
