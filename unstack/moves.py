@@ -32,7 +32,10 @@ from unstack.supports import Supports
 __all__ = [
     "MOVES_EXACT_MAX_BOXES",
     "MOVES_NEAR_TIE_MARGIN",
+    "MOVES_RULES",
+    "MOVES_VETO",
     "REASON_MIN_PROBABILITY",
+    "choose_on_moves",
     "decide_on_moves",
     "pick_reasons",
 ]
@@ -40,6 +43,12 @@ __all__ = [
 #: Picks whose expected boxes moved lie within this of the fewest count as tied (the box
 #: resting highest of them is taken).
 MOVES_NEAR_TIE_MARGIN = 0.05
+#: How the pick is chosen from the expected moves: ``fewest`` -- the fewest (near ties to the
+#: box resting highest); ``veto`` -- the box resting highest whose expected moves are below
+#: :data:`MOVES_VETO`, else the fewest (height first, vetoed where the model expects trouble).
+MOVES_RULES = ("fewest", "veto")
+#: A pick expected to move this many boxes or more is vetoed by the ``veto`` rule.
+MOVES_VETO = 0.5
 #: Groups of linked boxes up to this size get exact marginals, larger ones are sampled: the
 #: compiled walk of 8 boxes takes about a second, sampling them 30 ms, and the disturbance
 #: model reads marginals as features, not as the cost itself.
@@ -83,12 +92,39 @@ def pick_reasons(supports: Supports, marginals: np.ndarray, moves: np.ndarray) -
     return reasons
 
 
+def choose_on_moves(
+    objects: tuple[str, ...], moves: np.ndarray, heights: np.ndarray, *, rule: str = "fewest", margin: float
+) -> tuple[str, tuple[str, ...]]:
+    """The pick by ``rule`` (:data:`MOVES_RULES`) and the boxes it was chosen among.
+
+    Examples
+    --------
+    >>> objects, moves, heights = ("low", "high"), np.array([0.1, 0.3]), np.array([0.0, 0.4])
+    >>> choose_on_moves(objects, moves, heights, rule="fewest", margin=0.05)[0]
+    'low'
+    >>> choose_on_moves(objects, moves, heights, rule="veto", margin=0.05)[0]
+    'high'
+    """
+    from unstack.errors import InvalidArgument
+    from unstack.reasoner.decision import choose
+
+    if rule not in MOVES_RULES:
+        raise InvalidArgument(f"unknown moves rule {rule!r}; expected one of {', '.join(MOVES_RULES)}")
+    if rule == "veto":
+        allowed = [k for k in range(len(objects)) if moves[k] < MOVES_VETO]
+        if allowed:
+            best = max(allowed, key=lambda k: (float(heights[k]), objects[k]))
+            return objects[best], tuple(sorted(objects[k] for k in allowed))
+    return choose(objects, moves, heights=heights, margin=margin)
+
+
 def decide_on_moves(
     scene: Scene,
     supports: Supports,
     *,
     disturbance: Any = None,
     near_tie_margin: float | None = None,
+    rule: str = "fewest",
     **reasoning: Any,
 ) -> Any:
     """The box whose removal is expected to move the fewest boxes.
@@ -104,6 +140,8 @@ def decide_on_moves(
     near_tie_margin : float, optional
         Expected moves within this of the fewest count as tied (default
         :data:`MOVES_NEAR_TIE_MARGIN`; 0: the plain minimum).
+    rule : {"fewest", "veto"}
+        How the pick is chosen from the expected moves (:func:`choose_on_moves`).
     **reasoning
         ``method``, ``seed``, ``samples``, ``time_limit``, ``max_boxes`` (default
         :data:`MOVES_EXACT_MAX_BOXES`) of the reasoner's decision.
@@ -117,7 +155,7 @@ def decide_on_moves(
     from unstack.learning.disturbance import load_disturbance_model
     from unstack.learning.pick_features import pick_features
     from unstack.reasoner.arguments import check_margin
-    from unstack.reasoner.decision import choose, decide
+    from unstack.reasoner.decision import decide
 
     model = _disturbance(disturbance) if disturbance is not None else _shipped(load_disturbance_model)
     margin = MOVES_NEAR_TIE_MARGIN if near_tie_margin is None else check_margin(near_tie_margin, "near_tie_margin")
@@ -125,7 +163,8 @@ def decide_on_moves(
     base = decide(supports, cost="load", **reasoning)
     features = pick_features(scene, supports, base.marginals, base.expected_costs)
     moves = model.expected_moves(features)
-    choice, ties = choose(supports.objects, moves, heights=supports.heights, margin=margin)
+    heights = np.asarray(supports.heights)
+    choice, ties = choose_on_moves(supports.objects, moves, heights, rule=rule, margin=margin)
     return dataclasses.replace(
         base,
         choice=choice,

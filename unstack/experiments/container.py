@@ -33,7 +33,10 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     one that moves the fewest boxes, ties to the box resting highest (the floor no policy can pass; slow).
 ``moves``
     the learned cost of what a pick moves (:mod:`unstack.moves`): the default model's
-    probabilities and the reasoner's marginals through the disturbance model.
+    probabilities and the reasoner's marginals through the disturbance model; the fewest.
+``moves_veto``
+    the same expected moves, the ``veto`` rule: the box resting highest whose expected
+    moves are below :data:`~unstack.moves.MOVES_VETO`.
 
 Metrics per pile and per maker: boxes moved more than 2 cm, boxes fallen (dropped more than
 0.2 m or tipped more than 45 degrees), the share of picks that move nothing, and paired
@@ -62,7 +65,7 @@ __all__ = ["CONTAINER_MAKERS", "CONTAINER_SAMPLES", "container_experiment", "con
 
 CONTAINER_MAKERS = (
     "unstack", "min_cost", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random", "lookahead",
-    "moves",
+    "moves", "moves_veto",
 )  # fmt: skip
 #: Makers whose policy is told what every candidate's removal does in the engine (the true pile).
 PROBING_MAKERS = ("lookahead",)
@@ -140,7 +143,13 @@ def container_policies(
 
     loaded: list[Any] = []
 
-    def moves(scene: Scene) -> str:
+    def moving(rule: str) -> Callable[[Scene], str]:
+        def policy(scene: Scene) -> str:
+            return moves(scene, rule)
+
+        return policy
+
+    def moves(scene: Scene, rule: str) -> str:
         from unstack.learning.disturbance import load_disturbance_model
         from unstack.learning.probabilities import scene_support_probabilities
         from unstack.moves import decide_on_moves
@@ -149,7 +158,8 @@ def container_policies(
             given = disturbance
             loaded.append(load_disturbance_model(given) if isinstance(given, str | os.PathLike | None) else given)
         supports = scene_support_probabilities(scene, model)
-        return str(decide_on_moves(scene, supports, disturbance=loaded[0], samples=samples, seed=seed).choice)
+        decision = decide_on_moves(scene, supports, disturbance=loaded[0], samples=samples, seed=seed, rule=rule)
+        return str(decision.choice)
 
     every: dict[str, Callable[..., str]] = {
         "unstack": deciding("load"),
@@ -161,7 +171,8 @@ def container_policies(
         "nearest_door": nearest_door,
         "random": random,
         "lookahead": lookahead,
-        "moves": moves,
+        "moves": moving("fewest"),
+        "moves_veto": moving("veto"),
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:
@@ -241,7 +252,7 @@ def container_experiment(
     container_policies(model, seed=seed, makers=makers)  # unknown makers fail before any work
     if disturbance is not None and not isinstance(disturbance, str | os.PathLike):
         disturbance = disturbance.source  # sent to the workers by path
-    if "moves" in makers:
+    if {"moves", "moves_veto"} & set(makers):
         from unstack.learning.disturbance import default_disturbance_path
 
         disturbance_path = Path(default_disturbance_path() if disturbance is None else disturbance)
@@ -258,7 +269,7 @@ def container_experiment(
         digest = hashlib.sha256(path.read_bytes()).hexdigest()
         # detector_misses joins the key only when set: runs made before it keep their checkpoints
         kept = {name: value for name, value in settings.items() if name != "detector_misses" or value}
-        if "moves" in makers:  # the disturbance model joins the key only where it is used
+        if {"moves", "moves_veto"} & set(makers):  # the disturbance model joins the key only where it is used
             kept["disturbance_sha256"] = disturbance_digest
         return {"scene_sha256": digest, "model_sha256": model_digest, "makers": list(makers),
                 **kept, "seed": seed + number}  # fmt: skip

@@ -76,16 +76,45 @@ CONTACT_GAP = 0.02
 CLOUD_REACH = (1.5, 0.05, 0.04)
 #: A box resting lower than this (metres) stands on the floor.
 FLOOR_HEIGHT = 0.03
+#: Width of the cloud's columns for box queries (metres).
+COLUMN_WIDTH = 0.1
 #: Points inside a detected box grown by this (metres) are explained by it.
 EXPLAINED_MARGIN = 0.02
 
 
-def _within(points: np.ndarray, bound: np.ndarray, margin: float, above: float = 0.0) -> np.ndarray:
-    """Points inside ``bound`` grown by ``margin`` (and by ``above`` more over its top)."""
-    low = bound[:3] - margin
-    high = bound[3:] + margin + np.array([0.0, 0.0, above])
-    inside: np.ndarray = np.all((points >= low) & (points <= high), axis=1)
-    return inside
+class _Columns:
+    """The cloud binned into vertical columns of :data:`COLUMN_WIDTH` for fast box queries.
+
+    Points are sorted by column (x index major, y index minor), so the points under an
+    x-y rectangle are one contiguous run per x index.
+    """
+
+    def __init__(self, points: np.ndarray) -> None:
+        self.points = points
+        cells = np.floor(points[:, :2] / COLUMN_WIDTH).astype(np.int64) if len(points) else np.zeros((0, 2), np.int64)
+        self.low = cells.min(axis=0) if len(points) else np.zeros(2, np.int64)
+        cells -= self.low
+        self.span = int(cells[:, 1].max()) + 1 if len(points) else 1
+        keys = cells[:, 0] * self.span + cells[:, 1]
+        self.order = np.argsort(keys, kind="stable")
+        self.keys = keys[self.order]
+
+    def within(self, bound: np.ndarray, margin: float, above: float = 0.0) -> np.ndarray:
+        """Indices of the points inside ``bound`` grown by ``margin`` (and ``above`` more over its top)."""
+        low = bound[:3] - margin
+        high = bound[3:] + margin + np.array([0.0, 0.0, above])
+        if len(self.points) == 0:
+            return np.zeros(0, dtype=np.int64)
+        first = np.floor(low[:2] / COLUMN_WIDTH).astype(np.int64) - self.low
+        last = np.floor(high[:2] / COLUMN_WIDTH).astype(np.int64) - self.low
+        first_y, last_y = max(int(first[1]), 0), min(int(last[1]), self.span - 1)
+        runs = []
+        for x in range(max(int(first[0]), 0), int(last[0]) + 1):
+            start, stop = np.searchsorted(self.keys, [x * self.span + first_y, x * self.span + last_y + 1])
+            runs.append(self.order[start:stop])
+        near = np.concatenate(runs) if runs else np.zeros(0, dtype=np.int64)
+        inside = np.all((self.points[near] >= low) & (self.points[near] <= high), axis=1)
+        return np.sort(near[inside])
 
 
 def _overlap(first: np.ndarray, second: np.ndarray, axes: tuple[int, ...]) -> float:
@@ -175,9 +204,10 @@ def pick_features(scene: Scene, supports: Supports, marginals: np.ndarray, expec
     boxes = [scene.box(box_id) for box_id in objects]
     bounds = bounding_boxes(boxes)
     points = scene.points
+    columns = _Columns(points)
     explained = np.zeros(len(points), dtype=bool)
     for box, bound in zip(boxes, bounds, strict=True):
-        near = np.flatnonzero(_within(points, bound, EXPLAINED_MARGIN))
+        near = columns.within(bound, EXPLAINED_MARGIN)
         explained[near[points_in_box(points[near], box, margin=EXPLAINED_MARGIN)]] = True
     on_top, below, beside, covered = _contacts(bounds)
     hidden = np.zeros(n) if supports.hidden_load is None else np.asarray(supports.hidden_load, dtype=np.float64)
@@ -185,8 +215,8 @@ def pick_features(scene: Scene, supports: Supports, marginals: np.ndarray, expec
     rows = np.zeros((n, len(PICK_FEATURES)))
     for k, box in enumerate(boxes):
         bound = bounds[k]
-        reach = _within(points, bound, max(CLOUD_REACH[1:]) + 0.01, above=CLOUD_REACH[0])
-        cloud = _cloud_columns(points[reach], bound, explained[reach]) if reach.any() else (0.0,) * 5
+        reach = columns.within(bound, max(CLOUD_REACH[1:]) + 0.01, above=CLOUD_REACH[0])
+        cloud = _cloud_columns(points[reach], bound, explained[reach]) if len(reach) else (0.0,) * 5
         rows[k] = (
             bound[2],
             bound[5],
