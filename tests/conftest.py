@@ -37,8 +37,10 @@ def pytest_sessionstart(session: pytest.Session) -> None:
     warm_up(jobs=2)
 
 
-def unstack(*args: str, stdin: str | None = None, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
-    """Run ``python -m unstack ARGS`` in the repository (or ``cwd``); output captured as text."""
+def unstack(
+    *args: str, stdin: str | None = None, cwd: Path | None = None, env: dict[str, str] | None = None
+) -> subprocess.CompletedProcess[str]:
+    """Run ``python -m unstack ARGS`` in the repository (or ``cwd``, with ``env`` added); output as text."""
     return subprocess.run(
         [sys.executable, "-m", "unstack", *args],
         input=stdin,
@@ -46,6 +48,7 @@ def unstack(*args: str, stdin: str | None = None, cwd: Path | None = None) -> su
         text=True,
         cwd=cwd or REPO,
         timeout=300,
+        env=None if env is None else {**os.environ, **env},
     )
 
 

@@ -6,7 +6,7 @@ Every ``import`` counts, at module level or inside a function (imports under
 - the data model (``scene``, ``supports``, formats, checks, errors, geometry, atomic
   writes, data-set folders, ... -- the modules directly under ``unstack/``) at the bottom;
 - ``reasoner``, ``learning``, ``sim`` and ``pictures`` above it, none importing another;
-- the public API (``unstack``, ``api``, ``validation``, ``warmup``) above those;
+- the public API (``unstack``, ``api``, ``describe``, ``moves``, ``validation``, ``warmup``) above those;
 - ``experiments`` above that; ``cli`` on top.
 """
 
@@ -21,7 +21,7 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "unstack"
 MIDDLE = ("reasoner", "learning", "sim", "pictures")
-API = {"unstack", "unstack.api", "unstack.moves", "unstack.validation", "unstack.warmup"}
+API = {"unstack", "unstack.api", "unstack.describe", "unstack.moves", "unstack.validation", "unstack.warmup"}
 
 
 @dataclass(frozen=True)

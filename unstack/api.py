@@ -333,18 +333,29 @@ def decide(
             samples=samples,
             time_limit=time_limit,
         )
-        return decision
-    if disturbance is not None:
-        raise InvalidArgument("a disturbance model is used by the moves cost only; pass cost='moves'")
-    return decide_supports(
-        supports,
-        method=method,
-        cost=cost,
-        seed=seed,
-        samples=samples,
-        time_limit=time_limit,
-        near_tie_margin=near_tie_margin,
-    )
+    else:
+        if disturbance is not None:
+            raise InvalidArgument("a disturbance model is used by the moves cost only; pass cost='moves'")
+        decision = decide_supports(
+            supports,
+            method=method,
+            cost=cost,
+            seed=seed,
+            samples=samples,
+            time_limit=time_limit,
+            near_tie_margin=near_tie_margin,
+        )
+    return _described(decision, scene_or_supports, supports)
+
+
+def _described(decision: Decision, given: Scene | Supports, supports: Supports) -> Decision:
+    """The decision with the support model it rests on and where its pick is."""
+    import dataclasses
+
+    from unstack.describe import pick_place
+
+    model = str(supports.metadata.get("model", "")) if isinstance(given, Scene) else ""
+    return dataclasses.replace(decision, model=model, pick=pick_place(given, decision.choice))
 
 
 def plan(

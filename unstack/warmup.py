@@ -14,12 +14,15 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
+import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from typing import Any
 
 import numpy as np
 
-__all__ = ["KERNELS", "warm_up"]
+__all__ = ["KERNELS", "announcing_compilation", "might_compile", "warm_up"]
 
 
 def _exact() -> None:
@@ -67,6 +70,76 @@ KERNELS: tuple[tuple[str, Callable[[], None]], ...] = (
 #: Seconds each group took to compile on an empty cache, one after the other (2026-12-01, 2-core
 #: machine; the README): processes start the longest first.
 _COMPILE_SECONDS = {"exact engine": 35.4, "sampler": 37.5, "wide sampler": 53.6, "feature kernels": 10.2}
+
+
+#: The module each kernel group's compiled functions live in.
+_MODULES = {
+    "unstack.reasoner._insertion_kernels": "exact engine",
+    "unstack.reasoner._sampler_kernels": "sampler",
+    "unstack.reasoner._insertion_sum_kernels": "sampler",
+    "unstack.reasoner._wide_kernels": "wide sampler",
+    "unstack.learning._dbaf_kernel": "feature kernels",
+    "unstack.learning._contact_kernel": "feature kernels",
+}
+
+
+def might_compile(boxes: int) -> bool:
+    """Whether a decision on ``boxes`` boxes can call a compiled kernel at all.
+
+    Groups of up to 5 linked boxes are counted in plain Python (no numba import); a scene
+    with a model that reads the cloud may need the feature kernels whatever its size.
+
+    Examples
+    --------
+    >>> might_compile(5), might_compile(6)
+    (False, True)
+    """
+    return boxes > 5
+
+
+@contextlib.contextmanager
+def announcing_compilation(announce: Callable[[str], None]) -> Iterator[None]:
+    """Call ``announce(sentence)`` once, the moment numba starts compiling a kernel inside the block.
+
+    numba compiles a kernel on its first call in an environment whose on-disk cache does not
+    hold it (a fresh install); loading a cached kernel announces nothing. The sentence names
+    the kernel group, its compile time on one core (:data:`KERNELS`' measured seconds) and
+    ``unstack warm-up``. The listener is numba's own (``numba.core.event``) and is removed
+    when the block ends.
+
+    Examples
+    --------
+    >>> heard = []
+    >>> with announcing_compilation(heard.append):
+    ...     _ = warm_up()
+    >>> heard  # the suite's kernels are compiled already
+    []
+    """
+    from numba.core import event
+
+    lock = threading.Lock()
+    told: list[str] = []
+
+    class Listener(event.Listener):
+        def on_start(self, started: Any) -> None:
+            function = getattr(started.data.get("dispatcher"), "py_func", None)
+            group = _MODULES.get(getattr(function, "__module__", ""), "kernels")
+            with lock:
+                if told:
+                    return
+                told.append(group)
+            seconds = _COMPILE_SECONDS.get(group)
+            expected = f", about {seconds:.0f} s on one core" if seconds else ""
+            announce(
+                f"numba is compiling the {group} for first use in this environment (once{expected}; later "
+                "calls load it from numba's cache); 'unstack warm-up' compiles every kernel at once"
+            )
+
+        def on_end(self, ended: Any) -> None:
+            pass
+
+    with event.install_listener("numba:compile", Listener()):
+        yield
 
 
 def warm_up(progress: Callable[[str, float], None] | None = None, *, jobs: int = 1) -> dict[str, float]:

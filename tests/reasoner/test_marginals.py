@@ -117,5 +117,5 @@ def test_size_limit_is_a_clear_error() -> None:
 
 
 def test_sat_size_limit_is_a_clear_error() -> None:
-    with pytest.raises(TooLarge, match=r"limited to 6 boxes .* use the exact marginals engine"):
+    with pytest.raises(TooLarge, match=r"limited to 6 boxes .* decide without listing them \(unstack decide FILE"):
         enumerate_worlds(supports_of(np.zeros((7, 7))))

@@ -10,13 +10,14 @@ file loads neither scikit-learn, numba for small groups, networkx nor rich's tab
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import json
 import math
 import os
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import click
@@ -192,6 +193,31 @@ def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
     return command
 
 
+@contextlib.contextmanager
+def _first_call(loaded: Any) -> Iterator[None]:
+    """Say at once when numba starts compiling kernels inside the block; a spinner on a terminal meanwhile."""
+    import unstack
+    from unstack.warmup import might_compile
+
+    boxes = len(loaded.detected) if isinstance(loaded, unstack.Scene) else len(loaded.objects)
+    if not (isinstance(loaded, unstack.Scene) or might_compile(boxes)):
+        yield  # plain Python: numba is not even imported
+        return
+    from unstack.warmup import announcing_compilation
+
+    with contextlib.ExitStack() as stack:
+
+        def announce(sentence: str) -> None:
+            click.echo(f"unstack: note: {sentence}", err=True)
+            if sys.stderr.isatty():
+                from rich.console import Console
+
+                stack.enter_context(Console(stderr=True).status("compiling numba's kernels ..."))
+
+        with announcing_compilation(announce):
+            yield
+
+
 def _print_warnings(warnings: tuple[str, ...]) -> None:
     for warning in warnings:
         _warn(warning)
@@ -224,7 +250,9 @@ def decide(file: str, as_json: bool, output: str | None, timing: bool, model: st
     import unstack
 
     _check_output(output)
-    decision = unstack.decide(_load_input(file, model, reasoning["statics"]), model=model, **reasoning)
+    loaded = _load_input(file, model, reasoning["statics"])
+    with _first_call(loaded):
+        decision = unstack.decide(loaded, model=model, **reasoning)
     document = decision.to_dict(timing=timing)
     _write_output(output, document)
     _print_warnings(decision.warnings)
@@ -286,7 +314,7 @@ def plan(file: str, as_json: bool, output: str | None, model: str | None, **reas
 
     _check_output(output)
     supports = _load_input(file, model, reasoning["statics"])
-    with progress_bar("planning: steps") as report:
+    with _first_call(supports), progress_bar("planning: steps") as report:
         result = unstack.plan(supports, model=model, progress=report, **reasoning)
     document = result.to_dict()
     _write_output(output, document)

@@ -6,6 +6,8 @@ rich markup or a terminal escape sequence.
 
 from __future__ import annotations
 
+from typing import Any
+
 from rich.console import Group
 from rich.table import Table
 from rich.text import Text
@@ -32,18 +34,15 @@ MATRIX_MAX_BOXES = 12
 
 
 def decision_view(decision: Decision) -> Group:
-    """The choice, the expected cost of every box and the conditional support matrix."""
-    titles = {
-        "mass": "EC: expected kg supported (Eq. 13)",
-        "count": "EC: detected boxes supported (Eq. 11)",
-        "load": "EC: boxes supported, hidden load too",
-        "moves": "Expected boxes moved by taking the box out (learned disturbance model)",
-    }
+    """The choice and where it is, what the cost counts, every box's expected cost, the
+    conditional support matrix, and the model, method and evidence it rests on."""
+    from unstack.describe import COST_UNITS, cost_in_words, model_in_words, place_in_words
+
     order = sorted(range(len(decision.objects)), key=lambda i: (decision.expected_costs[i], decision.objects[i]))
-    costs = Table(title=titles.get(decision.cost, "EC (Eq. 13)"), title_justify="left")
+    costs = Table()
     costs.add_column("rank", justify="right")
     costs.add_column("box")
-    costs.add_column("moved" if decision.cost == "moves" else "EC", justify="right")
+    costs.add_column(f"expected {COST_UNITS.get(decision.cost, 'cost')}", justify="right")
     sampled = decision.sampling is not None and decision.expected_cost_errors is not None
     if sampled:
         costs.add_column("± s.e.", justify="right")
@@ -63,23 +62,7 @@ def decision_view(decision: Decision) -> Group:
             cells = ["-" if i == j else f"{decision.marginals[i, j]:.3f}" for j in range(len(decision.objects))]
             matrix.add_row(_id(box), *cells)
     else:
-        matrix = Text(f"({len(decision.objects)} boxes: P(row supports column | consistent) is in --json)")
-    worlds = "" if decision.consistent_worlds is None else f", {decision.consistent_worlds:,} consistent worlds"
-    evidence = decision.evidence
-    hard = f", hard evidence: {len(evidence.forced)} forced / {len(evidence.forbidden)} forbidden"
-    linked = [group for group in decision.components if len(group) > 1]
-    groups = (
-        f", {len(decision.components)} independent groups (largest {max(len(g) for g in decision.components)})"
-        if len(decision.components) > 1 and linked
-        else ""
-    )
-    footer = Text(f"method {decision.method}{worlds}{groups}{hard}, {decision.seconds:.3f} s", style="dim")
-    if decision.sampling is not None:
-        footer.append(
-            f"\nsampled: {sum(decision.sampling['samples']):,} sweeps in {decision.sampling['chains']} chains per "
-            f"group, seed {decision.sampling['seed']}, largest R-hat {decision.sampling['rhat_max']}; errors are "
-            "standard errors (about 95 % of true values lie within 2 of them)"
-        )
+        matrix = Text(f"({len(decision.objects)} boxes: P(row supports column | consistent world) is in --json)")
     headline = Text.assemble(("Unload first: ", "bold"), (printable(decision.choice), "bold green"))
     near = decision.near_tie_margin
     if decision.choice_probability < 1.0 or decision.sampling is not None:
@@ -89,9 +72,42 @@ def decision_view(decision: Decision) -> Group:
         others = ", ".join(printable(t) for t in decision.ties if t != decision.choice)
         rule = f"EC within {near:g} of the lowest; the box resting highest wins" if near else "smallest id wins"
         headline.append(f"  (tied with {others}: {rule})")
+    if decision.pick is not None:
+        headline.append(f"\nwhere: {place_in_words(decision.pick)}")
+    headline.append(f"\n{cost_in_words(decision.cost)}", style="dim")
+    parts: list[Any] = [headline]
     if decision.reasons:
-        return Group(headline, _why(decision), costs, matrix, footer)
-    return Group(headline, costs, matrix, footer)
+        parts.append(_why(decision))
+    return Group(*parts, costs, matrix, _footer(decision, model_in_words(decision.model)))
+
+
+def _footer(decision: Decision, model: str) -> Text:
+    """What the decision rests on: the model, the method, hard evidence, the sampler's run."""
+    worlds = "" if decision.consistent_worlds is None else f", {decision.consistent_worlds:,} consistent worlds"
+    evidence = decision.evidence
+    hard = (
+        f"hard evidence (probabilities 0 or 1): {len(evidence.forced)} forced, {len(evidence.forbidden)} forbidden"
+        if evidence.forced or evidence.forbidden
+        else "no hard evidence"
+    )
+    groups = (
+        f", {len(decision.components)} independent groups (largest {max(len(g) for g in decision.components)})"
+        if len(decision.components) > 1 and any(len(group) > 1 for group in decision.components)
+        else ""
+    )
+    footer = Text(
+        f"support model: {model}\nmethod {decision.method}{worlds}{groups}; {hard}; {decision.seconds:.3f} s",
+        style="dim",
+    )
+    if decision.sampling is not None:
+        seed = decision.sampling["seed"]
+        seeded = f"seed {seed}" if seed is not None else "no seed (a run differs slightly; --seed 0 repeats one)"
+        footer.append(
+            f"\nsampled: {sum(decision.sampling['samples']):,} sweeps in {decision.sampling['chains']} chains per "
+            f"group, {seeded}, largest R-hat {decision.sampling['rhat_max']}; ± s.e. are standard errors (about "
+            f"95 % of true values lie within 2 of them; --samples {4 * max(decision.sampling['samples'])} halves them)"
+        )
+    return footer
 
 
 def _why(decision: Decision) -> Text:

@@ -141,6 +141,12 @@ class Decision:
         what drives it (the boxes it holds up with their conditional P, its hidden load).
     disturbance_model : str
         With the ``moves`` cost: the disturbance model file the expected moves came from.
+    model : str
+        The support model that gave the probabilities (:func:`unstack.api.model_label`;
+        empty when the probabilities were given).
+    pick : dict or None
+        Where the chosen box is (:func:`unstack.describe.pick_place`): its centre and top
+        for a scene, its resting height for supports with heights.
 
     Examples
     --------
@@ -171,6 +177,8 @@ class Decision:
     near_tie_margin: float = 0.0
     reasons: tuple[dict[str, Any], ...] = ()
     disturbance_model: str = ""
+    model: str = ""
+    pick: dict[str, Any] | None = None
 
     def ranking(self) -> list[tuple[str, float, float]]:
         """Every box with its expected cost and that cost's standard error, best first.
@@ -228,6 +236,10 @@ class Decision:
             "method": self.method,
             "cost": self.cost,
         }
+        if self.model:
+            data["model"] = self.model
+        if self.pick is not None:
+            data["pick"] = dict(self.pick)
         if self.consistent_worlds is not None:
             data["consistent_worlds"] = self.consistent_worlds
         data["ties"] = list(self.ties)
@@ -424,15 +436,16 @@ def _sampling_summary(results: list[_GroupResult], seed: int | None) -> dict[str
     slowest = min(result.acceptance for result in sampled)
     worst_rhat = max(float(np.max(result.convergence_of(np.ones(result.marginals.shape[0])))) for result in sampled)
     summary["rhat_max"] = round(worst_rhat, 4) if np.isfinite(worst_rhat) else None
+    longer = 4 * max(result.samples for result in sampled)  # four times the sweeps halve the errors
     if slowest < LOW_ACCEPTANCE:
         summary["warning"] = (
             f"re-insertion moves were accepted in only {100 * slowest:.1f} % of the tries: the chains mix slowly "
-            "and the standard errors may be too small; sample longer and compare seeds"
+            f"and the standard errors may be too small; sample longer (--samples {longer}) and compare two seeds"
         )
     elif not worst_rhat <= HIGH_RHAT:
         summary["warning"] = (
             f"the chains disagree (R-hat of an EC {worst_rhat:.2f} > {HIGH_RHAT}): they have not mixed and the "
-            "standard errors are too small; sample longer"
+            f"standard errors are too small; sample longer (--samples {longer})"
         )
     return summary
 

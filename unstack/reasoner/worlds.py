@@ -118,7 +118,8 @@ def enumerate_worlds(supports: Supports, *, solver: str = SAT_SOLVER, max_boxes:
         raise TooLarge(
             f"{n} boxes: listing consistent worlds is limited to {max_boxes} boxes "
             f"(n = {max_boxes + 1} has {PREORDER_COUNTS[max_boxes + 1]:,} worlds); "
-            "use the exact marginals engine (method 'exact'), which does not list worlds"
+            "decide without listing them (unstack decide FILE, or method 'auto': exact up to 8 linked boxes, "
+            "sampled above)"
         )
     evidence = propagate_evidence(objects, supports.probabilities)
     variables = SupportVariables(objects)

@@ -1,0 +1,104 @@
+"""The decision's terminal text explains itself: the pick's place, the cost in words, the model, no "None"."""
+
+from __future__ import annotations
+
+import io
+import json
+from pathlib import Path
+
+import jsonschema
+import pytest
+from rich.console import Console
+
+import unstack
+from tests.conftest import EXAMPLES, PILE5
+from tests.conftest import unstack as unstack_cli
+from unstack.cli.render import decision_view
+from unstack.jsonio import load_schema
+from unstack.supports import Supports
+
+
+def text_of(decision: unstack.Decision) -> str:
+    buffer = io.StringIO()
+    Console(file=buffer, width=400, highlight=False).print(decision_view(decision))
+    return buffer.getvalue()
+
+
+@pytest.fixture(scope="module")
+def scene_decision() -> unstack.Decision:
+    return unstack.decide(unstack.load(EXAMPLES / "pile5.scene.json"))
+
+
+@pytest.mark.slow  # loads the default model
+def test_a_scene_decision_names_its_model_cost_and_where_the_pick_is(scene_decision: unstack.Decision) -> None:
+    text = text_of(scene_decision)
+    assert "support model: general (the default model)" in text
+    assert "cost 'load': the boxes that would come down with it" in text and "lower is safer" in text
+    assert "where: centre x" in text and "of the 5 detected boxes" in text
+    assert "expected boxes held up" in text and "None" not in text
+
+
+@pytest.mark.slow  # loads the default model
+def test_the_pick_is_where_the_scene_has_it(scene_decision: unstack.Decision) -> None:
+    from unstack.geometry import bounding_boxes
+
+    scene = unstack.load(EXAMPLES / "pile5.scene.json")
+    tops = {
+        box: float(bounds[5])
+        for box, bounds in zip(scene.detected, bounding_boxes([scene.box(b) for b in scene.detected]), strict=True)
+    }
+    pick = scene_decision.pick
+    assert pick is not None and pick["top"] == pytest.approx(tops[scene_decision.choice], abs=1e-4)
+    assert pick["height_rank"] == 1 + sum(top > tops[scene_decision.choice] for top in tops.values())
+    assert pick["centre"] == pytest.approx(scene.box(scene_decision.choice).position.tolist(), abs=1e-4)
+
+
+@pytest.mark.slow  # loads the default model
+def test_the_json_carries_the_model_and_the_pick_and_validates(scene_decision: unstack.Decision) -> None:
+    document = json.loads(json.dumps(scene_decision.to_dict()))
+    jsonschema.validate(document, load_schema("unstack.decision/1"))
+    assert document["model"] == "default:general-mix.skops" and document["pick"]["boxes"] == 5
+
+
+@pytest.mark.parametrize("seed", [None, 3])
+def test_a_sampled_decision_says_its_seed_in_words(seed: int | None) -> None:
+    supports = Supports([f"b{k}" for k in range(3)], [[0, 0.4, 0.2], [0.3, 0, 0.6], [0.5, 0.1, 0]])
+    decision = unstack.decide(supports, method="approx", samples=64, seed=seed)
+    text = text_of(decision)
+    assert "None" not in text and "support model: none (the probabilities were given)" in text
+    assert ("seed 3" in text) if seed is not None else ("no seed" in text and "--seed 0 repeats one" in text)
+    assert decision.sampling is not None and f"--samples {4 * max(decision.sampling['samples'])} halves them" in text
+
+
+def test_supports_with_heights_say_where_the_pick_rests() -> None:
+    supports = Supports(["low", "high"], [[0, 0.9], [0.05, 0]], heights=[0.0, 0.4])
+    decision = unstack.decide(supports)
+    assert decision.pick == {"rests_at": 0.4, "height_rank": 1, "boxes": 2}
+    assert "where: resting 0.40 m above the floor, the highest of the 2 boxes" in text_of(decision)
+
+
+def test_supports_without_heights_have_no_place() -> None:
+    decision = unstack.decide(Supports(["a", "b"], [[0, 0.2], [0.7, 0]]))
+    assert decision.pick is None and "where:" not in text_of(decision) and "pick" not in decision.to_dict()
+
+
+def test_hard_evidence_is_counted_in_words() -> None:
+    decision = unstack.decide(Supports(["a", "b", "c"], [[0, 1.0, 0.2], [0.0, 0, 0.3], [0.1, 0.2, 0]]))
+    assert "hard evidence (probabilities 0 or 1): 1 forced, 1 forbidden" in text_of(decision)
+
+
+@pytest.mark.slow  # subprocesses on an empty numba cache compile the contact kernel
+def test_a_first_call_that_compiles_says_so_and_the_next_one_is_quiet(tmp_path: Path) -> None:
+    call = ("decide", "examples/pile5.scene.json", "--model", "extended")
+    first = unstack_cli(*call, env={"NUMBA_CACHE_DIR": str(tmp_path)})
+    assert first.returncode == 0, first.stderr
+    assert "unstack: note: numba is compiling the feature kernels for first use in this environment" in first.stderr
+    assert "'unstack warm-up' compiles every kernel at once" in first.stderr
+    again = unstack_cli(*call, env={"NUMBA_CACHE_DIR": str(tmp_path)})
+    assert again.returncode == 0 and "numba is compiling" not in again.stderr
+
+
+@pytest.mark.slow  # a subprocess
+def test_a_call_in_plain_python_says_nothing(tmp_path: Path) -> None:
+    result = unstack_cli("decide", PILE5, env={"NUMBA_CACHE_DIR": str(tmp_path)})
+    assert result.returncode == 0 and result.stderr == ""

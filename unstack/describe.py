@@ -1,0 +1,143 @@
+"""A decision in plain words: what its cost means, which model gave the probabilities, where the pick is.
+
+The terminal output of ``unstack decide`` reads these; a planner's log can too.
+
+Examples
+--------
+>>> import unstack
+>>> scene = unstack.load("examples/pile5.scene.json")
+>>> place = pick_place(scene, "b13")
+>>> place["height_rank"], place["boxes"]
+(1, 5)
+>>> place_in_words(place)
+'centre x 1.11 m, y -0.06 m; top 0.78 m above the floor, the highest of the 5 detected boxes'
+>>> model_in_words("default:general-mix.skops")
+'general (the default model)'
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from unstack.scene import Scene
+from unstack.supports import Supports
+
+__all__ = ["COST_WORDS", "cost_in_words", "model_in_words", "ordinal", "pick_place", "place_in_words"]
+
+#: What each cost counts, in one sentence.
+COST_WORDS = {
+    "load": "the boxes that would come down with it (the detected boxes it holds up, directly or through "
+    "others, with the undetected load the point cloud shows on them)",
+    "count": "the detected boxes it is expected to hold up, directly or through others (the paper's Eq. 11)",
+    "mass": "the kilograms of detected boxes it is expected to hold up, directly or through others",
+    "moves": "the boxes that taking it out is expected to move by more than 2 cm (the learned disturbance model)",
+}
+#: The unit of each cost's expected value, for a column header.
+COST_UNITS = {"load": "boxes held up", "count": "boxes held up", "mass": "kg held up", "moves": "boxes moved"}
+
+
+def cost_in_words(cost: str) -> str:
+    """One sentence saying what ``cost`` counts, ending with which way is safer.
+
+    Examples
+    --------
+    >>> cost_in_words("mass")
+    "cost 'mass': the kilograms of detected boxes it is expected to hold up, directly or through others; lower is safer"
+    """
+    return f"cost {cost!r}: {COST_WORDS.get(cost, 'the expected cost of Eq. 13')}; lower is safer"
+
+
+def model_in_words(label: str) -> str:
+    """A support model's provenance label (:func:`unstack.api.model_label`) in words.
+
+    Examples
+    --------
+    >>> model_in_words("shipped:default-paper2.skops")
+    'paper (a shipped model)'
+    >>> model_in_words("")
+    'none (the probabilities were given)'
+    """
+    from unstack.learning.model_file import BUNDLED_MODELS
+
+    names = {file: name for name, file in BUNDLED_MODELS.items()}
+    kind, _, file = label.partition(":")
+    if kind == "default" and file in names:
+        return f"{names[file]} (the default model)"
+    if kind == "shipped" and file in names:
+        return f"{names[file]} (a shipped model)"
+    if not label:
+        return "none (the probabilities were given)"
+    return f"the model file {label}"
+
+
+def ordinal(rank: int) -> str:
+    """``1`` -> ``"1st"``, ``12`` -> ``"12th"``, ``23`` -> ``"23rd"``.
+
+    Examples
+    --------
+    >>> [ordinal(k) for k in (1, 2, 3, 4, 11, 12, 13, 21, 22)]
+    ['1st', '2nd', '3rd', '4th', '11th', '12th', '13th', '21st', '22nd']
+    """
+    suffix = "th" if 10 <= rank % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(rank % 10, "th")
+    return f"{rank}{suffix}"
+
+
+def pick_place(where: Scene | Supports, box: str) -> dict[str, Any] | None:
+    """Where ``box`` is: its centre and top (a scene) or its resting height (supports with heights).
+
+    Parameters
+    ----------
+    where : Scene or Supports
+        The scene decided on (the box's pose), or the support probabilities (their
+        ``heights``, the height each box rests at, if they carry them).
+    box : str
+        A detected box (a scene) or one of the objects (supports).
+
+    Returns
+    -------
+    dict or None
+        ``centre`` (x, y, z in metres, a scene only), ``top`` (its highest point, a scene
+        only), ``rests_at`` (its lowest point), ``height_rank`` (1: its top, or for supports
+        its resting height, is the highest of the boxes decided on) and ``boxes`` (how many
+        were decided on); ``None`` for supports without heights.
+    """
+    if isinstance(where, Scene):
+        from unstack.geometry import bounding_boxes
+
+        ids = list(where.detected)
+        bounds = bounding_boxes([where.box(box_id) for box_id in ids])
+        tops = bounds[:, 5]
+        k = ids.index(box)
+        return {
+            "centre": [round(float(value), 4) for value in where.box(box).position],
+            "top": round(float(tops[k]), 4),
+            "rests_at": round(float(bounds[k, 2]), 4),
+            "height_rank": int(np.sum(tops > tops[k]) + 1),
+            "boxes": len(ids),
+        }
+    if where.heights is None:
+        return None
+    heights = np.asarray(where.heights, dtype=np.float64)
+    k = where.objects.index(box)
+    return {"rests_at": round(float(heights[k]), 4), "height_rank": int(np.sum(heights > heights[k]) + 1),
+            "boxes": len(where.objects)}  # fmt: skip
+
+
+def place_in_words(place: dict[str, Any]) -> str:
+    """:func:`pick_place` as one phrase.
+
+    Examples
+    --------
+    >>> place_in_words({"rests_at": 0.3, "height_rank": 2, "boxes": 5})
+    'resting 0.30 m above the floor, the 2nd highest of the 5 boxes'
+    """
+    rank = "the highest" if place["height_rank"] == 1 else f"the {ordinal(place['height_rank'])} highest"
+    if "centre" not in place:
+        return f"resting {place['rests_at']:.2f} m above the floor, {rank} of the {place['boxes']} boxes"
+    x, y, _ = place["centre"]
+    return (
+        f"centre x {x:.2f} m, y {y:.2f} m; top {place['top']:.2f} m above the floor, "
+        f"{rank} of the {place['boxes']} detected boxes"
+    )
