@@ -29,9 +29,13 @@ from unstack.checks import check_ids, check_points, check_quaternion_xyzw, check
 from unstack.errors import InvalidScene
 from unstack.jsonio import Document, read_document, validate_document
 
-__all__ = ["SCENE_FORMAT", "Box", "Scene", "load_points", "load_scene"]
+__all__ = ["MAX_CLOUD_FILE_BYTES", "MAX_POINTS", "SCENE_FORMAT", "Box", "Scene", "load_points", "load_scene"]
 
 SCENE_FORMAT = "unstack.scene/1"
+#: Most points a cloud file may hold (``.npy`` files are refused from their header, unread).
+MAX_POINTS = 5_000_000
+#: Largest point cloud file read, in bytes (a ``.ply`` in ASCII of 5 million points is about 150 MiB).
+MAX_CLOUD_FILE_BYTES = 256 * 2**20
 
 
 def _check_edges(size: np.ndarray, source: str, path: str) -> np.ndarray:
@@ -162,8 +166,15 @@ def load_points(
         raise InvalidScene(source, json_path, f"expected a point cloud file, got the directory {str(file)!r}")
     if not file.exists():
         raise InvalidScene(source, json_path, f"point cloud file {str(file)!r} does not exist")
+    size = file.stat().st_size
+    if size > MAX_CLOUD_FILE_BYTES:
+        raise InvalidScene(
+            source, json_path, f"expected a point cloud file of at most {MAX_CLOUD_FILE_BYTES // 2**20} MiB, "
+            f"{file.name!r} has {size / 2**20:,.1f} MiB"
+        )  # fmt: skip
     try:
         if file.suffix.lower() == ".npy":
+            _refuse_large_npy(file, source, json_path)
             try:
                 array = np.load(file, allow_pickle=False)
             except ValueError:  # numpy's words suggest allowing pickle: never, for a user's file
@@ -181,7 +192,26 @@ def load_points(
         raise
     except Exception as error:  # noqa: BLE001 - any reader failure is the file's fault
         raise InvalidScene(source, json_path, f"cannot read point cloud {file.name!r}: {error}") from None
+    if len(array) > MAX_POINTS:
+        raise InvalidScene(
+            source, json_path, f"expected at most {MAX_POINTS:,} points, {file.name!r} has {len(array):,}"
+        )
     return check_points(array, source=source, path=json_path)
+
+
+def _refuse_large_npy(file: Path, source: str, json_path: str) -> None:
+    """Refuse a ``.npy`` cloud of more than :data:`MAX_POINTS` rows from its header, before reading it."""
+    with file.open("rb") as handle:
+        try:
+            version = np.lib.format.read_magic(handle)
+            read_header = (
+                np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
+            )
+            shape = read_header(handle)[0]  # the header only: no data is read
+        except (ValueError, OSError, SyntaxError):
+            return  # not a valid header: np.load says so in its own words below
+    if shape and shape[0] > MAX_POINTS:
+        raise InvalidScene(source, json_path, f"expected at most {MAX_POINTS:,} points, {file.name!r} has {shape[0]:,}")
 
 
 def _refuse_overlaps(boxes: tuple[Box, ...], source: str) -> None:
