@@ -15,7 +15,7 @@ from unstack.supports import Supports
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLES = REPO / "examples"
 #: The five-box example supports file, relative to the repository (the CLI runs there).
-PILE5 = "examples/pile5.supports.json"
+PILE5 = "examples/stack5.supports.json"
 
 # The suite runs on every core (pytest-xdist, ``-n auto``): one OpenMP thread per worker and per
 # CLI subprocess, or scikit-learn's boosting oversubscribes the cores and a 6 s fit takes a minute.

@@ -49,9 +49,9 @@ def test_a_model_file_is_loaded_by_path(tmp_path: Path) -> None:
 
 
 def test_wrong_arguments_are_invalid_arguments(examples: Path) -> None:
-    supports = unstack.load_supports(examples / "pile5.supports.json")
+    supports = unstack.load_supports(examples / "stack5.supports.json")
     with pytest.raises(
-        InvalidArgument, match=r"pile5\.supports\.json: a model turns a scene into support probabilities"
+        InvalidArgument, match=r"stack5\.supports\.json: a model turns a scene into support probabilities"
     ):
         unstack.decide(supports, model="paper")
     with pytest.raises(ValueError, match="expected a Scene or Supports, got dict"):
@@ -62,7 +62,7 @@ def test_wrong_arguments_are_invalid_arguments(examples: Path) -> None:
         unstack.load_model(3)  # type: ignore[arg-type]
     with pytest.raises(InvalidArgument, match="model must be a model name, a model file path or a SupportModel"):
         unstack.decide(unstack.load_scene(examples / "pile5.scene.json"), model=3.0)  # type: ignore[arg-type]
-    with pytest.raises(InvalidArgument, match=r"pile5\.supports\.json: statics adjusts the probabilities a model"):
+    with pytest.raises(InvalidArgument, match=r"stack5\.supports\.json: statics adjusts the probabilities a model"):
         unstack.decide(supports, statics=False)
     with pytest.raises(InvalidArgument, match="statics must be True or False, got 'no'"):
         unstack.support_probabilities(unstack.load_scene(examples / "scene3.json"), statics="no")  # type: ignore[arg-type]
@@ -83,7 +83,7 @@ def test_statics_raises_the_box_leant_on_and_can_be_turned_off(examples: Path) -
 def test_plan_from_a_scene_and_from_supports(examples: Path) -> None:
     plan = unstack.plan(unstack.load_scene(examples / "pile5.scene.json"), seed=0)
     assert sorted(plan.order) == sorted(plan.objects)
-    supports = unstack.load_supports(examples / "pile5.supports.json")
+    supports = unstack.load_supports(examples / "stack5.supports.json")
     assert unstack.plan(supports).order[0] == unstack.decide(supports).choice
 
 
@@ -95,7 +95,7 @@ def test_validate_summarises_a_file(examples: Path) -> None:
 def test_importing_unstack_and_deciding_on_supports_stays_light(repo: Path) -> None:
     code = (
         "import sys, unstack\n"
-        "unstack.decide(unstack.load_supports('examples/pile5.supports.json'))\n"
+        "unstack.decide(unstack.load_supports('examples/stack5.supports.json'))\n"
         "print(' '.join(sorted(sys.modules)))"
     )
     env = {**os.environ, "PYTHONPATH": str(repo)}

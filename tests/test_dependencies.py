@@ -30,7 +30,7 @@ sys.stderr.write(json.dumps(sorted(sys.modules)))
 
 @pytest.mark.parametrize("method", ["exact", "sat"])
 def test_decide_on_a_supports_file_imports_nothing_heavy(repo: Path, method: str) -> None:
-    probe = PROBE.format(file=str(repo / "examples" / "pile5.supports.json"), method=method)
+    probe = PROBE.format(file=str(repo / "examples" / "stack5.supports.json"), method=method)
     result = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300, check=True)
     modules = json.loads(result.stderr)
     assert json.loads(result.stdout)["choice"] == "top_left"
@@ -49,7 +49,7 @@ def test_importing_the_reasoner_loads_no_learning_or_simulation(repo: Path) -> N
 
 def test_a_small_decision_loads_only_what_it_needs(repo: Path) -> None:
     """``unstack decide FILE --json`` on five boxes: no compiled engine, SAT solver, schema library or tables."""
-    probe = PROBE.format(file=str(repo / "examples" / "pile5.supports.json"), method="auto")
+    probe = PROBE.format(file=str(repo / "examples" / "stack5.supports.json"), method="auto")
     result = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300, check=True)
     loaded = {name.split(".")[0] for name in json.loads(result.stderr)}
     lean = {"numba", "pysat", "networkx", "jsonschema", "rich", "scipy", *HEAVY}

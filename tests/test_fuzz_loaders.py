@@ -82,12 +82,12 @@ def test_scenes_round_trip_exactly(tmp_path: Path, original: Scene) -> None:
 
 
 def _documents() -> list[dict[str, Any]]:
-    pile5 = unstack.load_supports(REPO / "examples" / "pile5.supports.json")
+    pile5 = unstack.load_supports(REPO / "examples" / "stack5.supports.json")
     scene = json.loads((REPO / "examples" / "scene3.json").read_text())
     scene.pop("points_file", None)
     scene["points"] = [[1.0, 0.0, 0.5], [1.2, 0.1, 0.4]]
     return [
-        json.loads((REPO / "examples" / "pile5.supports.json").read_text()),
+        json.loads((REPO / "examples" / "stack5.supports.json").read_text()),
         json.loads((REPO / "examples" / "evidence3.supports.json").read_text()),
         scene,
         unstack.decide(pile5).to_dict(),

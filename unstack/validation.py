@@ -66,7 +66,7 @@ def validate(path: str | os.PathLike[str]) -> Validated:
 
     Examples
     --------
-    >>> validate("examples/pile5.supports.json").format
+    >>> validate("examples/stack5.supports.json").format
     'unstack.supports/1'
     """
     document = read_document(path)

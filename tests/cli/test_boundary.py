@@ -189,7 +189,7 @@ def test_warm_up_reports_each_kernel() -> None:
 
 
 def test_standard_input_that_is_not_utf8_is_refused_like_a_file(examples: Path) -> None:
-    document = (examples / "pile5.supports.json").read_text().replace('"top_left"', '"caf\u00e9"', 1)
+    document = (examples / "stack5.supports.json").read_text().replace('"top_left"', '"caf\u00e9"', 1)
     result = subprocess.run(
         [sys.executable, "-m", "unstack", "decide", "-"],
         input=document.encode("latin-1"),

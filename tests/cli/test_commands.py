@@ -241,4 +241,4 @@ def test_decide_on_a_scene_gives_near_ties_to_the_box_resting_highest(tmp_path: 
 def test_near_ties_on_supports_without_heights_exit_2() -> None:
     result = unstack("decide", PILE5, "--near-ties", "0.1")
     assert result.returncode == 2 and result.stderr.count("\n") == 1
-    assert "carry no heights" in result.stderr and "pile5.supports.json" in result.stderr
+    assert "carry no heights" in result.stderr and "stack5.supports.json" in result.stderr

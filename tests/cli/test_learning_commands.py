@@ -99,7 +99,7 @@ def test_decide_on_a_scene_with_a_given_model(model: Path) -> None:
     ("arguments", "message"),
     [
         (
-            ["decide", SCENE, "--model", "examples/pile5.supports.json"],
+            ["decide", SCENE, "--model", "examples/stack5.supports.json"],
             "expected an unstack model file (a skops file), got something else",
         ),
         (["decide", SCENE, "--model", "examples"], "examples: $: expected a model file, got a directory"),
@@ -162,6 +162,6 @@ def test_no_statics_keeps_the_models_probabilities(tmp_path: Path) -> None:
 
 
 def test_no_statics_on_a_supports_file_is_one_line() -> None:
-    result = unstack("decide", "examples/pile5.supports.json", "--no-statics")
+    result = unstack("decide", "examples/stack5.supports.json", "--no-statics")
     assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
     assert "--no-statics applies to a scene file" in result.stderr

@@ -57,7 +57,7 @@ def other_decision(tmp_path_factory: pytest.TempPathFactory) -> Path:
         ([PILE5, "-o", "{tmp}/x.pdf"], "x.pdf: expected a .png or .svg output file"),
         ([PILE5, "-o", "{tmp}/x.png", "--threshold", "1.5"], "threshold must be a probability in [0, 1], got 1.5"),
         ([PILE5, "-o", "{tmp}/x.png", "--decision", "{decision}"], "the decision's boxes do not match"),
-        ([PILE5, "-o", "{tmp}/x.png", "--decision", "examples/pile5.supports.json"], "expected unstack.decision/1"),
+        ([PILE5, "-o", "{tmp}/x.png", "--decision", "examples/stack5.supports.json"], "expected unstack.decision/1"),
         ([PILE5, "-o", "{tmp}/no/x.png"], "cannot write there"),
         (["examples/pile31.supports.json", "-o", "{tmp}/x.png", "--colour", "truth"], "no ground truth or geometry"),
     ],

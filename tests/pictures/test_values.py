@@ -58,9 +58,9 @@ def test_a_stored_decision_is_read(tmp_path: Path, examples: Path) -> None:
 
 def test_a_wrong_decision_file_is_refused(tmp_path: Path, examples: Path) -> None:
     with pytest.raises(InvalidFile, match=r"expected unstack\.decision/1"):
-        read_decision_values(examples / "pile5.supports.json")
+        read_decision_values(examples / "stack5.supports.json")
     path = tmp_path / "bad.json"
-    document = unstack.decide(unstack.load_supports(examples / "pile5.supports.json")).to_dict()
+    document = unstack.decide(unstack.load_supports(examples / "stack5.supports.json")).to_dict()
     document["expected_costs"] = document["expected_costs"][:2]
     path.write_text(json.dumps(document))
     with pytest.raises(InvalidFile, match=r"\$\.expected_costs: expected 5 numbers"):

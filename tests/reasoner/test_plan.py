@@ -35,7 +35,7 @@ def test_a_column_is_unloaded_from_the_top() -> None:
 
 @pytest.mark.slow
 def test_plan_command(tmp_path: Path) -> None:
-    result = unstack("plan", "examples/pile5.supports.json", "--json", "-o", str(tmp_path / "plan.json"))
+    result = unstack("plan", "examples/stack5.supports.json", "--json", "-o", str(tmp_path / "plan.json"))
     assert result.returncode == 0, result.stderr
     document = json.loads(result.stdout)
     jsonschema.validate(document, load_schema("unstack.plan/1"))

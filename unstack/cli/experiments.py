@@ -90,7 +90,7 @@ def table1(out: str, max_n: int, full: bool) -> None:
     Console().print(table)
 
 
-@experiment.command()
+@experiment.command(short_help="Fig. 5a: the validation confusion matrix of the SVM, beside the paper's.")
 @click.argument("data_dir", type=click.Path(file_okay=False))
 @click.option("--out", required=True, type=click.Path(), help="Folder for fig5a.json.")
 @click.option("--r", "r", type=click.IntRange(min=2), default=5, show_default=True, help="Boxes per ISet.")
@@ -172,7 +172,7 @@ def fig5a(
     Console().print(f"results in {folder / 'fig5a.json'} and {folder / 'fig5a.png'}")
 
 
-@experiment.command()
+@experiment.command(short_help="Fig. 4 and beyond: MSE(cost), first pick right, disturbance per decision maker.")
 @click.argument("data_dir", type=click.Path(file_okay=False))
 @click.option("--out", required=True, type=click.Path(), help="Folder for decisions.json and fig4.png.")
 @click.option("--model", "model_path", default=None, help=MODEL_HELP)

@@ -11,6 +11,7 @@ from rich.table import Table
 from rich.text import Text
 
 from unstack.cli.main import MODEL_HELP, STATICS_HELP
+from unstack.cli.text import counted
 from unstack.errors import UnstackError
 from unstack.learning.choices import LEARNERS, SPLITS
 from unstack.learning.features import FEATURE_SETS
@@ -166,7 +167,7 @@ def train(
     held_out = f"hold-out figures on {validation_size:.0%}, then " if validation_size > 0 else ""
     console.print(
         f"{len(examples.labels)} relations ({int(examples.labels.sum())} SUPP) from "
-        f"{len(set(examples.configuration.tolist()))} configurations; {held_out}cross-validating {learner} "
+        f"{counted(len(set(examples.configuration.tolist())), 'configuration')}; {held_out}cross-validating {learner} "
         f"({cv} folds) on all of them ..."
     )
     provenance = training_provenance(
@@ -179,6 +180,8 @@ def train(
     )  # fmt: skip
     model = run.model
     save_model(model, output)
+    for warning in run.warnings:
+        click.echo(f"unstack: warning: {warning}", err=True)
     validation = model.metadata["validation"]
     report = {"model": output, "learner": learner, "features": settings.to_dict(),
               **{k: model.metadata[k] for k in ("best_params", "cv_score")},

@@ -113,11 +113,13 @@ def simulate(
         summary = simulate_dataset(
             out, settings, configs=configs, seed=seed, jobs=jobs, scheduler=scheduler, progress=report
         )
+    from unstack.cli.text import counted
     from unstack.datasets import read_manifest
 
     statistics = (read_manifest(summary.folder) or {}).get("statistics", {})
     click.echo(
-        f"{summary.folder}: {summary.finished} configurations ({summary.made} made, {summary.skipped} already there) "
+        f"{summary.folder}: {counted(summary.finished, 'configuration')} "
+        f"({summary.made} made, {summary.skipped} already there) "
         f"in {summary.seconds:.1f} s; {statistics.get('support_relations', 0)} support relations among "
         f"{statistics.get('ordered_pairs', 0)} ordered pairs; removal labels break transitivity in "
         f"{100 * statistics.get('transitivity_violated_share', 0.0):.1f} % of "

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-__all__ = ["printable"]
+__all__ = ["counted", "printable"]
 
 
 def printable(text: str) -> str:
@@ -16,3 +16,14 @@ def printable(text: str) -> str:
     if text.isprintable():
         return text
     return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text)
+
+
+def counted(number: int, noun: str) -> str:
+    """``number`` and ``noun``, plural unless it is one.
+
+    Examples
+    --------
+    >>> counted(1, "configuration"), counted(3, "configuration")
+    ('1 configuration', '3 configurations')
+    """
+    return f"{number:,} {noun}{'' if number == 1 else 's'}"

@@ -20,6 +20,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
+import numpy as np
+
 from unstack.errors import UnstackError
 from unstack.learning.choices import SPLITS
 from unstack.learning.features import FeatureSettings
@@ -123,6 +125,7 @@ class TrainingRun:
 
     model: SupportModel
     holdout: HoldoutResult | None
+    warnings: tuple[str, ...] = ()
 
 
 def train_support_model(
@@ -187,7 +190,45 @@ def train_support_model(
         training_features=examples.features,
         validation=validation,
     )
-    return TrainingRun(model, holdout)
+    return TrainingRun(model, holdout, useless_model_warnings(classifier, examples))
+
+
+#: Fewer relations of either class than this make a model too thin to trust.
+MIN_CLASS_EXAMPLES = 20
+
+
+def useless_model_warnings(classifier: Any, examples: SupportExamples) -> tuple[str, ...]:
+    """Why a fitted model cannot be useful: one class too rare, or one answer for every relation.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> class Never:
+    ...     def predict_proba(self, features):
+    ...         return np.column_stack([np.ones(len(features)), np.zeros(len(features))])
+    >>> labels = np.r_[np.ones(20), np.zeros(20)]
+    >>> rows = SupportExamples(np.zeros((40, 2)), labels, np.arange(40) // 10, np.zeros(40), [])
+    >>> useless_model_warnings(Never(), rows)[0][:56]
+    'the model says P(SUPP) < 0.5 for every one of its 40 tra'
+    """
+    labels = np.asarray(examples.labels)
+    configurations = len(set(np.asarray(examples.configuration).tolist()))
+    more = f"simulate more piles (unstack simulate --configs {max(50, 4 * configurations)}) and train again"
+    warnings = []
+    positives, negatives = int(labels.sum()), int(len(labels) - labels.sum())
+    if min(positives, negatives) < MIN_CLASS_EXAMPLES:
+        warnings.append(
+            f"only {positives} support and {negatives} non-support relations from {configurations} configurations: "
+            f"too few to learn from; {more}"
+        )
+    predicted = classifier.predict_proba(examples.features)[:, 1] >= 0.5
+    if not predicted.any() or predicted.all():
+        side = "< 0.5" if not predicted.any() else ">= 0.5"
+        warnings.append(
+            f"the model says P(SUPP) {side} for every one of its {len(labels)} training relations: it cannot tell "
+            f"support from none (BER 0.5); {more}"
+        )
+    return tuple(warnings)
 
 
 def holdout_by_data_set(
