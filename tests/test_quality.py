@@ -51,3 +51,22 @@ def test_the_readme_names_the_fast_lane_and_tests_carry_the_slow_marker(repo: Pa
     assert readme_command(repo, "<!-- fast-lane -->") == 'pytest -m "not slow"'
     marked = [path for path in (repo / "tests").rglob("test_*.py") if "pytest.mark.slow" in path.read_text()]
     assert len(marked) >= 20, marked
+
+
+@pytest.mark.slow  # runs the main job in a subprocess
+def test_the_readme_shows_what_the_main_job_prints_today(repo: Path) -> None:
+    """The sample output under ``<!-- main-job-output -->`` is the main job's output, but for its seconds."""
+    import re
+
+    text = (repo / "README.md").read_text()
+    block = text.split("<!-- main-job-output -->", 1)[1].split("```text\n", 1)[1].split("```", 1)[0]
+    command = readme_command(repo, "<!-- main-job -->").split("&& unstack ", 1)[1].split()
+    result = subprocess.run(
+        [sys.executable, "-m", "unstack", *command], cwd=repo, capture_output=True, text=True, timeout=300
+    )
+    assert result.returncode == 0, result.stderr
+
+    def canonical(output: str) -> list[str]:
+        return [re.sub(r"\d+\.\d+ s$", "N s", line.rstrip()) for line in output.strip().splitlines()]
+
+    assert canonical(result.stdout) == canonical(block)

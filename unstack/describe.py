@@ -10,7 +10,7 @@ Examples
 >>> place["height_rank"], place["boxes"]
 (1, 5)
 >>> place_in_words(place)
-'centre x 1.11 m, y -0.06 m; top 0.78 m above the floor, the highest of the 5 detected boxes'
+'x 1.11 m, y -0.06 m (centre), top at 0.78 m: the highest of 5 detected'
 >>> model_in_words("default:general-mix.skops")
 'general (the default model)'
 """
@@ -126,18 +126,15 @@ def pick_place(where: Scene | Supports, box: str) -> dict[str, Any] | None:
 
 
 def place_in_words(place: dict[str, Any]) -> str:
-    """:func:`pick_place` as one phrase.
+    """:func:`pick_place` as one phrase (heights above the floor, z = 0).
 
     Examples
     --------
     >>> place_in_words({"rests_at": 0.3, "height_rank": 2, "boxes": 5})
-    'resting 0.30 m above the floor, the 2nd highest of the 5 boxes'
+    'resting at 0.30 m: the 2nd highest of 5'
     """
     rank = "the highest" if place["height_rank"] == 1 else f"the {ordinal(place['height_rank'])} highest"
     if "centre" not in place:
-        return f"resting {place['rests_at']:.2f} m above the floor, {rank} of the {place['boxes']} boxes"
+        return f"resting at {place['rests_at']:.2f} m: {rank} of {place['boxes']}"
     x, y, _ = place["centre"]
-    return (
-        f"centre x {x:.2f} m, y {y:.2f} m; top {place['top']:.2f} m above the floor, "
-        f"{rank} of the {place['boxes']} detected boxes"
-    )
+    return f"x {x:.2f} m, y {y:.2f} m (centre), top at {place['top']:.2f} m: {rank} of {place['boxes']} detected"

@@ -34,7 +34,7 @@ def test_a_scene_decision_names_its_model_cost_and_where_the_pick_is(scene_decis
     text = text_of(scene_decision)
     assert "support model: general (the default model)" in text
     assert "cost 'load': the boxes that would come down with it" in text and "lower is safer" in text
-    assert "where: centre x" in text and "of the 5 detected boxes" in text
+    assert "where: x " in text and "(centre), top at" in text and "of 5 detected" in text
     assert "expected boxes held up" in text and "None" not in text
 
 
@@ -74,7 +74,7 @@ def test_supports_with_heights_say_where_the_pick_rests() -> None:
     supports = Supports(["low", "high"], [[0, 0.9], [0.05, 0]], heights=[0.0, 0.4])
     decision = unstack.decide(supports)
     assert decision.pick == {"rests_at": 0.4, "height_rank": 1, "boxes": 2}
-    assert "where: resting 0.40 m above the floor, the highest of the 2 boxes" in text_of(decision)
+    assert "where: resting at 0.40 m: the highest of 2" in text_of(decision)
 
 
 def test_supports_without_heights_have_no_place() -> None:
