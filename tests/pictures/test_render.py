@@ -77,7 +77,8 @@ def test_the_pick_and_the_plan_are_shown(wall: Scene, wall_decision: DecisionVal
     assert chosen.get_color() == HIGHLIGHT and chosen.get_fontweight() == "bold"
     assert f"40. {wall_decision.order[-1]}" in labels
     ranking = _ranking(figure)
-    assert ranking.get_yticklabels()[0].get_text() == f"1. {pick}"
+    ticks = [tick.get_text() for tick in ranking.get_yticklabels()]
+    assert ticks[0] == pick and not any(". " in tick for tick in ticks)  # one numbering: the plan's, in the views
     assert any(type(container).__name__ == "ErrorbarContainer" for container in ranking.containers)  # sampled
     bar = figure.axes[2]
     assert "expected cost" in bar.get_ylabel() and "± s.e." in bar.get_ylabel()
@@ -129,3 +130,11 @@ def test_bad_input_is_refused_before_writing(tmp_path: Path, wall: Scene, wall_d
 def test_label_size_is_the_shared_constant() -> None:
     assert LABEL_POINTS >= 8
     assert np.isfinite(LABEL_POINTS)
+
+
+def test_the_pick_is_painted_last_in_the_oblique_view(wall: Scene, wall_decision: DecisionValues) -> None:
+    figure = draw_scene(wall, values=wall_decision)
+    oblique = figure.axes[0]
+    assert oblique.computed_zorder is False
+    last = oblique.collections[-1]  # painted over every other box
+    assert last.get_linewidth()[0] == max(collection.get_linewidth()[0] for collection in oblique.collections)

@@ -117,7 +117,7 @@ def draw_ranking(axes: Any, values: DecisionValues, colours: CostColours) -> Non
         error_kw={"elinewidth": 1.0, "capsize": 2.0, "ecolor": "0.2"},
         height=0.75,
     )
-    axes.set_yticks(rows, [box_label(values, box) for box in ids], fontsize=LABEL_POINTS)
+    axes.set_yticks(rows, ids, fontsize=LABEL_POINTS)  # ids only: the plan's numbers are the 3D panel's
     for tick, box in zip(axes.get_yticklabels(), ids, strict=True):
         if box == values.choice:
             tick.set_color(HIGHLIGHT)

@@ -63,12 +63,28 @@ def _truth_colours(scene: Scene) -> tuple[Callable[[int], Colour], Any, Any, int
     return colour, cmap, norm, top
 
 
+#: Elevation and azimuth (degrees) of the oblique view: from the door side, above.
+OBLIQUE_VIEW = (28.0, -150.0)
+
+
 def _draw_oblique(axes: Any, scene: Scene, colour: Callable[[int], Colour], values: DecisionValues | None) -> None:
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     detected = set(scene.detected)
     choice = values.choice if values is not None else None
-    for index, box in enumerate(scene.boxes):
+    # Painted in this order, not by matplotlib's depth sort: undetected boxes (faint) first, then the
+    # detected ones far to near as seen from the view below, the pick last -- never hidden behind others.
+    axes.computed_zorder = False
+    elevation, azimuth = np.radians(OBLIQUE_VIEW)
+    eye = np.array([np.cos(elevation) * np.cos(azimuth), np.cos(elevation) * np.sin(azimuth), np.sin(elevation)])
+
+    def painting(k: int) -> tuple[bool, bool, float]:
+        box = scene.boxes[k]
+        return (box.id == choice, box.id in detected, float(box.position @ eye))
+
+    order = sorted(range(len(scene.boxes)), key=painting)
+    for index in order:
+        box = scene.boxes[index]
         corners = box_corners(box)
         faces = [[corners[k] for k in face] for face in BOX_FACES]
         is_detected = box.id in detected
@@ -79,7 +95,7 @@ def _draw_oblique(axes: Any, scene: Scene, colour: Callable[[int], Colour], valu
                 facecolors=[colour(index)],
                 edgecolors=HIGHLIGHT if chosen else ("black" if is_detected else (0.3, 0.3, 0.3, 0.4)),
                 linewidths=2.6 if chosen else (1.0 if is_detected else 0.4),
-                alpha=0.95 if is_detected else 0.35,
+                alpha=0.95 if is_detected else 0.25,
             )
         )
     if choice is not None and choice in scene.box_ids:
@@ -96,7 +112,7 @@ def _draw_oblique(axes: Any, scene: Scene, colour: Callable[[int], Colour], valu
     for name, axis in (("x (into container, m)", "x"), ("y (m)", "y"), ("z (m)", "z")):
         getattr(axes, f"set_{axis}label")(name, fontsize=LABEL_POINTS, labelpad=-4)
     axes.tick_params(labelsize=LABEL_POINTS - 1, pad=0)
-    axes.view_init(elev=28, azim=-150)  # from the door side
+    axes.view_init(*OBLIQUE_VIEW)  # from the door side
     axes.set_title("oblique view (outlined: detected)", fontsize=LABEL_POINTS + 2)
 
 
