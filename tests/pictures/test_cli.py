@@ -75,7 +75,7 @@ def test_view_writes_one_self_contained_page(tmp_path: Path) -> None:
     assert result.returncode == 0, result.stderr
     assert " MB" in result.stdout and "pick " in result.stdout
     page = target.read_text()
-    assert "unloading order: " in page and "cloud (3,000 of " in page
+    assert "picks taken: " in page and "cloud (3,000 of " in page
 
 
 @pytest.mark.parametrize(

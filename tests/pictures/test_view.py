@@ -36,9 +36,12 @@ def test_the_page_holds_the_decision(wall: Scene, wall_decision: DecisionValues,
     steps = figure.layout.sliders[0].steps
     assert len(steps) == 41
     last = steps[-1].args[0]["visible"]
-    assert last[0] and sum(last) == len(figure.data) - 2 * 40  # every box taken away, the cloud stays
+    assert last[0] and sum(last) == len(figure.data) - 3 * 40  # every box taken away, the cloud stays
     first_pick = steps[1].args[0]["visible"]
-    assert first_pick.count(False) == 2  # the pick's mesh and outline
+    assert first_pick.count(False) == 3  # the pick's mesh, outline and label
+    label = next(trace for trace in figure.data if trace.name == f"{pick} label")
+    assert label.text[0] == f"<b>1. {pick}</b>" and label.textfont.color == "#e6007e"
+    assert [step.label for step in steps[:3]] == ["start", "1", "2"]  # short labels: 40 steps fit the width
 
 
 def test_hover_names_the_strongest_relations() -> None:

@@ -14,7 +14,8 @@ Examples
 --------
 >>> import tempfile, pathlib
 >>> from unstack.scene import Box, Scene
->>> from unstack.pictures.values import DecisionValues
+>>> from unstack.pictures.panels import box_label
+from unstack.pictures.values import DecisionValues
 >>> scene = Scene([Box("a", [0.6, 0.4, 0.4], [1.0, 0.0, 0.2]), Box("b", [0.4, 0.3, 0.3], [1.0, 0.0, 0.55])],
 ...               points=[[0.7, 0.0, 0.5]], detected=["a", "b"])
 >>> values = DecisionValues(["a", "b"], [1.0, 0.0], choice="b", order=["b", "a"], probabilities=[[0, 0.9], [0, 0]])
@@ -156,7 +157,8 @@ def build_view(
             y=points[:, 1],
             z=points[:, 2],
             mode="markers",
-            marker={"size": 1.0, "color": "rgba(120,120,120,0.25)"},
+            marker={"size": 1.2, "color": "rgb(60,60,60)"},
+            opacity=0.18,  # the trace's opacity: dark points, faint, never a white veil over the boxes
             hoverinfo="skip",
             name=f"cloud ({len(points):,} of {near:,} points: near the boxes, not on a detected one)",
         )
@@ -175,7 +177,7 @@ def build_view(
             colour = "rgb(180,180,180)"
         chosen = values is not None and box.id == values.choice
         text = hover_text(values, box.id)
-        box_traces[box.id] = [len(traces), len(traces) + 1]
+        box_traces[box.id] = [len(traces), len(traces) + 1, len(traces) + 2]
         traces.append(_mesh(go, [box], color=colour, opacity=1.0, hovertext=[text] * 8, name=box.id, showlegend=False))
         xs, ys, zs = _edges(box)
         traces.append(
@@ -188,6 +190,21 @@ def build_view(
                 hoverinfo="skip",
                 showlegend=False,
                 name=f"{box.id} outline",
+            )
+        )
+        number = values.plan_number(box.id) if values is not None else None
+        label = html.escape(box.id if number is None else f"{number}. {box.id}")
+        traces.append(  # the id (with its place in the plan) just above the box, taken away with it
+            go.Scatter3d(
+                x=[box.position[0]],
+                y=[box.position[1]],
+                z=[float(box_corners(box)[:, 2].max()) + 0.06],
+                mode="text",
+                text=[f"<b>{label}</b>" if chosen else label],
+                textfont={"size": 15 if chosen else 13, "color": HIGHLIGHT if chosen else "black"},
+                hoverinfo="skip",
+                showlegend=False,
+                name=f"{box.id} label",
             )
         )
     if values is not None:
@@ -225,8 +242,8 @@ def build_view(
             "camera": {"eye": {"x": -1.6, "y": -0.95, "z": 0.85}},  # from the door side
         },
     )
-    if values is not None and values.order:
-        figure.update_layout(sliders=[_plan_slider(values, box_traces, len(traces), heading)])
+    if values is not None and values.order:  # the slider below the scene, inside the page
+        figure.update_layout(sliders=[_plan_slider(values, box_traces, len(traces), heading)], margin={"b": 90})
     return figure
 
 
@@ -243,10 +260,11 @@ def _plan_slider(
         if k == 0:
             label, text = "start", heading
         else:
-            label = f"{k}. {values.order[k - 1]}"
+            label = str(k)  # short: 40 steps fit the page's width; the title names the boxes
             text = f"after {k} pick{'s' if k > 1 else ''}: {', '.join(values.order[:k])} taken away"
         steps.append({"label": label, "method": "update", "args": [{"visible": visible}, {"title.text": text}]})
-    return {"active": 0, "currentvalue": {"prefix": "unloading order: "}, "pad": {"t": 10}, "steps": steps}
+    return {"active": 0, "currentvalue": {"prefix": "picks taken: "}, "pad": {"t": 10, "b": 10}, "x": 0.05, "len": 0.9,
+            "y": 0, "yanchor": "top", "font": {"size": 11}, "steps": steps}  # fmt: skip
 
 
 def write_view(scene: Scene, output: str | os.PathLike[str], **options: Any) -> int:
