@@ -15,7 +15,7 @@ Examples
 >>> import tempfile, pathlib
 >>> from unstack.scene import Box, Scene
 >>> from unstack.pictures.panels import box_label
-from unstack.pictures.values import DecisionValues
+>>> from unstack.pictures.values import DecisionValues
 >>> scene = Scene([Box("a", [0.6, 0.4, 0.4], [1.0, 0.0, 0.2]), Box("b", [0.4, 0.3, 0.3], [1.0, 0.0, 0.55])],
 ...               points=[[0.7, 0.0, 0.5]], detected=["a", "b"])
 >>> values = DecisionValues(["a", "b"], [1.0, 0.0], choice="b", order=["b", "a"], probabilities=[[0, 0.9], [0, 0]])
