@@ -39,15 +39,6 @@ def _put(mask: np.ndarray, k: int, member: bool) -> None:
         mask[k >> 6] &= ~bit
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _meets(a: np.ndarray, b: np.ndarray) -> bool:
-    """Whether the sets ``a`` and ``b`` intersect."""
-    for w in range(a.shape[0]):  # noqa: SIM110 (numba compiles no generator inside any())
-        if a[w] & b[w]:
-            return True
-    return False
-
-
 @njit(cache=True, nogil=True)
 def _decide_side(
     x: int,
