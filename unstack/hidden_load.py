@@ -46,7 +46,7 @@ import numpy as np
 from unstack.geometry import bounding_boxes, box_corners, convex_hull_2d, footprint, points_in_box
 from unstack.scene import Box, Scene
 
-__all__ = ["EXPLAINED_MARGIN", "SIDE_REACH", "STACK_GAP", "container_planes", "hidden_load"]
+__all__ = ["EXPLAINED_MARGIN", "SIDE_REACH", "STACK_GAP", "container_planes", "hidden_load", "unexplained_points"]
 
 #: Points within this distance of a detected box belong to it (metres).
 EXPLAINED_MARGIN = 0.02
@@ -177,6 +177,27 @@ def _explained(points: np.ndarray, boxes: Sequence[Box], bounds: np.ndarray) -> 
     return explained
 
 
+def unexplained_points(points: np.ndarray, boxes: Sequence[Box]) -> np.ndarray:
+    """Which points no box of ``boxes`` explains and no container plane holds (boolean mask).
+
+    A point is explained when it lies inside one of the boxes grown by
+    :data:`EXPLAINED_MARGIN`; the container's walls and ceiling are :func:`container_planes`.
+
+    Examples
+    --------
+    >>> box = Box("a", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2])
+    >>> unexplained_points(np.array([[1.0, 0.0, 0.41], [1.0, 0.0, 0.7]]), [box]).tolist()
+    [False, True]
+    """
+    points = np.asarray(points, dtype=np.float64)
+    if len(points) == 0:
+        return np.zeros(0, dtype=bool)
+    free = ~container_planes(points)
+    if boxes:
+        free &= ~_explained(points, boxes, bounding_boxes(list(boxes)))
+    return free
+
+
 def hidden_load(scene: Scene, detected: Sequence[str] | None = None) -> np.ndarray:
     """Expected number of undetected boxes resting on each detected box, in ``scene.detected`` order.
 
@@ -199,7 +220,7 @@ def hidden_load(scene: Scene, detected: Sequence[str] | None = None) -> np.ndarr
     if len(points) == 0 or not boxes:
         return result
     bounds = bounding_boxes(boxes)
-    free = ~_explained(points, boxes, bounds) & ~container_planes(points)
+    free = unexplained_points(points, boxes)
     free &= points[:, 2] > bounds[:, 5].min() + FACE_TOLERANCE  # nothing lower lies on any box
     free_points = points[free]
     typical_height = float(np.median([np.ptp(box_corners(box)[:, 2]) for box in boxes]))

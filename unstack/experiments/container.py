@@ -37,6 +37,10 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
 ``moves_veto``
     the same expected moves, the ``veto`` rule: the box resting highest whose expected
     moves are below :data:`~unstack.moves.MOVES_VETO`.
+``belief``
+    physics on what the robot sees (:mod:`unstack.sim.belief`): the detected boxes at their
+    reported poses and the unseen material of the cloud put in the engine, every candidate's
+    removal tried; the fewest moved, ties to the box resting highest (slow).
 
 Metrics per pile and per maker: boxes moved more than 2 cm, boxes fallen (dropped more than
 0.2 m or tipped more than 45 degrees), the share of picks that move nothing, and paired
@@ -65,7 +69,7 @@ __all__ = ["CONTAINER_MAKERS", "CONTAINER_SAMPLES", "container_experiment", "con
 
 CONTAINER_MAKERS = (
     "unstack", "min_cost", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random", "lookahead",
-    "moves", "moves_veto",
+    "moves", "moves_veto", "belief",
 )  # fmt: skip
 #: Makers whose policy is told what every candidate's removal does in the engine (the true pile).
 PROBING_MAKERS = ("lookahead",)
@@ -161,6 +165,11 @@ def container_policies(
         decision = decide_on_moves(scene, supports, disturbance=loaded[0], samples=samples, seed=seed, rule=rule)
         return str(decision.choice)
 
+    def belief(scene: Scene) -> str:
+        from unstack.sim.belief import belief_choice
+
+        return belief_choice(scene)
+
     every: dict[str, Callable[..., str]] = {
         "unstack": deciding("load"),
         "min_cost": deciding("load", 0.0),
@@ -173,6 +182,7 @@ def container_policies(
         "lookahead": lookahead,
         "moves": moving("fewest"),
         "moves_veto": moving("veto"),
+        "belief": belief,
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:

@@ -196,6 +196,12 @@ class PhysicsWorld:
         self.boxes.append(body)
         return body
 
+    def add_fixed_block(self, size: Any, center: Any) -> int:
+        """Add a static, axis-aligned block (unseen material that holds up what rests on it)."""
+        body = self._static_box([float(value) / 2.0 for value in size], [float(value) for value in center])
+        self.static.append(body)
+        return body
+
     def remove_box(self, body: int) -> None:
         """Delete a box for good (only while building a pile, never after ``saveState``)."""
         self.client.removeBody(body)

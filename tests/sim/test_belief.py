@@ -1,0 +1,95 @@
+"""Physics on the belief: the unseen material of a cloud as blocks, removals tried on what is seen."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from unstack.clouds import surface_cloud
+from unstack.errors import UnstackError
+from unstack.scene import Box, Scene
+from unstack.sim.belief import BeliefBlock, belief_blocks, belief_choice, belief_removals
+
+VIEWPOINT = [-2.0, 0.0, 1.5]
+
+
+def _scene(boxes: list[Box], detected: list[str], seed: int = 0) -> Scene:
+    return Scene(boxes, surface_cloud(boxes, viewpoint=VIEWPOINT, seed=seed), detected)
+
+
+@pytest.fixture
+def column() -> list[Box]:
+    """Three boxes stacked on the floor and one beside them."""
+    return [
+        Box("bottom", [0.4, 0.4, 0.3], [1.0, -0.3, 0.15]),
+        Box("middle", [0.4, 0.4, 0.3], [1.0, -0.3, 0.45]),
+        Box("top", [0.4, 0.4, 0.3], [1.0, -0.3, 0.75]),
+        Box("beside", [0.4, 0.4, 0.3], [1.0, 0.3, 0.15]),
+    ]
+
+
+def test_nothing_unseen_when_every_box_is_detected(column: list[Box]) -> None:
+    assert belief_blocks(_scene(column, [box.id for box in column])) == []
+
+
+def test_an_undetected_box_on_a_detected_one_is_its_hidden_load(column: list[Box]) -> None:
+    blocks = belief_blocks(_scene(column, ["bottom", "middle", "beside"]))
+    assert [block.resting_on for block in blocks] == ["middle"]
+    load = blocks[0]
+    assert load.center[2] - load.size[2] / 2 == pytest.approx(0.6, abs=0.01)  # on the middle box's top
+    assert load.center[2] + load.size[2] / 2 == pytest.approx(0.9, abs=0.03)  # up to the unseen box's top
+
+
+def test_an_undetected_box_on_the_floor_is_fixed_material(column: list[Box]) -> None:
+    blocks = belief_blocks(_scene(column, ["bottom", "middle", "top"]))
+    assert blocks and all(block.resting_on is None for block in blocks)
+    tops = np.array([block.center[2] + block.size[2] / 2 for block in blocks])
+    assert tops.max() == pytest.approx(0.3, abs=0.02)
+    assert all(block.center[1] > 0.05 for block in blocks)  # where the beside box stands
+
+
+def test_an_empty_cloud_has_no_unseen_material(column: list[Box]) -> None:
+    assert belief_blocks(Scene(column, np.zeros((0, 3)), ["bottom"])) == []
+
+
+def test_blocks_are_typed_values(column: list[Box]) -> None:
+    block = belief_blocks(_scene(column, ["bottom", "middle", "beside"]))[0]
+    assert isinstance(block, BeliefBlock) and block.size.shape == (3,) and np.all(block.size > 0)
+
+
+@pytest.mark.slow  # physics
+def test_removing_a_box_under_others_moves_them_and_the_top_box_moves_nothing(column: list[Box]) -> None:
+    outcomes = belief_removals(_scene(column, [box.id for box in column]), worlds=2)
+    assert set(outcomes["middle"].moved) == {"top"}
+    assert set(outcomes["bottom"].moved) == {"middle", "top"}
+    assert outcomes["top"].expected_moved == 0.0 and outcomes["beside"].expected_moved == 0.0
+
+
+@pytest.mark.slow  # physics
+def test_the_hidden_load_falls_with_the_box_that_carries_it(column: list[Box]) -> None:
+    outcomes = belief_removals(_scene(column, ["bottom", "middle", "beside"]), worlds=1)
+    assert "load:middle" in outcomes["middle"].moved
+    assert {"middle", "load:middle"} <= set(outcomes["bottom"].moved)
+    assert outcomes["beside"].moved == ()
+
+
+@pytest.mark.slow  # physics
+def test_the_choice_is_a_box_that_moves_nothing_resting_highest(column: list[Box]) -> None:
+    assert belief_choice(_scene(column, [box.id for box in column]), worlds=1) == "top"
+    assert belief_choice(_scene(column, ["bottom", "middle", "beside"]), worlds=1) == "beside"
+
+
+@pytest.mark.slow  # physics
+def test_the_same_seed_gives_the_same_outcomes(column: list[Box]) -> None:
+    scene = _scene(column, ["bottom", "middle", "beside"])
+    assert belief_removals(scene, worlds=3, seed=5) == belief_removals(scene, worlds=3, seed=5)
+
+
+def test_candidates_that_are_not_detected_are_refused(column: list[Box]) -> None:
+    with pytest.raises(UnstackError, match=r"candidates \['top'\] are not detected"):
+        belief_removals(_scene(column, ["bottom"]), ["top"])
+
+
+def test_at_least_one_world_is_needed(column: list[Box]) -> None:
+    with pytest.raises(UnstackError, match="worlds must be at least 1"):
+        belief_removals(_scene(column, ["bottom"]), worlds=0)

@@ -1,0 +1,351 @@
+"""Physics on the belief: what a pick would move, tried in the engine on what the robot sees.
+
+The physics look-ahead of the container experiment (:func:`unstack.sim.unloading.probe_removals`)
+knows the true pile. A robot knows less: the detected boxes at the poses its detector reports,
+and a point cloud. This module builds a physics world from that alone (issue 34, route b):
+
+* every detected box at its reported pose, as a dynamic body of the typical mass (the
+  settings' mean; a detector reports no masses);
+* the cloud points no detected box explains and no container wall holds
+  (:func:`unstack.hidden_load.unexplained_points`) are binned into columns of
+  :data:`CELL` metres across; in each column, the points between two detected boxes (or
+  between the floor and the lowest detected box, or above the highest) are one stretch of
+  unseen material, filled down to what lies under it: a detected box's top or the floor;
+* stretches standing on the floor are **fixed** blocks (something unseen holds them up;
+  the robot will not move it by taking a detected box); the stretches resting on one
+  detected box are together **one dynamic body** on it -- the load nobody detected, which
+  falls when that box is taken (its footprint clipped to the box's, its height the median
+  top of its stretches).
+
+A box the robot sees standing still but that falls in the belief world (it leans on or
+rests on boxes nobody sees, behind the front of the pile) is held by something unseen: it
+is fixed in place (:data:`HOLD_ROUNDS` rounds of settling and looking), and a removal that
+touches it counts it as moved -- the belief cannot say what it would do, only that it
+leant on the removed box.
+
+The world settles for :data:`~unstack.sim.unloading.RESETTLE_SECONDS`; then each candidate's
+removal is tried as the look-ahead tries it (the same horizon, thresholds and parking, the
+state restored after each try), counting the detected boxes and the hidden-load bodies that
+move more than 2 cm or turn more than 5 degrees. This is done in :data:`BELIEF_WORLDS`
+worlds: the first with the typical mass and the reported poses, the others with masses drawn
+from the settings' range and positions jittered by :data:`POSE_JITTER` (a pile near a
+tipping point answers differently). :func:`belief_choice` takes the candidate whose removal
+moves the fewest on average, ties to the box resting highest.
+
+Examples
+--------
+>>> from unstack.scene import Box, Scene
+>>> from unstack.clouds import surface_cloud
+>>> boxes = [Box("low", [0.4, 0.4, 0.3], [1.0, 0.0, 0.15]), Box("high", [0.4, 0.4, 0.3], [1.0, 0.0, 0.45])]
+>>> scene = Scene(boxes, surface_cloud(boxes, viewpoint=[-2.0, 0.0, 1.5], seed=0), ["low"])
+>>> [block.resting_on for block in belief_blocks(scene)]   # "high" is not detected: load on "low"
+['low']
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from unstack.errors import UnstackError
+from unstack.scene import Scene
+
+__all__ = ["CELL", "BeliefBlock", "BeliefOutcome", "belief_blocks", "belief_choice", "belief_removals"]
+
+#: Width of the columns the unexplained points are binned into (metres).
+CELL = 0.08
+#: Points lower than this are the floor (metres).
+FLOOR_LEVEL = 0.05
+#: A stretch of unexplained points whose lowest point is within this of a detected box's top
+#: rests on that box (metres); the box's footprint is grown by it to catch its load's front face.
+REST_TOLERANCE = 0.08
+#: Blocks are made this much smaller than their column on every side (metres), so that a
+#: fixed block does not touch the detected boxes beside it before anything moves.
+CLEARANCE = 0.005
+#: Fewer unexplained points than this in a column are noise.
+MIN_POINTS = 3
+#: Rounds of fixing in place the boxes a belief world lets fall (:func:`belief_removals`).
+HOLD_ROUNDS = 3
+#: Belief worlds per decision (:func:`belief_removals`).
+BELIEF_WORLDS = 4
+#: Standard deviation of the horizontal jitter of the detected boxes' positions in the
+#: belief worlds after the first (metres).
+POSE_JITTER = 0.003
+
+
+@dataclass(frozen=True)
+class BeliefBlock:
+    """Unseen material put into the belief world: a fixed block or a detected box's hidden load.
+
+    Attributes
+    ----------
+    size, center : numpy.ndarray, shape (3,)
+        Axis-aligned extents and centre (metres).
+    resting_on : str or None
+        The detected box the block rests on (a dynamic body) or None (fixed, on the floor).
+    """
+
+    size: np.ndarray
+    center: np.ndarray
+    resting_on: str | None
+
+
+@dataclass(frozen=True)
+class BeliefOutcome:
+    """What removing one candidate does in the belief world."""
+
+    box: str
+    moved: tuple[str, ...]  # in the first world: detected boxes moved, ``load:<box>`` for a hidden load
+    expected_moved: float  # the mean over the belief worlds
+
+
+def _stretches(zs: np.ndarray, floors: list[tuple[float, float]]) -> list[tuple[float, float, float]]:
+    """Split a column's point heights by the detected boxes' z-intervals over it.
+
+    Returns ``(base, lowest, top)`` per stretch: the height of what lies under it (a box's
+    top or 0), its lowest and its highest point.
+    """
+    intervals = sorted(floors)
+    result = []
+    base = 0.0
+    edges = [*intervals, (np.inf, np.inf)]
+    for bottom, top in edges:
+        inside = zs[(zs > base) & (zs < bottom)]
+        if len(inside) >= MIN_POINTS:
+            result.append((base, float(inside.min()), float(inside.max())))
+        base = max(base, top)
+    return result
+
+
+def belief_blocks(scene: Scene, detected: Sequence[str] | None = None) -> list[BeliefBlock]:
+    """The unseen material of a scene as blocks (see the module docstring).
+
+    Parameters
+    ----------
+    scene : Scene
+        Only the detected boxes' poses and the point cloud are used.
+    detected : sequence of str, optional
+        Box ids to treat as detected instead of ``scene.detected``.
+
+    Returns
+    -------
+    list of BeliefBlock
+        Fixed blocks first (one per column stretch on the floor), then one hidden load per
+        detected box that carries one.
+    """
+    from unstack.geometry import bounding_boxes
+    from unstack.hidden_load import unexplained_points
+
+    ids = list(scene.detected if detected is None else detected)
+    boxes = [scene.box(box_id) for box_id in ids]
+    points = scene.points
+    if len(points) == 0:
+        return []
+    points = points[unexplained_points(points, boxes) & (points[:, 2] > FLOOR_LEVEL)]
+    if len(points) == 0:
+        return []
+    bounds = bounding_boxes(boxes) if boxes else np.zeros((0, 6))
+    cells = np.floor(points[:, :2] / CELL).astype(np.int64)
+    order = np.lexsort((cells[:, 1], cells[:, 0]))
+    cells, points = cells[order], points[order]
+    starts = np.flatnonzero(np.any(np.diff(cells, axis=0) != 0, axis=1)) + 1
+    fixed: list[BeliefBlock] = []
+    loads: dict[int, list[tuple[np.ndarray, float]]] = {}
+    for chunk in np.split(np.arange(len(points)), starts):
+        low = cells[chunk[0]] * CELL
+        high = low + CELL
+        over = np.flatnonzero(
+            np.all(bounds[:, :2] < high + REST_TOLERANCE, axis=1)
+            & np.all(bounds[:, 3:5] > low - REST_TOLERANCE, axis=1)
+        )
+        inside = [k for k in over if np.all(bounds[k, :2] < high) and np.all(bounds[k, 3:5] > low)]
+        for base, lowest, top in _stretches(points[chunk, 2], [(bounds[k, 2], bounds[k, 5]) for k in inside]):
+            resting = [
+                k for k in over if abs(bounds[k, 5] - base) < 1e-9 or 0.0 <= lowest - bounds[k, 5] < REST_TOLERANCE
+            ]
+            if resting and lowest > FLOOR_LEVEL + REST_TOLERANCE:
+                carrier = int(max(resting, key=lambda k: bounds[k, 5]))
+                loads.setdefault(carrier, []).append((np.array([*low, *high]), top))
+                continue
+            size = np.array([CELL - 2 * CLEARANCE, CELL - 2 * CLEARANCE, top - base - CLEARANCE])
+            if size[2] <= 0.01:
+                continue
+            fixed.append(BeliefBlock(size, np.array([*(low + CELL / 2), base + CLEARANCE + size[2] / 2]), None))
+    carried = []
+    for k, columns in sorted(loads.items()):
+        area = np.array([column for column, _ in columns])
+        lower = np.maximum(area[:, :2].min(axis=0), bounds[k, :2]) + CLEARANCE
+        upper = np.minimum(area[:, 2:].max(axis=0), bounds[k, 3:5]) - CLEARANCE
+        top = float(np.median([top for _, top in columns]))
+        height = top - bounds[k, 5]
+        if np.any(upper - lower < 0.02) or height < 0.02:
+            continue
+        size = np.array([*(upper - lower), height - CLEARANCE])
+        center = np.array([*((upper + lower) / 2), bounds[k, 5] + CLEARANCE + size[2] / 2])
+        carried.append(BeliefBlock(size, center, ids[k]))
+    return fixed + carried
+
+
+def _settings(scene: Scene, settings: Any) -> Any:
+    from unstack.sim.settings import SimulationSettings
+
+    if settings is not None:
+        return settings
+    data = scene.metadata.get("settings")
+    if isinstance(data, dict):
+        return SimulationSettings.from_dict(data)
+    return SimulationSettings()
+
+
+def _disturbed(before: tuple[np.ndarray, np.ndarray], after: tuple[np.ndarray, np.ndarray], truth: Any) -> np.ndarray:
+    """Which bodies moved more than the ground truth's thresholds between two pose sets."""
+    from unstack.geometry import rotation_angles_deg
+
+    moved: np.ndarray = (np.linalg.norm(after[0] - before[0], axis=1) > truth.displacement_threshold) | (
+        rotation_angles_deg(before[1], after[1]) > truth.rotation_threshold_deg
+    )
+    return moved
+
+
+def _try_removals(
+    scene: Scene, blocks: list[BeliefBlock], tried: list[str], simulation: Any, rng: np.random.Generator | None
+) -> dict[str, tuple[str, ...]]:
+    """One belief world: build, hold what it cannot hold, try each removal and undo it.
+
+    ``rng`` None: every detected box of the typical mass at its reported pose; else masses
+    drawn uniformly from the settings' range and poses jittered by :data:`POSE_JITTER`.
+    Returns what moved per candidate.
+    """
+    from unstack.sim.ground_truth import PARKING, run_horizon
+    from unstack.sim.unloading import RESETTLE_SECONDS
+    from unstack.sim.world import PhysicsWorld
+
+    truth = simulation.ground_truth
+    low_mass, high_mass = simulation.pile.mass_range
+    typical_mass = (low_mass + high_mass) / 2.0
+    with PhysicsWorld(simulation, door=False) as world:
+        client = world.client
+        bodies = {}
+        for box_id in scene.detected:
+            box = scene.box(box_id)
+            position = np.asarray(box.position, dtype=np.float64)
+            mass = typical_mass
+            if rng is not None:
+                position = position + rng.normal(0.0, POSE_JITTER, 3) * [1.0, 1.0, 0.0]
+                mass = float(rng.uniform(low_mass, high_mass))
+            bodies[box_id] = world.add_box(box.size, position, box.orientation_xyzw, mass=mass)
+        for block in blocks:
+            if block.resting_on is None:
+                world.add_fixed_block(block.size, block.center)
+            else:
+                volume = float(np.prod(scene.box(block.resting_on).size))
+                load_mass = typical_mass * min(1.0, float(np.prod(block.size)) / volume)
+                bodies[f"load:{block.resting_on}"] = world.add_box(
+                    block.size, block.center, [0, 0, 0, 1], mass=load_mass
+                )
+        names = list(bodies)
+        every = [bodies[name] for name in names]
+        built = client.saveState()
+        held: set[str] = set()
+        for _ in range(HOLD_ROUNDS):  # a box the belief lets fall is held by something unseen: fix it in place
+            start = world.poses(every)
+            world.step(RESETTLE_SECONDS)
+            run_horizon(world, truth, every)
+            falling = {names[k] for k in np.flatnonzero(_disturbed(start, world.poses(every), truth))} - held
+            client.restoreState(stateId=built)
+            if not falling:
+                break
+            held |= falling
+            for name in falling:
+                client.changeDynamics(bodies[name], -1, mass=0.0)
+        client.removeState(built)
+        world.step(RESETTLE_SECONDS)
+        state = client.saveState()
+        outcomes = {}
+        try:
+            for box_id in tried:
+                watched_names = [name for name in names if name != box_id and name not in held]
+                watched = [bodies[name] for name in watched_names]
+                leaning = tuple(
+                    name for name in sorted(held - {box_id}) if client.getContactPoints(bodies[box_id], bodies[name])
+                )
+                before = world.poses(watched)
+                client.resetBasePositionAndOrientation(bodies[box_id], PARKING.tolist(), [0.0, 0.0, 0.0, 1.0])
+                client.resetBaseVelocity(bodies[box_id], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+                run_horizon(world, truth, watched)
+                moved = _disturbed(before, world.poses(watched), truth)
+                outcomes[box_id] = tuple(watched_names[k] for k in np.flatnonzero(moved)) + leaning
+                client.restoreState(stateId=state)
+        finally:
+            client.removeState(state)
+    return outcomes
+
+
+def belief_removals(
+    scene: Scene,
+    candidates: Sequence[str] | None = None,
+    *,
+    worlds: int = BELIEF_WORLDS,
+    seed: int = 0,
+    settings: Any = None,
+) -> dict[str, BeliefOutcome]:
+    """What removing each candidate moves in the belief worlds built from ``scene``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The detected boxes (reported poses) and the point cloud; the poses of undetected
+        boxes are never read.
+    candidates : sequence of str, optional
+        Detected boxes to try (default: all detected).
+    worlds : int
+        Belief worlds: the first with the typical mass and the reported poses, the others
+        with masses drawn from the settings' range and poses jittered (a detector reports
+        neither masses nor exact poses, and a pile near a tipping point answers differently).
+    seed : int
+        Seeds the draws of the other worlds.
+    settings : SimulationSettings, optional
+        Container, friction, time step, masses and the removal thresholds; default: the
+        scene's own (``metadata.settings`` of a simulated scene), else the defaults.
+
+    Returns
+    -------
+    dict of str to BeliefOutcome
+        ``expected_moved``: the mean over the worlds.
+    """
+    detected = list(scene.detected)
+    tried = detected if candidates is None else list(candidates)
+    unknown = [box_id for box_id in tried if box_id not in detected]
+    if unknown:
+        raise UnstackError(f"{scene.source}: candidates {unknown} are not detected boxes of the scene")
+    if worlds < 1:
+        raise UnstackError(f"worlds must be at least 1, got {worlds}")
+    simulation = _settings(scene, settings)
+    blocks = belief_blocks(scene)
+    rng = np.random.default_rng(seed)
+    runs = [_try_removals(scene, blocks, tried, simulation, None if world == 0 else rng) for world in range(worlds)]
+    return {
+        box_id: BeliefOutcome(box_id, runs[0][box_id], float(np.mean([len(run[box_id]) for run in runs])))
+        for box_id in tried
+    }
+
+
+def belief_choice(scene: Scene, *, worlds: int = BELIEF_WORLDS, seed: int = 0, settings: Any = None) -> str:
+    """The detected box whose removal moves the fewest in the belief world; ties to the box resting highest.
+
+    Examples
+    --------
+    >>> from unstack.scene import Box, Scene
+    >>> from unstack.clouds import surface_cloud
+    >>> boxes = [Box("low", [0.4, 0.4, 0.3], [1.0, 0.0, 0.15]), Box("high", [0.4, 0.4, 0.3], [1.0, 0.0, 0.45])]
+    >>> belief_choice(Scene(boxes, surface_cloud(boxes, viewpoint=[-2.0, 0.0, 1.5], seed=0), ["low", "high"]))
+    'high'
+    """
+    from unstack.geometry import bounding_boxes
+
+    outcomes = belief_removals(scene, worlds=worlds, seed=seed, settings=settings)
+    resting = {box_id: float(bounding_boxes([scene.box(box_id)])[0, 2]) for box_id in scene.detected}
+    return min(scene.detected, key=lambda box_id: (outcomes[box_id].expected_moved, -resting[box_id], box_id))
