@@ -526,6 +526,55 @@ def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int
         console.print(f"physics disagrees with the labels of {key}: {'; '.join(problems)}")
 
 
+@experiment.command("belief-calibration")
+@click.argument("data_dir", type=click.Path(file_okay=False))
+@click.option("--out", required=True, type=click.Path(), help="Folder for belief-calibration.json.")
+@click.option("--piles", type=click.IntRange(min=1), default=2, show_default=True, help="Piles (the first N).")
+@click.option("--detector-misses", type=click.FloatRange(0.0, 0.9), default=0.0, show_default=True,
+              help="Share of the seen boxes the detector misses at each scan.")  # fmt: skip
+@click.option("--worlds", type=click.IntRange(min=1), default=None, help="Belief worlds per decision (default 4).")
+@click.option("--max-picks", type=click.IntRange(min=1), default=None, help="Stop each pile after this many picks.")
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True)
+@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Piles run in parallel.")
+def belief_calibration_command(
+    data_dir: str, out: str, piles: int, detector_misses: float, worlds: int | None, max_picks: int | None, seed: int,
+    jobs: int,
+) -> None:  # fmt: skip
+    """What physics on the belief expects each pick to move, against what it moves.
+
+    Piles are emptied highest first; before every pick each candidate's removal is tried in
+    the true pile and in the belief built from what the robot sees. Prints Spearman's rank
+    correlation, the means per predicted bin, and what each rule's pick would have moved.
+    """
+    from unstack.datasets import require_configurations
+    from unstack.experiments.belief_calibration import belief_calibration
+
+    require_configurations(data_dir)
+    folder = _out(out)
+    with progress_bar("piles") as report:
+        result = belief_calibration(
+            data_dir, piles=piles, detector_misses=detector_misses, worlds=worlds, max_picks=max_picks, seed=seed,
+            n_jobs=jobs, progress=report,
+        )  # fmt: skip
+    _write_json(folder / "belief-calibration.json", result)
+    table = Table(title=f"Expected against actual boxes moved per candidate ({result['piles']} piles of {data_dir})")
+    for column in ("expected", "candidates", "mean expected", "mean actual"):
+        table.add_column(column, justify="right")
+    for row in result["calibration"]["bins"]:
+        upper = "" if row["predicted_to"] is None else f"{row['predicted_to']:g}"
+        table.add_row(f"{row['predicted_from']:g} - {upper}", str(row["picks"]), f"{row['mean_predicted']:.2f}",
+                      f"{row['mean_actual']:.2f}")  # fmt: skip
+    console = Console()
+    console.print(table)
+    picks = result["picks"]
+    console.print(f"Spearman's rank correlation: {result['calibration']['spearman']:.3f}")
+    console.print(
+        f"boxes the pick would have moved over {picks['states']} states: highest first {picks['highest']}, "
+        f"the belief's choice {picks['belief']}, the look-ahead's {picks['lookahead']}"
+    )
+    click.echo(f"results in {folder / 'belief-calibration.json'}")
+
+
 @experiment.command("pick-responses")
 @click.argument("data_dirs", nargs=-1, required=True, type=click.Path(file_okay=False))
 @click.option("--out", required=True, type=click.Path(), help="Folder of the collected states (resumable).")

@@ -17,19 +17,20 @@ and a point cloud. This module builds a physics world from that alone (issue 34,
   falls when that box is taken (its footprint clipped to the box's, its height the median
   top of its stretches).
 
-A box the robot sees standing still but that falls in the belief world (it leans on or
-rests on boxes nobody sees, behind the front of the pile) is held by something unseen: it
-is fixed in place (:data:`HOLD_ROUNDS` rounds of settling and looking), and a removal that
-touches it counts it as moved -- the belief cannot say what it would do, only that it
-leant on the removed box.
+A box the robot sees standing still that falls in the belief world rests or leans on boxes
+nobody sees (behind the front of the pile). First the space under it that no detected box
+fills is taken to be solid (:func:`unseen_supports`); a box that still falls leans on
+something unseen and is fixed in place, and a removal that touches it counts it as moved --
+the belief cannot say what it would do, only that it leant on the removed box
+(:data:`HOLD_ROUNDS` rounds of settling and looking).
 
 The world settles for :data:`~unstack.sim.unloading.RESETTLE_SECONDS`; then each candidate's
 removal is tried as the look-ahead tries it (the same horizon, thresholds and parking, the
 state restored after each try), counting the detected boxes and the hidden-load bodies that
 move more than 2 cm or turn more than 5 degrees. This is done in :data:`BELIEF_WORLDS`
-worlds: the first with the typical mass and the reported poses, the others with masses drawn
-from the settings' range and positions jittered by :data:`POSE_JITTER` (a pile near a
-tipping point answers differently). :func:`belief_choice` takes the candidate whose removal
+worlds: the first with the typical mass, the others with masses drawn from the settings'
+range (a detector reports no masses, and a pile near a tipping point answers differently).
+:func:`belief_choice` takes the candidate whose removal
 moves the fewest on average, ties to the box resting highest.
 
 Examples
@@ -51,9 +52,17 @@ from typing import Any
 import numpy as np
 
 from unstack.errors import UnstackError
-from unstack.scene import Scene
+from unstack.scene import Box, Scene
 
-__all__ = ["CELL", "BeliefBlock", "BeliefOutcome", "belief_blocks", "belief_choice", "belief_removals"]
+__all__ = [
+    "CELL",
+    "BeliefBlock",
+    "BeliefOutcome",
+    "belief_blocks",
+    "belief_choice",
+    "belief_removals",
+    "unseen_supports",
+]
 
 #: Width of the columns the unexplained points are binned into (metres).
 CELL = 0.08
@@ -71,9 +80,6 @@ MIN_POINTS = 3
 HOLD_ROUNDS = 3
 #: Belief worlds per decision (:func:`belief_removals`).
 BELIEF_WORLDS = 4
-#: Standard deviation of the horizontal jitter of the detected boxes' positions in the
-#: belief worlds after the first (metres).
-POSE_JITTER = 0.003
 
 
 @dataclass(frozen=True)
@@ -210,14 +216,106 @@ def _disturbed(before: tuple[np.ndarray, np.ndarray], after: tuple[np.ndarray, n
     return moved
 
 
+def _bottom_heights(box: Box, xy: np.ndarray) -> np.ndarray:
+    """Height of the box's underside above each point ``xy`` (nan where a vertical line misses it)."""
+    from unstack.geometry import rotation_matrix
+
+    rotation = rotation_matrix(box.orientation_xyzw)
+    half = np.asarray(box.size, dtype=np.float64) / 2.0
+    origins = (np.column_stack([xy, np.zeros(len(xy))]) - box.position) @ rotation  # in the box's frame
+    direction = rotation[2]  # the world's up in the box's frame
+    low = np.full(len(xy), -np.inf)
+    high = np.full(len(xy), np.inf)
+    for axis in range(3):
+        if abs(direction[axis]) < 1e-9:
+            outside = np.abs(origins[:, axis]) > half[axis]
+            low[outside], high[outside] = np.inf, -np.inf
+            continue
+        first = (-half[axis] - origins[:, axis]) / direction[axis]
+        second = (half[axis] - origins[:, axis]) / direction[axis]
+        low = np.maximum(low, np.minimum(first, second))
+        high = np.minimum(high, np.maximum(first, second))
+    return np.where(low <= high, low, np.nan)
+
+
+def unseen_supports(box: Box, others: Sequence[Box]) -> list[BeliefBlock]:
+    """Fixed blocks filling the space under ``box`` where no box of ``others`` stands.
+
+    A box the robot sees standing still that falls in the belief world rests on something
+    nobody sees; the space under it that no detected box fills is taken to be that.
+
+    Examples
+    --------
+    >>> from unstack.scene import Box
+    >>> floating = Box("up", [0.4, 0.4, 0.3], [1.0, 0.0, 0.55])
+    >>> half_under = Box("under", [0.2, 0.4, 0.4], [0.9, 0.0, 0.2])
+    >>> blocks = unseen_supports(floating, [half_under])
+    >>> bool(min(block.center[0] - block.size[0] / 2 for block in blocks) >= 1.0)   # only the other half
+    True
+    """
+    from unstack.geometry import bounding_boxes
+
+    bound = bounding_boxes([box])[0]
+    others_bounds = bounding_boxes(list(others)) if others else np.zeros((0, 6))
+    xs = np.arange(np.floor(bound[0] / CELL), np.ceil(bound[3] / CELL)) * CELL + CELL / 2
+    ys = np.arange(np.floor(bound[1] / CELL), np.ceil(bound[4] / CELL)) * CELL + CELL / 2
+    centres = np.array([(x, y) for x in xs for y in ys]).reshape(-1, 2)
+    bottoms = _bottom_heights(box, centres)
+    blocks = []
+    for centre, bottom in zip(centres, bottoms, strict=True):
+        if not np.isfinite(bottom) or bottom < 0.02:
+            continue
+        low, high = centre - CELL / 2, centre + CELL / 2
+        under = np.all(others_bounds[:, :2] < high, axis=1) & np.all(others_bounds[:, 3:5] > low, axis=1)
+        under &= others_bounds[:, 2] < bottom
+        if under.any():
+            continue  # a detected box stands in this cell: it is the support there, or the belief's error
+        height = bottom - 2 * CLEARANCE
+        size = np.array([CELL - 2 * CLEARANCE, CELL - 2 * CLEARANCE, height])
+        blocks.append(BeliefBlock(size, np.array([*centre, CLEARANCE + height / 2]), None))
+    return blocks
+
+
+def _build(
+    world: Any, scene: Scene, blocks: Sequence[BeliefBlock], masses: dict[str, float], held: set[str]
+) -> dict[str, int]:
+    """Put the detected boxes, the blocks and the hidden loads in ``world``; body ids by name."""
+    bodies = {}
+    for box_id in scene.detected:
+        box = scene.box(box_id)
+        mass = 0.0 if box_id in held else masses[box_id]
+        bodies[box_id] = world.add_box(box.size, box.position, box.orientation_xyzw, mass=mass)
+    typical_mass = float(np.mean(list(masses.values()))) if masses else 1.0
+    for block in blocks:
+        if block.resting_on is None:
+            world.add_fixed_block(block.size, block.center)
+        else:
+            volume = float(np.prod(scene.box(block.resting_on).size))
+            load_mass = typical_mass * min(1.0, float(np.prod(block.size)) / volume)
+            bodies[f"load:{block.resting_on}"] = world.add_box(block.size, block.center, [0, 0, 0, 1], mass=load_mass)
+    return bodies
+
+
+def _falling(world: Any, bodies: dict[str, int], truth: Any) -> set[str]:
+    """The bodies that move, with nothing taken, over a settle and a horizon."""
+    from unstack.sim.ground_truth import run_horizon
+    from unstack.sim.unloading import RESETTLE_SECONDS
+
+    names = list(bodies)
+    every = [bodies[name] for name in names]
+    start = world.poses(every)
+    world.step(RESETTLE_SECONDS)
+    run_horizon(world, truth, every)
+    return {names[k] for k in np.flatnonzero(_disturbed(start, world.poses(every), truth))}
+
+
 def _try_removals(
     scene: Scene, blocks: list[BeliefBlock], tried: list[str], simulation: Any, rng: np.random.Generator | None
 ) -> dict[str, tuple[str, ...]]:
-    """One belief world: build, hold what it cannot hold, try each removal and undo it.
+    """One belief world: build, support or hold what it cannot hold, try each removal and undo it.
 
-    ``rng`` None: every detected box of the typical mass at its reported pose; else masses
-    drawn uniformly from the settings' range and poses jittered by :data:`POSE_JITTER`.
-    Returns what moved per candidate.
+    ``rng`` None: every detected box of the typical mass; else masses drawn uniformly from the
+    settings' range. Returns what moved per candidate.
     """
     from unstack.sim.ground_truth import PARKING, run_horizon
     from unstack.sim.unloading import RESETTLE_SECONDS
@@ -225,43 +323,32 @@ def _try_removals(
 
     truth = simulation.ground_truth
     low_mass, high_mass = simulation.pile.mass_range
-    typical_mass = (low_mass + high_mass) / 2.0
+    masses = {
+        box_id: (low_mass + high_mass) / 2.0 if rng is None else float(rng.uniform(low_mass, high_mass))
+        for box_id in scene.detected
+    }
+    detected_boxes = [scene.box(box_id) for box_id in scene.detected]
+    held: set[str] = set()
+    supported: set[str] = set()
+    all_blocks = list(blocks)
+    for _ in range(HOLD_ROUNDS):  # what falls in the belief stands on, or leans on, something unseen
+        with PhysicsWorld(simulation, door=False) as world:
+            falling = _falling(world, _build(world, scene, all_blocks, masses, held), truth) - held
+        falling = {name for name in falling if not name.startswith("load:")}
+        if not falling:
+            break
+        fresh = falling - supported
+        if fresh:  # first: the unseen space under a falling box holds it
+            for box_id in sorted(fresh):
+                others = [box for box in detected_boxes if box.id != box_id]
+                all_blocks += unseen_supports(scene.box(box_id), others)
+            supported |= fresh
+        else:  # still falling on its supports: it leans on something unseen; fixed in place
+            held |= falling
     with PhysicsWorld(simulation, door=False) as world:
         client = world.client
-        bodies = {}
-        for box_id in scene.detected:
-            box = scene.box(box_id)
-            position = np.asarray(box.position, dtype=np.float64)
-            mass = typical_mass
-            if rng is not None:
-                position = position + rng.normal(0.0, POSE_JITTER, 3) * [1.0, 1.0, 0.0]
-                mass = float(rng.uniform(low_mass, high_mass))
-            bodies[box_id] = world.add_box(box.size, position, box.orientation_xyzw, mass=mass)
-        for block in blocks:
-            if block.resting_on is None:
-                world.add_fixed_block(block.size, block.center)
-            else:
-                volume = float(np.prod(scene.box(block.resting_on).size))
-                load_mass = typical_mass * min(1.0, float(np.prod(block.size)) / volume)
-                bodies[f"load:{block.resting_on}"] = world.add_box(
-                    block.size, block.center, [0, 0, 0, 1], mass=load_mass
-                )
+        bodies = _build(world, scene, all_blocks, masses, held)
         names = list(bodies)
-        every = [bodies[name] for name in names]
-        built = client.saveState()
-        held: set[str] = set()
-        for _ in range(HOLD_ROUNDS):  # a box the belief lets fall is held by something unseen: fix it in place
-            start = world.poses(every)
-            world.step(RESETTLE_SECONDS)
-            run_horizon(world, truth, every)
-            falling = {names[k] for k in np.flatnonzero(_disturbed(start, world.poses(every), truth))} - held
-            client.restoreState(stateId=built)
-            if not falling:
-                break
-            held |= falling
-            for name in falling:
-                client.changeDynamics(bodies[name], -1, mass=0.0)
-        client.removeState(built)
         world.step(RESETTLE_SECONDS)
         state = client.saveState()
         outcomes = {}
