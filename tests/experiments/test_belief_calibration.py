@@ -31,8 +31,11 @@ def test_the_calibration_bins_hold_every_candidate(result: dict[str, object]) ->
 
 
 def test_the_summary_sums_each_rule() -> None:
-    states = [{"highest": 3, "belief": 1, "lookahead": 0}, {"highest": 1, "belief": 1, "lookahead": 1}]
-    assert pick_summary(states) == {"states": 2, "highest": 4, "belief": 2, "lookahead": 1}
+    states = [
+        {"highest": 3, "belief": 1, "belief_veto": 2, "lookahead": 0},
+        {"highest": 1, "belief": 1, "belief_veto": 1, "lookahead": 1},
+    ]
+    assert pick_summary(states) == {"states": 2, "highest": 4, "belief": 2, "belief_veto": 3, "lookahead": 1}
 
 
 def test_the_cli_writes_the_report(small_dataset: Path, tmp_path: Path) -> None:

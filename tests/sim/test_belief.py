@@ -8,7 +8,7 @@ import pytest
 from unstack.clouds import surface_cloud
 from unstack.errors import UnstackError
 from unstack.scene import Box, Scene
-from unstack.sim.belief import BeliefBlock, belief_blocks, belief_choice, belief_removals
+from unstack.sim.belief import BeliefBlock, belief_blocks, belief_choice, belief_removals, choose_by_expected_moves
 
 VIEWPOINT = [-2.0, 0.0, 1.5]
 
@@ -93,3 +93,21 @@ def test_candidates_that_are_not_detected_are_refused(column: list[Box]) -> None
 def test_at_least_one_world_is_needed(column: list[Box]) -> None:
     with pytest.raises(UnstackError, match="worlds must be at least 1"):
         belief_removals(_scene(column, ["bottom"]), worlds=0)
+
+
+def test_an_unknown_rule_is_refused(column: list[Box]) -> None:
+    with pytest.raises(UnstackError, match="unknown belief rule 'tallest'"):
+        belief_choice(_scene(column, ["bottom"]), rule="tallest")
+
+
+@pytest.mark.parametrize(
+    ("expected", "rule", "choice"),
+    [
+        ({"low": 0.0, "high": 0.5}, "fewest", "low"),
+        ({"low": 0.0, "high": 0.5}, "veto", "high"),
+        ({"low": 0.0, "high": 1.0}, "veto", "low"),
+        ({"low": 0.0, "high": 0.0}, "fewest", "high"),
+    ],
+)
+def test_the_rules_pick_from_the_expected_moves(expected: dict[str, float], rule: str, choice: str) -> None:
+    assert choose_by_expected_moves(expected, {"low": 0.0, "high": 0.3}, rule) == choice

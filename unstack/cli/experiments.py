@@ -570,7 +570,8 @@ def belief_calibration_command(
     console.print(f"Spearman's rank correlation: {result['calibration']['spearman']:.3f}")
     console.print(
         f"boxes the pick would have moved over {picks['states']} states: highest first {picks['highest']}, "
-        f"the belief's choice {picks['belief']}, the look-ahead's {picks['lookahead']}"
+        f"the belief's fewest {picks['belief']}, height vetoed by the belief {picks['belief_veto']}, "
+        f"the look-ahead's {picks['lookahead']}"
     )
     click.echo(f"results in {folder / 'belief-calibration.json'}")
 

@@ -12,8 +12,9 @@ in the same states (highest first, the belief's choice, the look-ahead's).
 
 Examples
 --------
->>> pick_summary([{"highest": 2, "belief": 0, "lookahead": 0}, {"highest": 0, "belief": 1, "lookahead": 0}])
-{'states': 2, 'highest': 2, 'belief': 1, 'lookahead': 0}
+>>> pick_summary([{"highest": 2, "belief": 0, "belief_veto": 0, "lookahead": 0},
+...               {"highest": 0, "belief": 1, "belief_veto": 0, "lookahead": 0}])
+{'states': 2, 'highest': 2, 'belief': 1, 'belief_veto': 0, 'lookahead': 0}
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ from unstack.scene import Scene
 
 __all__ = ["belief_calibration", "pick_summary"]
 
-RULES = ("highest", "belief", "lookahead")
+RULES = ("highest", "belief", "belief_veto", "lookahead")
 
 
 def pick_summary(states: Sequence[dict[str, int]]) -> dict[str, int]:
@@ -41,7 +42,7 @@ def pick_summary(states: Sequence[dict[str, int]]) -> dict[str, int]:
 def _calibrate_pile(path: Path, number: int, options: dict[str, Any]) -> tuple[int, dict[str, Any]]:
     from unstack.geometry import bounding_boxes
     from unstack.scene import load_scene
-    from unstack.sim.belief import belief_removals
+    from unstack.sim.belief import belief_removals, choose_by_expected_moves
     from unstack.sim.unloading import unload_container
 
     scene = load_scene(path)
@@ -56,9 +57,11 @@ def _calibrate_pile(path: Path, number: int, options: dict[str, Any]) -> tuple[i
             return min(current.detected, key=lambda box_id: (moves(box_id), -resting[box_id], box_id))
 
         highest = max(current.detected, key=lambda box_id: (resting[box_id], box_id))
+        means = {box_id: expected[box_id].expected_moved for box_id in current.detected}
         picks = {
             "highest": highest,
-            "belief": calmest(lambda box_id: expected[box_id].expected_moved),
+            "belief": choose_by_expected_moves(means, resting, "fewest"),
+            "belief_veto": choose_by_expected_moves(means, resting, "veto"),
             "lookahead": calmest(lambda box_id: outcomes[box_id].boxes_moved),
         }
         pairs.extend((expected[box_id].expected_moved, outcomes[box_id].boxes_moved) for box_id in current.detected)

@@ -41,6 +41,9 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     physics on what the robot sees (:mod:`unstack.sim.belief`): the detected boxes at their
     reported poses and the unseen material of the cloud put in the engine, every candidate's
     removal tried; the fewest moved, ties to the box resting highest (slow).
+``belief_veto``
+    the same expected moves, the ``veto`` rule: the box resting highest unless the belief
+    expects its removal to move at least :data:`~unstack.sim.belief.BELIEF_VETO` boxes.
 
 Metrics per pile and per maker: boxes moved more than 2 cm, boxes fallen (dropped more than
 0.2 m or tipped more than 45 degrees), the share of picks that move nothing, and paired
@@ -69,7 +72,7 @@ __all__ = ["CONTAINER_MAKERS", "CONTAINER_SAMPLES", "container_experiment", "con
 
 CONTAINER_MAKERS = (
     "unstack", "min_cost", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random", "lookahead",
-    "moves", "moves_veto", "belief",
+    "moves", "moves_veto", "belief", "belief_veto",
 )  # fmt: skip
 #: Makers whose policy is told what every candidate's removal does in the engine (the true pile).
 PROBING_MAKERS = ("lookahead",)
@@ -165,10 +168,13 @@ def container_policies(
         decision = decide_on_moves(scene, supports, disturbance=loaded[0], samples=samples, seed=seed, rule=rule)
         return str(decision.choice)
 
-    def belief(scene: Scene) -> str:
-        from unstack.sim.belief import belief_choice
+    def believing(rule: str) -> Callable[[Scene], str]:
+        def policy(scene: Scene) -> str:
+            from unstack.sim.belief import belief_choice
 
-        return belief_choice(scene)
+            return belief_choice(scene, rule=rule)
+
+        return policy
 
     every: dict[str, Callable[..., str]] = {
         "unstack": deciding("load"),
@@ -182,7 +188,8 @@ def container_policies(
         "lookahead": lookahead,
         "moves": moving("fewest"),
         "moves_veto": moving("veto"),
-        "belief": belief,
+        "belief": believing("fewest"),
+        "belief_veto": believing("veto"),
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:

@@ -61,6 +61,7 @@ __all__ = [
     "belief_blocks",
     "belief_choice",
     "belief_removals",
+    "choose_by_expected_moves",
     "unseen_supports",
 ]
 
@@ -78,6 +79,10 @@ CLEARANCE = 0.005
 MIN_POINTS = 3
 #: Rounds of fixing in place the boxes a belief world lets fall (:func:`belief_removals`).
 HOLD_ROUNDS = 3
+#: How :func:`belief_choice` picks: the fewest expected moves, or height vetoed by them.
+BELIEF_RULES = ("fewest", "veto")
+#: The ``veto`` rule passes over the highest box when its removal is expected to move this many.
+BELIEF_VETO = 1.0
 #: Belief worlds per decision (:func:`belief_removals`).
 BELIEF_WORLDS = 4
 
@@ -420,8 +425,14 @@ def belief_removals(
     }
 
 
-def belief_choice(scene: Scene, *, worlds: int = BELIEF_WORLDS, seed: int = 0, settings: Any = None) -> str:
-    """The detected box whose removal moves the fewest in the belief world; ties to the box resting highest.
+def belief_choice(
+    scene: Scene, *, rule: str = "fewest", worlds: int = BELIEF_WORLDS, seed: int = 0, settings: Any = None
+) -> str:
+    """The detected box to take by the belief's expected moves (:data:`BELIEF_RULES`).
+
+    ``fewest``: the box whose removal moves the fewest on average, ties to the box resting
+    highest. ``veto``: the box resting highest, unless the belief expects its removal to move
+    at least :data:`BELIEF_VETO` boxes; then the fewest.
 
     Examples
     --------
@@ -433,6 +444,25 @@ def belief_choice(scene: Scene, *, worlds: int = BELIEF_WORLDS, seed: int = 0, s
     """
     from unstack.geometry import bounding_boxes
 
+    if rule not in BELIEF_RULES:
+        raise UnstackError(f"unknown belief rule {rule!r}; expected one of {', '.join(BELIEF_RULES)}")
     outcomes = belief_removals(scene, worlds=worlds, seed=seed, settings=settings)
     resting = {box_id: float(bounding_boxes([scene.box(box_id)])[0, 2]) for box_id in scene.detected}
-    return min(scene.detected, key=lambda box_id: (outcomes[box_id].expected_moved, -resting[box_id], box_id))
+    expected = {box_id: outcome.expected_moved for box_id, outcome in outcomes.items()}
+    return choose_by_expected_moves(expected, resting, rule)
+
+
+def choose_by_expected_moves(expected: dict[str, float], resting: dict[str, float], rule: str) -> str:
+    """The pick of ``rule`` (:data:`BELIEF_RULES`) from each candidate's expected moves and resting height.
+
+    Examples
+    --------
+    >>> choose_by_expected_moves({"a": 0.0, "b": 0.5}, {"a": 0.0, "b": 0.3}, "fewest")
+    'a'
+    >>> choose_by_expected_moves({"a": 0.0, "b": 0.5}, {"a": 0.0, "b": 0.3}, "veto")
+    'b'
+    """
+    highest = max(expected, key=lambda box_id: (resting[box_id], box_id))
+    if rule == "veto" and expected[highest] < BELIEF_VETO:
+        return highest
+    return min(expected, key=lambda box_id: (expected[box_id], -resting[box_id], box_id))
