@@ -526,6 +526,47 @@ def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int
         console.print(f"physics disagrees with the labels of {key}: {'; '.join(problems)}")
 
 
+@experiment.command("camera-roundtrip")
+@click.argument("data_dir", type=click.Path(file_okay=False))
+@click.option("--out", required=True, type=click.Path(), help="Folder for camera-roundtrip.json.")
+@click.option("--model", "model_path", default=None, help=MODEL_HELP)
+@click.option("--piles", type=click.IntRange(min=1), default=2, show_default=True, help="Piles (the first N).")
+@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Piles run in parallel.")
+def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, piles: int, jobs: int) -> None:
+    """Render piles as camera files, build the scenes back (unstack scene's method), compare with the truth.
+
+    Prints the position and yaw errors of the fitted boxes, the share of sizes right and the
+    share of piles whose decision on the built scene is the one on the true poses.
+    """
+    from unstack.cli.main import load_model_option
+    from unstack.datasets import require_configurations
+    from unstack.experiments.camera_roundtrip import camera_roundtrip
+
+    require_configurations(data_dir)
+    model, _ = load_model_option(model_path)
+    folder = _out(out)
+    with progress_bar("piles") as report:
+        result = camera_roundtrip(data_dir, model, piles=piles, n_jobs=jobs, progress=report)
+    _write_json(folder / "camera-roundtrip.json", result)
+    summary = result["summary"]
+    table = Table(title=f"Camera files to scenes: {summary['boxes']} boxes fitted from {summary['masks']} masks "
+                  f"({summary['piles']} piles of {data_dir})")  # fmt: skip
+    for column in ("figure", "median", "90th percentile"):
+        table.add_column(column, justify="right")
+    table.add_row("position error (mm)", f"{1000 * summary['position_error_m_median']:.1f}",
+                  f"{1000 * summary['position_error_m_p90']:.1f}")  # fmt: skip
+    table.add_row(
+        "yaw error (degrees)", f"{summary['yaw_error_deg_median']:.1f}", f"{summary['yaw_error_deg_p90']:.1f}"
+    )
+    Console().print(table)
+    click.echo(
+        f"sizes right {100 * summary['size_right_share']:.0f} %; fitted from the top face "
+        f"{100 * summary['top_faces_share']:.0f} %; the same decision as on the true poses in "
+        f"{100 * summary['same_decision_share']:.0f} % of piles"
+    )
+    click.echo(f"results in {folder / 'camera-roundtrip.json'}")
+
+
 @experiment.command("belief-calibration")
 @click.argument("data_dir", type=click.Path(file_okay=False))
 @click.option("--out", required=True, type=click.Path(), help="Folder for belief-calibration.json.")

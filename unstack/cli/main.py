@@ -46,6 +46,7 @@ LAZY_COMMANDS = {
     "evaluate": "unstack.cli.learning:evaluate",
     "probabilities": "unstack.cli.learning:probabilities",
     "experiment": "unstack.cli.experiments:experiment",
+    "scene": "unstack.cli.camera:scene",
 }
 
 

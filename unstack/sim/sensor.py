@@ -27,13 +27,14 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from unstack.sim.settings import SensorSettings
 from unstack.sim.world import PhysicsWorld
 
-__all__ = ["Scan", "camera_matrices", "scan_pile"]
+__all__ = ["Scan", "camera_matrices", "scan_pile", "sensor_intrinsics", "sensor_pose"]
 
 
 @dataclass(frozen=True)
@@ -69,6 +70,43 @@ def camera_matrices(world: PhysicsWorld, sensor: SensorSettings) -> tuple[list[f
         sensor.vertical_fov_deg, sensor.width / sensor.height, sensor.near, sensor.far
     )
     return list(view), list(projection)
+
+
+def sensor_intrinsics(sensor: SensorSettings) -> Any:
+    """The sensor as a pinhole camera (:class:`unstack.camera.Intrinsics`) for its depth image.
+
+    The renderer's pixel (row r, column c) is the ray through ``x = 2 c / W - 1`` and
+    ``y = 2 (H - 1 - r) / H - 1`` (see the module docstring): so ``cx = W / 2``,
+    ``cy = H / 2 - 1`` and ``fx = fy = H / (2 tan(fov / 2))`` (square pixels).
+
+    Examples
+    --------
+    >>> sensor_intrinsics(SensorSettings(width=64, height=48)).cy
+    23.0
+    """
+    from unstack.camera.files import Intrinsics
+
+    focal = sensor.height / (2.0 * np.tan(np.radians(sensor.vertical_fov_deg) / 2.0))
+    return Intrinsics(focal, focal, sensor.width / 2.0, sensor.height / 2.0 - 1.0, sensor.width, sensor.height)
+
+
+def sensor_pose(sensor: SensorSettings) -> np.ndarray:
+    """The sensor's camera-to-world transform (4 x 4; camera x right, y down, z forward).
+
+    Examples
+    --------
+    >>> sensor_pose(SensorSettings(position=(0.0, 0.0, 1.0), target=(1.0, 0.0, 1.0)))[:3, 2].tolist()
+    [1.0, 0.0, 0.0]
+    """
+    forward = np.asarray(sensor.target, dtype=np.float64) - np.asarray(sensor.position, dtype=np.float64)
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    down = np.cross(forward, right)
+    pose = np.eye(4)
+    pose[:3, :3] = np.column_stack([right, down, forward])
+    pose[:3, 3] = sensor.position
+    return pose
 
 
 def _unproject(depth_buffer: np.ndarray, view: list[float], projection: list[float]) -> np.ndarray:

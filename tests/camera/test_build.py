@@ -1,0 +1,77 @@
+"""Scenes from synthetic depth images: poses, sizes and gravity recovered."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.camera.conftest import INTRINSICS, render_tops
+from unstack.camera import scene_from_depth
+from unstack.errors import UnstackError
+from unstack.geometry import rotation_matrix
+
+SIZES = [(0.6, 0.4, 0.4), (0.4, 0.3, 0.3)]
+
+
+def _yaw_deg(orientation: np.ndarray) -> float:
+    rotation = rotation_matrix(orientation)
+    return float(np.degrees(np.arctan2(rotation[1, 0], rotation[0, 0])))
+
+
+@pytest.mark.parametrize("tilt_deg", [0.0, 5.0, 9.0, 15.0])
+def test_poses_and_sizes_come_back_whatever_the_tilt_of_the_pose_frame(three_cartons, tilt_deg: float) -> None:
+    depth, masks, pose = render_tops(three_cartons, tilt_deg)
+    built = scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES, door=None)
+    assert built.frame.tilt_deg == pytest.approx(tilt_deg, abs=0.3)
+    assert len(built.fitted) == 3 and not built.duplicates and not built.unfitted
+    for item, (_x, _y, _yaw, long, short, height) in zip(built.fitted, three_cartons, strict=True):
+        assert sorted(item.box.size) == pytest.approx(sorted((long, short, height)))
+        assert item.box.position[2] == pytest.approx(height / 2, abs=0.01)  # on the floor, put at z = 0
+        assert item.residual_m < 0.003 and item.fill > 0.9
+
+
+def test_relative_positions_and_yaws_are_kept(three_cartons) -> None:
+    depth, masks, pose = render_tops(three_cartons)
+    built = scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES, door=[-1.0, 0.0, 0.0])
+    positions = np.array([item.box.position[:2] for item in built.fitted])
+    truth = np.array([carton[:2] for carton in three_cartons])
+    assert np.abs(positions - truth).max() < 0.015
+    for item, carton in zip(built.fitted, three_cartons, strict=True):
+        difference = (_yaw_deg(item.box.orientation_xyzw) - carton[2]) % 180.0
+        assert min(difference, 180.0 - difference) < 2.0
+
+
+def test_a_mask_inside_a_larger_one_is_a_duplicate_left_out(three_cartons) -> None:
+    depth, masks, pose = render_tops(three_cartons)
+    part = masks[1] & (np.cumsum(masks[1], axis=1) < 30)  # a second detection of part of carton 1
+    built = scene_from_depth(depth, INTRINSICS, pose, [*masks, part], known_sizes=SIZES)
+    assert built.duplicates == {"b03": "b01"}
+    assert built.scene.detected == ("b00", "b01", "b02")
+
+
+def test_without_known_sizes_the_top_and_the_drop_to_the_floor_give_the_size(three_cartons) -> None:
+    depth, masks, pose = render_tops(three_cartons[:1])
+    built = scene_from_depth(depth, INTRINSICS, pose, masks)
+    assert built.fitted[0].box.size == pytest.approx([0.4, 0.3, 0.3], abs=0.01)
+
+
+def test_the_report_names_every_box_with_its_residual(three_cartons) -> None:
+    depth, masks, pose = render_tops(three_cartons)
+    report = scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES).report()
+    assert [row["id"] for row in report["boxes"]] == ["b00", "b01", "b02"]
+    assert all(row["residual_m"] >= 0 for row in report["boxes"])
+
+
+def test_a_pose_that_hides_every_horizontal_plane_is_refused(three_cartons) -> None:
+    depth, masks, _ = render_tops(three_cartons)
+    sideways = np.array(
+        [[1.0, 0, 0, 0], [0, 0, -1.0, 0], [0, 1.0, 0, 2.5], [0, 0, 0, 1.0]]
+    )  # the camera's axis horizontal
+    with pytest.raises(UnstackError, match="no horizontal plane"):
+        scene_from_depth(depth, INTRINSICS, sideways, masks)
+
+
+def test_ids_must_match_the_masks(three_cartons) -> None:
+    depth, masks, pose = render_tops(three_cartons)
+    with pytest.raises(UnstackError, match="expected 3 distinct box ids"):
+        scene_from_depth(depth, INTRINSICS, pose, masks, ids=["a", "a", "b"])

@@ -1,0 +1,82 @@
+"""Reading a camera's files: units checked, poses validated, one-line errors."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from unstack.camera import load_depth, load_intrinsics, load_mask, load_pose
+from unstack.errors import InvalidFile
+
+
+def _png(path: Path, array: np.ndarray) -> Path:
+    Image.fromarray(array).save(path)
+    return path
+
+
+def test_a_16_bit_png_in_millimetres_reads_as_metres(tmp_path: Path) -> None:
+    depth = load_depth(_png(tmp_path / "d.png", np.full((4, 5), 1250, dtype=np.uint16)))
+    assert depth.dtype == np.float64 and depth[0, 0] == pytest.approx(1.25)
+
+
+def test_metres_declared_as_millimetres_are_refused(tmp_path: Path) -> None:
+    with pytest.raises(InvalidFile, match="declared in mm but every reading is at most 20 mm: are the values metres"):
+        load_depth(_png(tmp_path / "d.png", np.full((4, 5), 2, dtype=np.uint16)))
+
+
+def test_millimetres_declared_as_metres_are_refused(tmp_path: Path) -> None:
+    np.save(tmp_path / "d.npy", np.full((4, 5), 1250.0))
+    with pytest.raises(InvalidFile, match="declared in m but the median reading is 1250 m: are the values millimetres"):
+        load_depth(tmp_path / "d.npy")
+
+
+def test_a_depth_image_without_readings_is_refused(tmp_path: Path) -> None:
+    with pytest.raises(InvalidFile, match="holds no reading"):
+        load_depth(_png(tmp_path / "d.png", np.zeros((4, 5), dtype=np.uint16)))
+
+
+@pytest.mark.parametrize(
+    ("pose", "message"),
+    [
+        (np.eye(3).tolist(), "expected a 4 x 4 matrix"),
+        ((2 * np.eye(4)).tolist(), "expected the last row 0 0 0 1"),
+        (np.diag([2.0, 1.0, 1.0, 1.0]).tolist(), "expected a rotation"),
+        ({"a": np.eye(4).tolist(), "b": np.eye(4).tolist()}, "exactly one matrix"),
+    ],
+)
+def test_a_pose_that_is_not_a_rigid_transform_is_refused(tmp_path: Path, pose: object, message: str) -> None:
+    (tmp_path / "pose.json").write_text(json.dumps(pose))
+    with pytest.raises(InvalidFile, match=message):
+        load_pose(tmp_path / "pose.json")
+
+
+def test_a_pose_inside_an_object_is_read(tmp_path: Path) -> None:
+    (tmp_path / "pose.json").write_text(json.dumps({"cam2root": np.eye(4).tolist()}))
+    assert load_pose(tmp_path / "pose.json").shape == (4, 4)
+
+
+def test_intrinsics_need_positive_pixels(tmp_path: Path) -> None:
+    (tmp_path / "k.json").write_text(json.dumps({"fx": -1, "fy": 1, "cx": 1, "cy": 1, "width": 2, "height": 2}))
+    with pytest.raises(InvalidFile, match=r"\$\.fx: expected a positive number of pixels, got -1"):
+        load_intrinsics(tmp_path / "k.json")
+
+
+def test_a_mask_of_another_size_than_the_depth_image_is_refused(tmp_path: Path) -> None:
+    mask = _png(tmp_path / "m.png", np.full((3, 3), 255, dtype=np.uint8))
+    with pytest.raises(InvalidFile, match="expected a mask of 5 x 4 pixels like the depth image, got 3 x 3"):
+        load_mask(mask, (4, 5))
+
+
+def test_a_mask_holding_depth_values_is_a_mask_where_they_are_not_zero(tmp_path: Path) -> None:
+    values = np.zeros((4, 5), dtype=np.uint16)
+    values[1:3, 1:4] = 1684  # the NEURA capture's masks hold the depth inside the box
+    assert load_mask(_png(tmp_path / "m.png", values)).sum() == 6
+
+
+def test_an_empty_mask_is_refused(tmp_path: Path) -> None:
+    with pytest.raises(InvalidFile, match="the mask is empty"):
+        load_mask(_png(tmp_path / "m.png", np.zeros((4, 5), dtype=np.uint8)))

@@ -1,0 +1,360 @@
+"""One box per instance mask: top plane, yaw from the top face, size from the known cartons.
+
+For each mask (points already in the gravity frame, z up, floor at 0):
+
+* the **top face** is the highest horizontal plane among the mask's points (RANSAC with the
+  normal within :data:`~unstack.camera.planes.HORIZONTAL_TOLERANCE_DEG` of z); its height is
+  the box's top;
+* the **yaw** and the top's extents come from the minimum-area rectangle around the top
+  face's points (the convex hull's edges, rotating calipers), the long edge on the long
+  extent;
+* the **size** is matched to the known carton sizes (any edge may stand vertical): the known
+  size whose top edges are closest to the rectangle, ties to the one whose bottom lands nearest
+  a surface (the floor or another box's top); without known sizes, the rectangle and the
+  height down to the surface below;
+* the **residual** is the RMS distance of the top points to the fitted top plane, and the
+  **fill** the share of the rectangle the top points cover;
+* a mask whose pixels are mostly (:data:`DUPLICATE_SHARE`) inside another, larger mask is a
+  **duplicate** detection: reported and left out.
+
+A mask that shows no top face (a box above the camera, seen from the front) is fitted from
+its front face instead: the vertical plane's normal gives the yaw, the face its width and
+height, the known size its depth.
+
+Examples
+--------
+>>> rng = np.random.default_rng(0)
+>>> top = np.column_stack([rng.uniform(-0.2, 0.2, 400), rng.uniform(-0.15, 0.15, 400), np.full(400, 0.3)])
+>>> fitted = fit_box("b00", top, known_sizes=[(0.4, 0.3, 0.3)], surfaces=[0.0], rng=rng)
+>>> [round(float(value), 2) for value in fitted.box.size], round(float(fitted.box.position[2]), 2)
+([0.4, 0.3, 0.3], 0.15)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from unstack.camera.planes import PLANE_THRESHOLD, fit_plane
+from unstack.errors import UnstackError
+from unstack.scene import Box
+
+__all__ = ["DUPLICATE_SHARE", "FittedBox", "boxes_from_masks", "duplicate_masks", "fit_box", "min_area_rectangle"]
+
+#: A mask with at least this share of its pixels inside a larger mask is a duplicate.
+DUPLICATE_SHARE = 0.5
+#: Fewer points than this on a mask's top face (or front face) cannot be fitted.
+MIN_FACE_POINTS = 30
+#: A mask is fitted from its top face when the top plane holds at least this share of its points.
+TOP_SHARE = 0.15
+#: An edge measured longer than a known size's costs this many times one measured shorter.
+OVERSIZE_WEIGHT = 4.0
+#: Known sizes whose top edges differ from the rectangle's by less than this (metres, summed)
+#: are ties, decided by where the bottom lands.
+SIZE_TIE = 0.02
+
+
+@dataclass(frozen=True)
+class FittedBox:
+    """A box fitted to one mask, with how well it fits.
+
+    Attributes
+    ----------
+    box : Box
+    face : {"top", "front"}
+        The face it was fitted from.
+    residual_m : float
+        RMS distance of the face's points to the fitted face plane.
+    fill : float
+        Share of the fitted face rectangle its points cover (0-1; low for a partly hidden face).
+    size_error_m : float
+        Summed difference between the face's measured edges and the matched known size's.
+    points : int
+        Points of the mask.
+    """
+
+    box: Box
+    face: str
+    residual_m: float
+    fill: float
+    size_error_m: float
+    points: int
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "id": self.box.id,
+            "face": self.face,
+            "residual_m": self.residual_m,
+            "fill": self.fill,
+            "size_error_m": self.size_error_m,
+            "points": self.points,
+        }
+
+
+def min_area_rectangle(xy: np.ndarray) -> tuple[np.ndarray, float, np.ndarray]:
+    """The smallest-area rectangle around 2-D points: centre, angle of its long edge, (long, short).
+
+    Examples
+    --------
+    >>> corners = np.array([[0.0, 0.0], [0.4, 0.0], [0.4, 0.2], [0.0, 0.2]])
+    >>> centre, angle, extents = min_area_rectangle(corners)
+    >>> centre.round(2).tolist(), round(angle, 3), extents.round(2).tolist()
+    ([0.2, 0.1], 0.0, [0.4, 0.2])
+    """
+    from scipy.spatial import ConvexHull, QhullError
+
+    xy = np.asarray(xy, dtype=np.float64)
+    try:
+        hull = xy[ConvexHull(xy).vertices]
+    except (QhullError, ValueError):
+        hull = xy
+    edges = np.diff(np.vstack([hull, hull[:1]]), axis=0)
+    angles = np.unique(np.mod(np.arctan2(edges[:, 1], edges[:, 0]), np.pi / 2))
+    best: tuple[float, np.ndarray, float, np.ndarray] | None = None
+    for angle in angles:
+        axes = np.array([[np.cos(angle), np.sin(angle)], [-np.sin(angle), np.cos(angle)]])
+        local = hull @ axes.T
+        low, high = local.min(axis=0), local.max(axis=0)
+        area = float(np.prod(high - low))
+        if best is None or area < best[0]:
+            best = (area, (low + high) / 2 @ axes, float(angle), high - low)
+    assert best is not None
+    _, centre, angle, extents = best
+    if extents[1] > extents[0]:
+        angle += np.pi / 2
+        extents = extents[::-1]
+    angle = float(np.mod(angle + np.pi / 2, np.pi) - np.pi / 2)  # the long edge's direction, in (-90, 90] degrees
+    return np.asarray(centre), angle, np.asarray(extents)
+
+
+def _yaw_quaternion(yaw: float) -> np.ndarray:
+    return np.array([0.0, 0.0, np.sin(yaw / 2), np.cos(yaw / 2)])
+
+
+def _match_size(
+    top_edges: np.ndarray,
+    top: float,
+    known_sizes: Sequence[Sequence[float]],
+    surfaces: Sequence[float],
+) -> tuple[np.ndarray, float, bool]:
+    """The known size nearest the measured top edges; ties by where the bottom lands.
+
+    A face seen in part is smaller than the box, never larger: an edge measured longer than a
+    size's costs :data:`OVERSIZE_WEIGHT` times as much as one measured shorter, and a size lower
+    than the height the front face shows is passed over. Returns the size as (along the measured
+    long edge, across it, height), the error, and whether the size's long edge lies across the
+    measured long edge (a face seen in part can show a box's short edge as its longer extent).
+    """
+    options: list[tuple[float, float, np.ndarray, bool]] = []
+    for size in known_sizes:
+        edges = np.asarray(size, dtype=np.float64)
+        for vertical in range(3):
+            height = edges[vertical]
+            across = np.sort(np.delete(edges, vertical))[::-1]
+            landing = min(abs(top - height - surface) for surface in surfaces) if surfaces else 0.0
+            if top - height < -PLANE_THRESHOLD * 3:
+                landing += 10.0  # the bottom would lie under the floor
+            for turned in (False, True):
+                placed = across[::-1] if turned else across
+                difference = top_edges - placed
+                error = float(np.sum(np.where(difference > 0, OVERSIZE_WEIGHT * difference, -difference)))
+                options.append((error, landing, np.array([*placed, height]), turned))
+    best_error = min(option[0] for option in options)
+    tied = [option for option in options if option[0] <= best_error + SIZE_TIE]
+    chosen = min(tied, key=lambda option: option[1])
+    return np.asarray(chosen[2], dtype=np.float64), float(chosen[0]), chosen[3]
+
+
+def _front_face(points: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, float, np.ndarray] | None:
+    """The vertical face turned towards the door (-x) among ``points``: normal, offset, inliers."""
+    if len(points) < MIN_FACE_POINTS:
+        return None
+    normal, offset, inliers = fit_plane(points, rng=rng, near_normal=np.array([-1.0, 0.0, 0.0]), tolerance_deg=75.0)
+    if inliers.sum() < max(MIN_FACE_POINTS, TOP_SHARE * len(points)) or abs(normal[2]) > np.sin(np.radians(25.0)):
+        return None
+    return normal, offset, inliers
+
+
+def fit_box(
+    box_id: str,
+    points: np.ndarray,
+    *,
+    known_sizes: Sequence[Sequence[float]] | None,
+    surfaces: Sequence[float],
+    rng: np.random.Generator,
+) -> FittedBox:
+    """Fit one box to a mask's points (gravity frame); see the module docstring."""
+    points = np.asarray(points, dtype=np.float64)
+    if len(points) < MIN_FACE_POINTS:
+        raise UnstackError(
+            f"{box_id}: the mask holds {len(points)} points with depth; at least {MIN_FACE_POINTS} needed"
+        )
+    up = np.array([0.0, 0.0, 1.0])
+    normal, offset, inliers = fit_plane(points, rng=rng, near_normal=up)
+    if inliers.sum() >= max(MIN_FACE_POINTS, TOP_SHARE * len(points)):
+        return _fit_from_top(box_id, points, normal, offset, inliers, known_sizes, surfaces, rng)
+    return _fit_from_front(box_id, points, known_sizes, surfaces, rng)
+
+
+def _fit_from_top(
+    box_id: str,
+    points: np.ndarray,
+    normal: np.ndarray,
+    offset: float,
+    inliers: np.ndarray,
+    known_sizes: Sequence[Sequence[float]] | None,
+    surfaces: Sequence[float],
+    rng: np.random.Generator,
+) -> FittedBox:
+    face = points[inliers]
+    top = float(np.median(face[:, 2]))
+    residual = float(np.sqrt(np.mean((face @ normal - offset) ** 2)))
+    centre, yaw, extents = min_area_rectangle(face[:, :2])
+    extents = extents + _spacing(face[:, :2])  # pixel samples stop half a spacing short of each edge
+    front = _front_face(points[~inliers], rng)
+    seen_height = 0.0
+    if front is not None:
+        front_heights = points[~inliers][front[2], 2]
+        if np.percentile(front_heights, 95) < top - 0.03:
+            front = None  # points below the top that do not reach it: another surface seen past the edge
+        else:
+            seen_height = top - float(np.percentile(front_heights, 5))
+    below = [surface for surface in surfaces if surface < top - 0.02]
+    turned = False
+    if known_sizes:
+        # the front face's height is not a bound: below a box's side the sides of the boxes under it
+        # continue in the same plane; where the bottom lands decides among near sizes instead
+        size, size_error, turned = _match_size(extents, top, known_sizes, below or [0.0])
+    else:
+        support = max(below, default=0.0)
+        size, size_error = np.array([*extents, max(top - support, seen_height, 0.02)]), 0.0
+    fill = _fill(face[:, :2], centre, yaw, extents)
+    axes = np.array([[np.cos(yaw), np.sin(yaw)], [-np.sin(yaw), np.cos(yaw)]])  # rows: the measured long, short
+    if front is not None:  # the box's near face lies on the front face; the rest of it is hidden beyond
+        toward = front[0][:2] / np.linalg.norm(front[0][:2])  # out of the box, towards the door
+        along = int(np.argmax(np.abs(axes @ toward)))
+        direction = axes[along] * np.sign(axes[along] @ toward)
+        near_now = float(np.max((face[:, :2] - centre) @ direction))
+        centre = centre + direction * (near_now - size[along] / 2)
+    if turned:
+        yaw += np.pi / 2
+        size = np.array([size[1], size[0], size[2]])
+    box = Box(box_id, size, [centre[0], centre[1], top - size[2] / 2], _yaw_quaternion(yaw))
+    return FittedBox(box, "top", residual, fill, size_error, len(points))
+
+
+def _spacing(xy: np.ndarray) -> float:
+    """The median distance between neighbouring points (the pixels' footprint on the face)."""
+    from scipy.spatial import cKDTree
+
+    if len(xy) < 2:
+        return 0.0
+    distances, _ = cKDTree(xy).query(xy, k=2)
+    return float(np.median(distances[:, 1]))
+
+
+def _fill(xy: np.ndarray, centre: np.ndarray, yaw: float, extents: np.ndarray) -> float:
+    """Share of the rectangle's cells holding a point (cells of 2 cm, or twice the points' spacing)."""
+    cell = max(0.02, 2.0 * _spacing(xy))
+    axes = np.array([[np.cos(yaw), np.sin(yaw)], [-np.sin(yaw), np.cos(yaw)]])
+    local = (xy - centre) @ axes.T + extents / 2
+    bins = np.maximum(1, np.ceil(extents / cell)).astype(int)
+    index = np.clip((local / extents * bins).astype(int), 0, bins - 1)
+    occupied = len(np.unique(index[:, 0] * bins[1] + index[:, 1]))
+    return float(occupied / (bins[0] * bins[1]))
+
+
+def _fit_from_front(
+    box_id: str,
+    points: np.ndarray,
+    known_sizes: Sequence[Sequence[float]] | None,
+    surfaces: Sequence[float],
+    rng: np.random.Generator,
+) -> FittedBox:
+    """A box seen from the front only: its vertical face gives yaw, width and height."""
+    normal, offset, inliers = fit_plane(points, rng=rng, near_normal=np.array([-1.0, 0.0, 0.0]), tolerance_deg=75.0)
+    if inliers.sum() < MIN_FACE_POINTS or abs(normal[2]) > np.sin(np.radians(25.0)):
+        raise UnstackError(f"{box_id}: neither a top face nor a front face could be fitted to the mask's points")
+    face = points[inliers]
+    horizontal = np.array([normal[0], normal[1], 0.0])
+    horizontal /= np.linalg.norm(horizontal)
+    centre_face = face.mean(axis=0)
+    if horizontal @ centre_face > 0:  # the normal points away from the box's inside... towards the camera side
+        horizontal = -horizontal
+    across = np.array([-horizontal[1], horizontal[0], 0.0])
+    width = float(np.ptp(face @ across))
+    low, high = float(face[:, 2].min()), float(face[:, 2].max())
+    residual = float(np.sqrt(np.mean((face @ normal - offset) ** 2)))
+    if known_sizes:
+        best = min(
+            ((abs(np.sort([a, b])[::-1] - np.sort([width, high - low])[::-1]).sum(), a, b, c)
+             for size in known_sizes for a, b, c in _faces(size)),
+            key=lambda option: option[0],
+        )  # fmt: skip
+        size_error, face_width, face_height, depth = best
+    else:
+        size_error, face_width, face_height, depth = 0.0, width, high - low, width
+    face_centre = centre_face - (centre_face @ across - (face @ across).min() - width / 2) * across
+    centre = face_centre - horizontal * depth / 2
+    yaw = float(np.arctan2(horizontal[1], horizontal[0]))
+    size = np.array([depth, face_width, face_height])
+    box = Box(box_id, size, [centre[0], centre[1], low + face_height / 2], _yaw_quaternion(yaw))
+    return FittedBox(box, "front", residual, 1.0, float(size_error), len(points))
+
+
+def _faces(size: Sequence[float]) -> list[tuple[float, float, float]]:
+    """(face width, face height, depth) for each way a carton can show its front."""
+    a, b, c = (float(value) for value in size)
+    return [(a, b, c), (b, a, c), (a, c, b), (c, a, b), (b, c, a), (c, b, a)]
+
+
+def duplicate_masks(masks: Sequence[np.ndarray]) -> dict[int, int]:
+    """Masks mostly inside a larger one: ``{duplicate index: the larger mask's index}``.
+
+    Examples
+    --------
+    >>> big = np.zeros((4, 4), bool); big[:3, :3] = True
+    >>> small = np.zeros((4, 4), bool); small[1:3, 1:3] = True
+    >>> other = np.zeros((4, 4), bool); other[3, 3] = True
+    >>> duplicate_masks([big, small, other])
+    {1: 0}
+    """
+    areas = [int(mask.sum()) for mask in masks]
+    duplicates = {}
+    for k, mask in enumerate(masks):
+        for j, other in enumerate(masks):
+            if j == k or areas[j] < areas[k] or (areas[j] == areas[k] and j > k) or j in duplicates:
+                continue
+            if (mask & other).sum() >= DUPLICATE_SHARE * areas[k]:
+                duplicates[k] = j
+                break
+    return duplicates
+
+
+def boxes_from_masks(
+    mask_points: Sequence[np.ndarray],
+    ids: Sequence[str],
+    *,
+    known_sizes: Sequence[Sequence[float]] | None = None,
+    seed: int = 0,
+) -> tuple[list[FittedBox], dict[str, str]]:
+    """Fit a box to each mask's points (gravity frame); bottoms land on the floor or other tops.
+
+    Returns the fitted boxes and, for each mask that could not be fitted, why.
+    """
+    rng = np.random.default_rng(seed)
+    if len(mask_points) != len(ids):
+        raise UnstackError(f"{len(mask_points)} masks but {len(ids)} ids")
+    tops = [float(np.percentile(points[:, 2], 95)) if len(points) else 0.0 for points in mask_points]
+    fitted: list[FittedBox] = []
+    unfitted: dict[str, str] = {}
+    for k, (box_id, points) in enumerate(zip(ids, mask_points, strict=True)):
+        surfaces = [0.0, *(top for j, top in enumerate(tops) if j != k)]
+        try:
+            fitted.append(fit_box(box_id, points, known_sizes=known_sizes, surfaces=surfaces, rng=rng))
+        except UnstackError as error:
+            unfitted[box_id] = str(error)
+    return fitted, unfitted

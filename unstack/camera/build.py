@@ -1,0 +1,150 @@
+"""A scene from a depth image, intrinsics, a camera pose and one mask per box.
+
+Examples
+--------
+>>> from unstack.camera.files import Intrinsics
+>>> camera = Intrinsics(fx=100.0, fy=100.0, cx=80.0, cy=60.0, width=160, height=120)
+>>> depth = np.full((120, 160), 1.0); depth[39:82, 51:108] = 0.7      # a carton 0.3 m tall, seen from above
+>>> looking_down = np.array([[1.0, 0, 0, 0], [0, -1.0, 0, 0], [0, 0, -1.0, 1.0], [0, 0, 0, 1.0]])
+>>> mask = np.zeros((120, 160), bool); mask[39:82, 51:108] = True
+>>> built = scene_from_depth(depth, camera, looking_down, [mask], known_sizes=[(0.4, 0.3, 0.3)])
+>>> built.scene.detected, [round(float(v), 2) for v in built.scene.box("b00").size]
+(('b00',), [0.4, 0.3, 0.3])
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from unstack.camera.boxes import FittedBox, boxes_from_masks, duplicate_masks
+from unstack.camera.files import Intrinsics
+from unstack.camera.planes import GravityFrame, depth_points, gravity_frame
+from unstack.errors import UnstackError
+from unstack.scene import Box, Scene
+
+__all__ = ["CameraScene", "scene_from_depth"]
+
+#: Points per mask kept for fitting (a random subset of larger masks).
+MAX_MASK_POINTS = 20_000
+#: Cloud points kept in the scene (a random subset of larger clouds).
+MAX_SCENE_POINTS = 200_000
+
+
+@dataclass(frozen=True)
+class CameraScene:
+    """The scene built from camera files, and how it was built."""
+
+    scene: Scene
+    frame: GravityFrame
+    fitted: tuple[FittedBox, ...]
+    duplicates: dict[str, str] = field(default_factory=dict)
+    unfitted: dict[str, str] = field(default_factory=dict)
+
+    def report(self) -> dict[str, Any]:
+        """JSON-ready: gravity (tilt, planes, floor), every fitted box with its residual, duplicates."""
+        return {
+            "tilt_deg": self.frame.tilt_deg,
+            "horizontal_planes": self.frame.planes,
+            "floor_points": self.frame.floor_inliers,
+            "boxes": [item.to_dict() for item in self.fitted],
+            "duplicates": dict(self.duplicates),
+            "unfitted": dict(self.unfitted),
+        }
+
+
+def _without_overlaps(fitted: list[FittedBox], unfitted: dict[str, str]) -> list[FittedBox]:
+    """The fitted boxes, best fits first, leaving out each that overlaps an accepted one by more
+    than a scene allows (:data:`~unstack.plausibility.REFUSED_OVERLAP`; its reason goes to ``unfitted``)."""
+    from unstack.plausibility import REFUSED_OVERLAP, overlapping_pairs
+
+    accepted: list[FittedBox] = []
+    for item in sorted(fitted, key=lambda item: (-item.fill, item.size_error_m, item.box.id)):
+        clashes = [
+            accepted[i].box.id
+            for i, j, _ in overlapping_pairs([*(other.box for other in accepted), item.box], REFUSED_OVERLAP)
+            if j == len(accepted)
+        ]
+        if clashes:
+            unfitted[item.box.id] = f"{item.box.id}: the fitted box overlaps {clashes[0]} by more than half"
+        else:
+            accepted.append(item)
+    order = {item.box.id: k for k, item in enumerate(fitted)}
+    return sorted(accepted, key=lambda item: order[item.box.id])
+
+
+def scene_from_depth(
+    depth_m: np.ndarray,
+    intrinsics: Intrinsics,
+    camera_to_world: np.ndarray,
+    masks: Sequence[np.ndarray],
+    *,
+    ids: Sequence[str] | None = None,
+    known_sizes: Sequence[Sequence[float]] | None = None,
+    door: Sequence[float] | None = None,
+    seed: int = 0,
+) -> CameraScene:
+    """Build an ``unstack.scene/1`` scene: gravity frame, one fitted box per mask, the cloud.
+
+    Parameters
+    ----------
+    depth_m : numpy.ndarray, shape (height, width)
+        Depth along the optical axis in metres, 0 where there is no reading.
+    intrinsics : Intrinsics
+    camera_to_world : numpy.ndarray, shape (4, 4)
+        The camera's pose in a world frame whose z is roughly up.
+    masks : sequence of numpy.ndarray of bool
+        One per detected box.
+    ids : sequence of str, optional
+        Box ids (default ``b00``, ``b01``, ...).
+    known_sizes : sequence of (3,) sizes, optional
+        The carton sizes that can occur (metres).
+    door : (3,) direction, optional
+        Out of the container through the door, in the input frame; default: towards the camera
+        (the pose frame's -x when the camera looks down from above the pile).
+    seed : int
+        Seeds RANSAC and the subsets.
+    """
+    rng = np.random.default_rng(seed)
+    names = [f"b{k:02d}" for k in range(len(masks))] if ids is None else list(ids)
+    if len(names) != len(masks) or len(set(names)) != len(names):
+        raise UnstackError(f"expected {len(masks)} distinct box ids, got {names}")
+    if not masks:
+        raise UnstackError("at least one box mask is needed")
+    pose = np.asarray(camera_to_world, dtype=np.float64)
+    cloud = depth_points(depth_m, intrinsics, pose)
+    if len(cloud) < 100:
+        raise UnstackError(f"the depth image holds {len(cloud)} readings; at least 100 are needed")
+    if len(cloud) > MAX_SCENE_POINTS:
+        cloud = cloud[np.sort(rng.choice(len(cloud), MAX_SCENE_POINTS, replace=False))]
+    if door is None:  # towards the camera; a camera above the pile says nothing: the pose frame's -x
+        toward_camera = pose[:3, 3] - np.median(cloud, axis=0)
+        horizontal = np.linalg.norm(toward_camera[:2])
+        door = list(toward_camera if horizontal > 0.3 * np.linalg.norm(toward_camera) else [-1.0, 0.0, 0.0])
+    frame = gravity_frame(cloud, door=np.asarray(door, dtype=np.float64), seed=seed)
+    duplicates = duplicate_masks(masks)
+    kept = [k for k in range(len(masks)) if k not in duplicates]
+    mask_points = []
+    for k in kept:
+        points = frame.apply(depth_points(depth_m, intrinsics, pose, masks[k]))
+        if len(points) > MAX_MASK_POINTS:
+            points = points[rng.choice(len(points), MAX_MASK_POINTS, replace=False)]
+        mask_points.append(points)
+    fitted, unfitted = boxes_from_masks(mask_points, [names[k] for k in kept], known_sizes=known_sizes, seed=seed)
+    if not fitted:
+        raise UnstackError(f"no box could be fitted: {'; '.join(unfitted.values())}")
+    fitted = _without_overlaps(fitted, unfitted)
+    boxes: list[Box] = [item.box for item in fitted]
+    metadata = {
+        "camera": {
+            "tilt_deg": frame.tilt_deg,
+            "gravity_rotation": frame.rotation.tolist(),
+            "gravity_translation": frame.translation.tolist(),
+            "duplicates": {names[k]: names[j] for k, j in duplicates.items()},
+        }
+    }
+    scene = Scene(boxes, frame.apply(cloud), [box.id for box in boxes], metadata=metadata, source="<camera>")
+    return CameraScene(scene, frame, tuple(fitted), {names[k]: names[j] for k, j in duplicates.items()}, unfitted)

@@ -1,0 +1,189 @@
+"""A camera's files: depth image, pinhole intrinsics, camera pose, instance masks.
+
+Every reader returns canonical arrays (float64 metres for depth, a 4 x 4 float64 pose, bool
+masks) or raises :class:`~unstack.errors.InvalidFile` naming the file, the JSON path and
+what was expected. Depth units are checked, not assumed: a 16-bit PNG declared in
+millimetres whose readings are all below :data:`MAX_DEPTH_M` is refused as "metres", and a
+float image declared in metres whose median is above it is refused as "millimetres".
+
+Examples
+--------
+>>> import json, tempfile, pathlib
+>>> folder = pathlib.Path(tempfile.mkdtemp())
+>>> _ = (folder / "k.json").write_text(json.dumps({"fx": 600, "fy": 600, "cx": 320, "cy": 240,
+...                                                  "width": 640, "height": 480}))
+>>> load_intrinsics(folder / "k.json").cx
+320.0
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from unstack.errors import InvalidFile
+
+__all__ = ["DEPTH_UNITS", "MAX_DEPTH_M", "Intrinsics", "load_depth", "load_intrinsics", "load_mask", "load_pose"]
+
+#: Units a depth image can be declared in, and metres per unit.
+DEPTH_UNITS = {"mm": 0.001, "m": 1.0}
+#: No depth camera in a container or a cell reads further than this (metres).
+MAX_DEPTH_M = 20.0
+
+
+@dataclass(frozen=True)
+class Intrinsics:
+    """A pinhole camera: focal lengths and principal point in pixels, image size.
+
+    A pixel (row ``v``, column ``u``) with depth ``z`` along the optical axis is the camera-frame
+    point ``((u - cx) z / fx, (v - cy) z / fy, z)`` (x right, y down, z forward: OpenCV's).
+    """
+
+    fx: float
+    fy: float
+    cx: float
+    cy: float
+    width: int
+    height: int
+
+
+def _read_json(path: str | os.PathLike[str]) -> tuple[Any, str]:
+    file = Path(path)
+    source = str(file)
+    try:
+        return json.loads(file.read_text(encoding="utf-8")), source
+    except FileNotFoundError:
+        raise InvalidFile(source, "$", "the file does not exist") from None
+    except (OSError, UnicodeDecodeError, ValueError) as error:
+        raise InvalidFile(source, "$", f"expected a JSON file: {error}") from None
+
+
+def load_intrinsics(path: str | os.PathLike[str]) -> Intrinsics:
+    """Read ``{"fx", "fy", "cx", "cy", "width", "height"}`` (pixels) from a JSON file."""
+    data, source = _read_json(path)
+    if not isinstance(data, dict):
+        raise InvalidFile(source, "$", "expected an object with fx, fy, cx, cy, width and height")
+    values = {}
+    for name in ("fx", "fy", "cx", "cy", "width", "height"):
+        value = data.get(name)
+        if isinstance(value, bool) or not isinstance(value, int | float) or not np.isfinite(value) or value <= 0:
+            raise InvalidFile(source, f"$.{name}", f"expected a positive number of pixels, got {value!r}")
+        values[name] = float(value)
+    if values["width"] != int(values["width"]) or values["height"] != int(values["height"]):
+        raise InvalidFile(source, "$.width", "expected whole numbers of pixels for width and height")
+    return Intrinsics(
+        values["fx"], values["fy"], values["cx"], values["cy"], int(values["width"]), int(values["height"])
+    )
+
+
+def load_pose(path: str | os.PathLike[str]) -> np.ndarray:
+    """Read a 4 x 4 camera-to-world transform: a JSON matrix, or an object holding one matrix.
+
+    The rotation part must be a rotation (orthonormal, determinant 1, within 1e-3) and the
+    last row ``0 0 0 1``.
+    """
+    data, source = _read_json(path)
+    json_path = "$"
+    if isinstance(data, dict):
+        matrices = [key for key, value in data.items() if isinstance(value, list)]
+        if len(matrices) != 1:
+            raise InvalidFile(source, "$", "expected a 4 x 4 matrix, or an object with exactly one matrix")
+        json_path = f"$.{matrices[0]}"
+        data = data[matrices[0]]
+    try:
+        pose = np.array(data, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InvalidFile(source, json_path, "expected a 4 x 4 matrix of numbers") from None
+    if pose.shape != (4, 4) or not np.all(np.isfinite(pose)):
+        raise InvalidFile(source, json_path, f"expected a 4 x 4 matrix of finite numbers, got shape {pose.shape}")
+    rotation = pose[:3, :3]
+    if not np.allclose(pose[3], [0.0, 0.0, 0.0, 1.0]):
+        raise InvalidFile(source, f"{json_path}[3]", "expected the last row 0 0 0 1")
+    if not np.allclose(rotation.T @ rotation, np.eye(3), atol=1e-3) or not np.isclose(
+        np.linalg.det(rotation), 1.0, atol=1e-3
+    ):
+        raise InvalidFile(source, json_path, "expected a rotation in the upper 3 x 3 block (orthonormal, det 1)")
+    return pose
+
+
+def _read_image(file: Path) -> np.ndarray:
+    from PIL import Image
+
+    with Image.open(file) as image:
+        return np.array(image)
+
+
+def load_depth(path: str | os.PathLike[str], *, units: str | None = None) -> np.ndarray:
+    """Read a depth image as float64 metres along the optical axis; 0 where there is no reading.
+
+    Parameters
+    ----------
+    path : path-like
+        A 16-bit PNG (default units ``mm``) or a ``.npy`` array of floats (default units ``m``).
+    units : {"mm", "m"}, optional
+        What the values are; checked against the readings.
+    """
+    file = Path(path)
+    source = str(file)
+    if not file.is_file():
+        raise InvalidFile(source, "$", "the depth image does not exist")
+    suffix = file.suffix.lower()
+    try:
+        if suffix == ".npy":
+            raw = np.load(file, allow_pickle=False)
+        elif suffix == ".png":
+            raw = _read_image(file)
+        else:
+            raise InvalidFile(source, "$", f"expected a depth image .png (16-bit) or .npy, got {file.name!r}")
+    except InvalidFile:
+        raise
+    except Exception as error:  # noqa: BLE001 - any reader failure is the file's fault
+        raise InvalidFile(source, "$", f"cannot read the depth image: {error}") from None
+    if raw.ndim != 2 or not (np.issubdtype(raw.dtype, np.integer) or np.issubdtype(raw.dtype, np.floating)):
+        raise InvalidFile(source, "$", f"expected a single-channel depth image, got shape {raw.shape} of {raw.dtype}")
+    declared = units or ("m" if np.issubdtype(raw.dtype, np.floating) else "mm")
+    if declared not in DEPTH_UNITS:
+        raise InvalidFile(source, "$", f"unknown depth units {declared!r}; expected one of {', '.join(DEPTH_UNITS)}")
+    values = raw.astype(np.float64)
+    valid = np.isfinite(values) & (values > 0)
+    if not valid.any():
+        raise InvalidFile(source, "$", "the depth image holds no reading (every pixel is 0 or not a number)")
+    metres = np.where(valid, values, 0.0) * DEPTH_UNITS[declared]
+    median = float(np.median(metres[valid]))
+    if median > MAX_DEPTH_M:
+        raise InvalidFile(
+            source, "$", f"declared in {declared} but the median reading is {median:g} m: are the values millimetres?"
+        )
+    if declared == "mm" and float(values[valid].max()) <= MAX_DEPTH_M:
+        raise InvalidFile(
+            source, "$", f"declared in mm but every reading is at most {MAX_DEPTH_M:g} mm: are the values metres?"
+        )
+    return metres
+
+
+def load_mask(path: str | os.PathLike[str], shape: tuple[int, int] | None = None) -> np.ndarray:
+    """Read an instance mask (a PNG, or a ``.npy`` array): True where the box is, of ``shape`` if given."""
+    file = Path(path)
+    source = str(file)
+    if not file.is_file():
+        raise InvalidFile(source, "$", "the mask does not exist")
+    try:
+        raw = np.load(file, allow_pickle=False) if file.suffix.lower() == ".npy" else _read_image(file)
+    except Exception as error:  # noqa: BLE001 - any reader failure is the file's fault
+        raise InvalidFile(source, "$", f"cannot read the mask: {error}") from None
+    if raw.ndim == 3:
+        raw = raw[..., :3].max(axis=-1)  # a colour mask: any non-black pixel
+    if raw.ndim != 2:
+        raise InvalidFile(source, "$", f"expected a single-channel mask image, got shape {raw.shape}")
+    if shape is not None and raw.shape != shape:
+        raise InvalidFile(source, "$", f"expected a mask of {shape[1]} x {shape[0]} pixels like the depth image, "
+                          f"got {raw.shape[1]} x {raw.shape[0]}")  # fmt: skip
+    mask = np.asarray(raw) > 0
+    if not mask.any():
+        raise InvalidFile(source, "$", "the mask is empty")
+    return mask

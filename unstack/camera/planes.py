@@ -1,0 +1,241 @@
+"""Points from depth pixels, robust planes, and the world's gravity frame from them.
+
+A camera's world frame (the robot's root, a calibration target) need not have its z along
+gravity: in the NEURA palletizer capture the box tops and the pallet deck are tilted about 9
+degrees in the root frame. Box tops and floors are horizontal, so the dominant planes of a
+pile's cloud whose normals lie within :data:`HORIZONTAL_TOLERANCE_DEG` of the frame's z tell
+where up is: their normals, averaged with their inlier counts as weights, are the gravity
+frame's z. The floor is the lowest such plane, put at z = 0.
+
+Examples
+--------
+>>> rng = np.random.default_rng(0)
+>>> floor = np.column_stack([rng.uniform(-1, 1, 500), rng.uniform(-1, 1, 500), 0.002 * rng.normal(size=500)])
+>>> normal, offset, inliers = fit_plane(floor, rng=np.random.default_rng(1))
+>>> bool(abs(normal[2]) > 0.999), int(inliers.sum()) > 480
+(True, True)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from unstack.camera.files import Intrinsics
+from unstack.errors import UnstackError
+
+__all__ = ["GravityFrame", "depth_points", "fit_plane", "gravity_frame"]
+
+#: Distance (metres) within which a point belongs to a plane.
+PLANE_THRESHOLD = 0.01
+#: Random three-point samples of a RANSAC fit.
+RANSAC_ITERATIONS = 300
+#: A plane whose normal is within this of the frame's z is a horizontal plane candidate.
+HORIZONTAL_TOLERANCE_DEG = 25.0
+#: Horizontal planes within this of the largest one's direction give gravity together (degrees).
+PARALLEL_DEG = 2.0
+#: Planes found in turn (each plane's inliers removed before the next).
+MAX_PLANES = 8
+#: A plane holding fewer than this share of the points ends the search.
+MIN_PLANE_SHARE = 0.02
+#: A proposal takes its second and third points among an anchor's this many nearest neighbours.
+NEIGHBOURS = 24
+#: Points used for the plane search (a random subset of larger clouds; the fit is refined on all).
+PLANE_SAMPLE = 60_000
+
+
+def depth_points(
+    depth_m: np.ndarray, intrinsics: Intrinsics, camera_to_world: np.ndarray, mask: np.ndarray | None = None
+) -> np.ndarray:
+    """World points (N, 3) of the pixels with a reading (and in ``mask``), row by row.
+
+    Examples
+    --------
+    >>> camera = Intrinsics(fx=100.0, fy=100.0, cx=1.0, cy=1.0, width=3, height=3)
+    >>> depth_points(np.full((3, 3), 2.0), camera, np.eye(4))[0].tolist()   # the top-left pixel
+    [-0.02, -0.02, 2.0]
+    """
+    depth = np.asarray(depth_m, dtype=np.float64)
+    if depth.shape != (intrinsics.height, intrinsics.width):
+        raise UnstackError(
+            f"the depth image is {depth.shape[1]} x {depth.shape[0]} pixels, the intrinsics say "
+            f"{intrinsics.width} x {intrinsics.height}"
+        )
+    selected = depth > 0
+    if mask is not None:
+        selected &= mask
+    rows, columns = np.nonzero(selected)
+    z = depth[rows, columns]
+    camera = np.column_stack(
+        [(columns - intrinsics.cx) * z / intrinsics.fx, (rows - intrinsics.cy) * z / intrinsics.fy, z]
+    )
+    pose = np.asarray(camera_to_world, dtype=np.float64)
+    points: np.ndarray = camera @ pose[:3, :3].T + pose[:3, 3]
+    return points
+
+
+def fit_plane(
+    points: np.ndarray,
+    *,
+    threshold: float = PLANE_THRESHOLD,
+    iterations: int = RANSAC_ITERATIONS,
+    rng: np.random.Generator,
+    near_normal: np.ndarray | None = None,
+    tolerance_deg: float = HORIZONTAL_TOLERANCE_DEG,
+) -> tuple[np.ndarray, float, np.ndarray]:
+    """The plane ``normal . p = offset`` holding the most points within ``threshold`` (RANSAC).
+
+    Three nearby points (an anchor and two of its nearest neighbours) propose a plane; the one
+    with most inliers is refined by a least-squares fit (the smallest principal axis of its
+    inliers). With ``near_normal``, only planes whose normal is within ``tolerance_deg`` of it
+    are proposed (the normal is returned pointing its way).
+
+    Returns
+    -------
+    normal : numpy.ndarray, shape (3,)
+    offset : float
+    inliers : numpy.ndarray of bool, shape (N,)
+    """
+    points = np.asarray(points, dtype=np.float64)
+    if len(points) < 3:
+        raise UnstackError(f"a plane needs at least 3 points, got {len(points)}")
+    from scipy.spatial import cKDTree
+
+    check = points if len(points) <= PLANE_SAMPLE else points[rng.choice(len(points), PLANE_SAMPLE, replace=False)]
+    # three points of one surface: an anchor and two of its nearest neighbours (random triples
+    # across a cloud of mostly vertical faces almost never propose a floor)
+    neighbours = min(NEIGHBOURS, len(check))
+    anchors_index = rng.integers(0, len(check), size=iterations)
+    _, near = cKDTree(check).query(check[anchors_index], k=neighbours)
+    near = np.asarray(near).reshape(iterations, -1)
+    picks = near[np.arange(iterations)[:, None], rng.integers(1, max(2, near.shape[1]), size=(iterations, 2))]
+    samples = np.stack([check[anchors_index], check[picks[:, 0]], check[picks[:, 1]]], axis=1)
+    normals = np.cross(samples[:, 1] - samples[:, 0], samples[:, 2] - samples[:, 0])
+    lengths = np.linalg.norm(normals, axis=1)
+    usable = lengths > 1e-12
+    normals = normals[usable] / lengths[usable, None]
+    anchors = samples[usable, 0]
+    if near_normal is not None:
+        reference = np.asarray(near_normal, dtype=np.float64) / np.linalg.norm(near_normal)
+        normals *= np.sign(normals @ reference)[:, None]
+        keep = normals @ reference >= np.cos(np.radians(tolerance_deg))
+        normals, anchors = normals[keep], anchors[keep]
+    if len(normals) == 0:
+        return np.array([0.0, 0.0, 1.0]), 0.0, np.zeros(len(points), dtype=bool)
+    offsets = np.einsum("ij,ij->i", normals, anchors)
+    counts = [
+        (np.abs(check @ normal - offset) < threshold).sum() for normal, offset in zip(normals, offsets, strict=True)
+    ]
+    best = int(np.argmax(counts))
+    inliers = np.abs(points @ normals[best] - offsets[best]) < threshold
+    normal, offset = normals[best], float(offsets[best])
+    if inliers.sum() >= 3:
+        centre = points[inliers].mean(axis=0)
+        refined = np.linalg.svd(points[inliers] - centre, full_matrices=False)[2][-1]
+        refined *= np.sign(refined @ normal) or 1.0
+        normal, offset = refined, float(refined @ centre)
+        inliers = np.abs(points @ normal - offset) < threshold
+    return normal, offset, inliers
+
+
+@dataclass(frozen=True)
+class GravityFrame:
+    """A rigid transform from the camera's world frame to one with z up and the floor at z = 0.
+
+    Attributes
+    ----------
+    rotation : numpy.ndarray, shape (3, 3)
+        Applied as ``p' = rotation @ p + translation``.
+    translation : numpy.ndarray, shape (3,)
+    tilt_deg : float
+        Angle between the input frame's z and gravity.
+    planes : int
+        Horizontal planes that gave the direction.
+    floor_inliers : int
+        Points on the floor plane (0 when the floor was taken as the lowest points).
+    """
+
+    rotation: np.ndarray
+    translation: np.ndarray
+    tilt_deg: float
+    planes: int
+    floor_inliers: int
+
+    def apply(self, points: np.ndarray) -> np.ndarray:
+        """The points in the gravity frame."""
+        moved: np.ndarray = np.asarray(points, dtype=np.float64) @ self.rotation.T + self.translation
+        return moved
+
+
+def _rotation_onto_z(up: np.ndarray, heading: np.ndarray) -> np.ndarray:
+    """The rotation taking ``up`` to +z and the horizontal part of ``heading`` to -x."""
+    z = up / np.linalg.norm(up)
+    toward = heading - (heading @ z) * z
+    if np.linalg.norm(toward) < 1e-9:
+        toward = np.array([1.0, 0.0, 0.0]) - z[0] * z
+    x = -toward / np.linalg.norm(toward)
+    y = np.cross(z, x)
+    return np.vstack([x, y, z])
+
+
+def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: int = 0) -> GravityFrame:
+    """Gravity and floor from a cloud's horizontal planes; the door towards -x.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (N, 3)
+        The cloud in the camera's world frame, whose z is roughly up (within
+        :data:`HORIZONTAL_TOLERANCE_DEG`).
+    door : numpy.ndarray, shape (3,), optional
+        A direction in the input frame pointing out of the container through the door
+        (towards where the robot stands); it becomes -x. Default: the input frame's -x.
+    seed : int
+        Seeds RANSAC.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> tilt = np.radians(9.0)
+    >>> flat = np.column_stack([rng.uniform(-1, 1, 2000), rng.uniform(-1, 1, 2000), np.zeros(2000)])
+    >>> turn = np.array([[1, 0, 0], [0, np.cos(tilt), -np.sin(tilt)], [0, np.sin(tilt), np.cos(tilt)]])
+    >>> frame = gravity_frame(flat @ turn.T + [0, 0, 0.7])
+    >>> round(frame.tilt_deg, 1), round(float(np.abs(frame.apply(flat @ turn.T + [0, 0, 0.7])[:, 2]).max()), 3)
+    (9.0, 0.0)
+    """
+    points = np.asarray(points, dtype=np.float64)
+    rng = np.random.default_rng(seed)
+    up_guess = np.array([0.0, 0.0, 1.0])
+    remaining = points
+    found: list[tuple[np.ndarray, float, int]] = []
+    for _ in range(MAX_PLANES):
+        if len(remaining) < max(3, MIN_PLANE_SHARE * len(points)):
+            break
+        normal, offset, inliers = fit_plane(remaining, rng=rng, near_normal=up_guess)
+        if inliers.sum() < MIN_PLANE_SHARE * len(points):
+            break
+        found.append((normal, offset, int(inliers.sum())))
+        remaining = remaining[~inliers]
+    if not found:
+        raise UnstackError(
+            f"no horizontal plane in the cloud (none within {HORIZONTAL_TOLERANCE_DEG:g} degrees of the frame's z "
+            "holds 2 % of the points): is the camera pose right?"
+        )
+    # the largest plane (a floor, a deck, a layer of tops) leads; planes parallel to it within
+    # PARALLEL_DEG join it, weighted by their points; a box resting tilted does not
+    lead = max(found, key=lambda plane: plane[2])[0]
+    parallel = [plane for plane in found if plane[0] @ lead >= np.cos(np.radians(PARALLEL_DEG))]
+    up = np.sum([normal * count for normal, _, count in parallel], axis=0)
+    up /= np.linalg.norm(up)
+    found = parallel
+    heading = np.array([-1.0, 0.0, 0.0]) if door is None else np.asarray(door, dtype=np.float64)
+    rotation = _rotation_onto_z(up, heading)
+    heights = points @ up
+    floor_heights = [offset / (normal @ up) for normal, offset, _ in found]
+    lowest = int(np.argmin(floor_heights))
+    floor_level = float(floor_heights[lowest])
+    floor_inliers = found[lowest][2]
+    if floor_level > np.percentile(heights, 5) + 0.05:  # the lowest plane is not under the cloud: no floor seen
+        floor_level, floor_inliers = float(np.percentile(heights, 1)), 0
+    tilt = float(np.degrees(np.arccos(np.clip(up @ up_guess, -1.0, 1.0))))
+    return GravityFrame(rotation, np.array([0.0, 0.0, -floor_level]), tilt, len(found), floor_inliers)

@@ -1,0 +1,116 @@
+"""``unstack scene``: an ``unstack.scene/1`` file from a depth camera's files and box masks.
+
+The command reads the files (:mod:`unstack.camera.files`), calls
+:func:`unstack.camera.scene_from_depth` and writes the scene (its cloud in a ``.npy`` beside
+it) and, on request, the fit report; it prints the gravity tilt and every fitted box with its
+residual, the duplicates left out and the masks that could not be fitted.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import click
+
+from unstack.errors import UnstackError
+
+__all__ = ["scene"]
+
+
+def _sizes(text: str | None) -> list[tuple[float, float, float]] | None:
+    """``0.255x0.155x0.1,0.34x0.25x0.095`` -> sizes (metres)."""
+    if not text:
+        return None
+    sizes = []
+    for item in text.split(","):
+        try:
+            edges = tuple(float(value) for value in item.lower().split("x"))
+        except ValueError:
+            raise UnstackError(f"--sizes: expected sizes like 0.4x0.3x0.3 separated by commas, got {item!r}") from None
+        if len(edges) != 3 or not all(0.01 <= edge <= 3.0 for edge in edges):
+            raise UnstackError(f"--sizes: expected three edges of 0.01-3 m per size, got {item!r}")
+        sizes.append((edges[0], edges[1], edges[2]))
+    return sizes
+
+
+def _door(text: str | None) -> list[float] | None:
+    if not text:
+        return None
+    try:
+        values = [float(value) for value in text.split(",")]
+    except ValueError:
+        values = []
+    if len(values) != 3 or not any(values):
+        raise UnstackError(f"--door: expected a direction x,y,z in the pose's frame, got {text!r}")
+    return values
+
+
+@click.command()
+@click.option("--depth", "depth_file", required=True, type=click.Path(dir_okay=False),
+              help="Depth image: a 16-bit PNG (mm) or a .npy of floats (m).")  # fmt: skip
+@click.option("--depth-units", type=click.Choice(["mm", "m"]), default=None,
+              help="Units of the depth values (default: mm for a PNG, m for a .npy); checked.")  # fmt: skip
+@click.option("--intrinsics", "intrinsics_file", required=True, type=click.Path(dir_okay=False),
+              help='JSON {"fx", "fy", "cx", "cy", "width", "height"} in pixels.')  # fmt: skip
+@click.option("--pose", "pose_file", required=True, type=click.Path(dir_okay=False),
+              help="JSON 4 x 4 camera-to-world matrix (or an object holding one); z roughly up.")  # fmt: skip
+@click.option("--mask", "mask_files", multiple=True, required=True, type=click.Path(dir_okay=False),
+              help="One instance mask per detected box (PNG or .npy, non-zero where the box is); repeat.")  # fmt: skip
+@click.option("--ids", default=None, help="Comma-separated box ids, one per mask (default b00, b01, ...).")
+@click.option("--sizes", default=None, help="Known carton sizes, e.g. 0.255x0.155x0.1,0.34x0.25x0.095 (metres).")
+@click.option("--door", default=None,
+              help="Direction x,y,z (pose frame) out through the door; default: towards the camera.")  # fmt: skip
+@click.option("--out", required=True, type=click.Path(dir_okay=False), help="The scene file to write (.json).")
+@click.option("--report", "report_file", default=None, type=click.Path(dir_okay=False),
+              help="Also write the fit report (tilt, residuals, duplicates) as JSON.")  # fmt: skip
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Seeds the RANSAC fits.")
+def scene(
+    depth_file: str, depth_units: str | None, intrinsics_file: str, pose_file: str, mask_files: tuple[str, ...],
+    ids: str | None, sizes: str | None, door: str | None, out: str, report_file: str | None, seed: int,
+) -> None:  # fmt: skip
+    """Build a scene from a depth camera's files and one mask per detected box.
+
+    Gravity and the floor come from the cloud's horizontal planes, each box from its mask's
+    top face (or front face) matched to the known sizes. Decide on the result with
+    ``unstack decide OUT``.
+    """
+    from rich.console import Console
+    from rich.table import Table
+
+    from unstack.atomic import atomic_write_text
+    from unstack.camera import load_depth, load_intrinsics, load_mask, load_pose, scene_from_depth
+
+    known = _sizes(sizes)
+    direction = _door(door)
+    names = [name.strip() for name in ids.split(",")] if ids else None
+    if names is not None and len(names) != len(mask_files):
+        raise UnstackError(f"--ids names {len(names)} boxes but {len(mask_files)} masks were given")
+    target = Path(out)
+    if target.suffix.lower() != ".json":
+        raise UnstackError(f"--out: expected a .json file name, got {out!r}")
+    depth = load_depth(depth_file, units=depth_units)
+    intrinsics = load_intrinsics(intrinsics_file)
+    pose = load_pose(pose_file)
+    masks = [load_mask(path, depth.shape) for path in mask_files]
+    built = scene_from_depth(depth, intrinsics, pose, masks, ids=names, known_sizes=known, door=direction, seed=seed)
+    built.scene.save(target, points_file=f"{target.stem}.points.npy")
+    if report_file is not None:
+        atomic_write_text(Path(report_file), json.dumps(built.report(), indent=2) + "\n")
+    console = Console()
+    table = Table(title=f"{len(built.fitted)} boxes from {len(masks)} masks (gravity tilted {built.frame.tilt_deg:.1f} "
+                  "degrees from the pose's z)")  # fmt: skip
+    for column in ("box", "face", "size (m)", "position (m)", "residual (mm)", "face seen"):
+        table.add_column(column, justify="right")
+    for item in built.fitted:
+        table.add_row(
+            item.box.id, item.face, " x ".join(f"{edge:.3f}" for edge in item.box.size),
+            ", ".join(f"{value:.3f}" for value in item.box.position), f"{1000 * item.residual_m:.1f}",
+            f"{100 * item.fill:.0f} %",
+        )  # fmt: skip
+    console.print(table)
+    for duplicate, kept in built.duplicates.items():
+        console.print(f"left out {duplicate}: its mask lies mostly inside {kept}'s (a duplicate detection)")
+    for box_id, reason in built.unfitted.items():
+        console.print(f"left out {box_id}: {reason}")
+    click.echo(f"scene in {target}; decide with: unstack decide {target}")

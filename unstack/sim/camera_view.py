@@ -1,0 +1,80 @@
+"""The simulator's sensor as a camera's files: depth image, intrinsics, pose, one mask per box.
+
+What a robot's depth camera and box detector hand over, rendered from a simulated scene, so
+that :func:`unstack.camera.scene_from_depth` can be tried against the truth. The sensor is the
+one the scene was scanned with (its jittered viewpoint when the data set moved it); a box is
+given a mask when the sensor sees at least ``min_pixels`` of it, the data sets' detection rule.
+
+Examples
+--------
+>>> from unstack.scene import Box, Scene
+>>> from unstack.sim.settings import SensorSettings, SimulationSettings
+>>> settings = SimulationSettings(boxes=(1, 1), sensor=SensorSettings(width=80, height=60, min_pixels=5))
+>>> box = Box("b00", [0.6, 0.4, 0.4], [1.0, 0.0, 0.2])
+>>> scene = Scene([box], [], ["b00"], metadata={"settings": settings.to_dict()})
+>>> view = camera_view(scene)
+>>> view.depth_m.shape, sorted(view.masks)
+((60, 80), ['b00'])
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from unstack.errors import UnstackError
+from unstack.scene import Scene
+
+__all__ = ["CameraView", "camera_view", "scene_sensor"]
+
+
+@dataclass(frozen=True)
+class CameraView:
+    """One rendered frame: depth (metres, 0 where nothing was hit), intrinsics, pose, masks by box id."""
+
+    depth_m: np.ndarray
+    intrinsics: Any
+    camera_to_world: np.ndarray
+    masks: dict[str, np.ndarray]
+
+
+def scene_sensor(scene: Scene) -> Any:
+    """The sensor a simulated scene was scanned with (its viewpoint moved as the data set moved it)."""
+    from unstack.sim.settings import SimulationSettings
+
+    data = scene.metadata.get("settings")
+    if not isinstance(data, dict):
+        raise UnstackError(f"{scene.source}: $.metadata.settings: rendering a camera view needs a simulated scene")
+    sensor = dataclasses.replace(SimulationSettings.from_dict(data).sensor, position_jitter=0.0)
+    simulation = scene.metadata.get("simulation", {})
+    if "sensor_position" in simulation:
+        sensor = dataclasses.replace(
+            sensor, position=tuple(simulation["sensor_position"]), target=tuple(simulation["sensor_target"])
+        )
+    return sensor
+
+
+def camera_view(scene: Scene, *, noise_seed: int | None = None) -> CameraView:
+    """Render the scene's boxes with its sensor: depth, intrinsics, pose and the masks of the seen boxes.
+
+    ``noise_seed``: with the sensor's depth noise on (its ``noise`` setting), the seed of the noise.
+    """
+    from unstack.sim.sensor import scan_pile, sensor_intrinsics, sensor_pose
+    from unstack.sim.settings import SimulationSettings
+    from unstack.sim.world import PhysicsWorld
+
+    sensor = scene_sensor(scene)
+    settings = SimulationSettings.from_dict(scene.metadata["settings"])
+    with PhysicsWorld(settings, door=False) as world:
+        for box in scene.boxes:
+            world.add_box(box.size, box.position, box.orientation_xyzw, mass=1.0)
+        scan = scan_pile(world, sensor, seed=noise_seed)
+    hit = scan.box_image >= -1
+    depth = np.where(hit, scan.depth_image, 0.0)
+    masks = {
+        box.id: scan.box_image == k for k, box in enumerate(scene.boxes) if scan.pixel_counts[k] >= sensor.min_pixels
+    }
+    return CameraView(depth, sensor_intrinsics(sensor), sensor_pose(sensor), masks)
