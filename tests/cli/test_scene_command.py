@@ -25,8 +25,8 @@ def camera_files(tmp_path: Path) -> list[str]:
     arguments = ["--depth", str(tmp_path / "depth.png"), "--intrinsics", str(tmp_path / "k.json"),
                  "--pose", str(tmp_path / "pose.json")]  # fmt: skip
     for k, mask in enumerate(masks):
-        Image.fromarray(mask.astype(np.uint8) * 255).save(tmp_path / f"mask{k}.png")
-        arguments += ["--mask", str(tmp_path / f"mask{k}.png")]
+        Image.fromarray(mask.astype(np.uint8) * 255).save(tmp_path / f"mask-b{k:02d}.png")
+        arguments.append(str(tmp_path / f"mask-b{k:02d}.png"))
     return arguments
 
 

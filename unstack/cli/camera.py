@@ -34,6 +34,15 @@ def _sizes(text: str | None) -> list[tuple[float, float, float]] | None:
     return sizes
 
 
+def _mask_id(path: str) -> str:
+    """A box id from a mask file's name: ``masks/mask-b07.png`` -> ``b07``."""
+    stem = Path(path).stem
+    for prefix in ("mask-", "mask_"):
+        if stem.lower().startswith(prefix):
+            return stem[len(prefix) :]
+    return stem
+
+
 def _door(text: str | None) -> list[float] | None:
     if not text:
         return None
@@ -47,6 +56,7 @@ def _door(text: str | None) -> list[float] | None:
 
 
 @click.command()
+@click.argument("mask_files", nargs=-1, required=True, type=click.Path(dir_okay=False))
 @click.option("--depth", "depth_file", required=True, type=click.Path(dir_okay=False),
               help="Depth image: a 16-bit PNG (mm) or a .npy of floats (m).")  # fmt: skip
 @click.option("--depth-units", type=click.Choice(["mm", "m"]), default=None,
@@ -55,9 +65,8 @@ def _door(text: str | None) -> list[float] | None:
               help='JSON {"fx", "fy", "cx", "cy", "width", "height"} in pixels.')  # fmt: skip
 @click.option("--pose", "pose_file", required=True, type=click.Path(dir_okay=False),
               help="JSON 4 x 4 camera-to-world matrix (or an object holding one); z roughly up.")  # fmt: skip
-@click.option("--mask", "mask_files", multiple=True, required=True, type=click.Path(dir_okay=False),
-              help="One instance mask per detected box (PNG or .npy, non-zero where the box is); repeat.")  # fmt: skip
-@click.option("--ids", default=None, help="Comma-separated box ids, one per mask (default b00, b01, ...).")
+@click.option("--ids", default=None,
+              help="Comma-separated box ids, one per mask (default: the file names without mask-).")  # fmt: skip
 @click.option("--sizes", default=None, help="Known carton sizes, e.g. 0.255x0.155x0.1,0.34x0.25x0.095 (metres).")
 @click.option("--door", default=None,
               help="Direction x,y,z (pose frame) out through the door; default: towards the camera.")  # fmt: skip
@@ -66,10 +75,11 @@ def _door(text: str | None) -> list[float] | None:
               help="Also write the fit report (tilt, residuals, duplicates) as JSON.")  # fmt: skip
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Seeds the RANSAC fits.")
 def scene(
-    depth_file: str, depth_units: str | None, intrinsics_file: str, pose_file: str, mask_files: tuple[str, ...],
+    mask_files: tuple[str, ...], depth_file: str, depth_units: str | None, intrinsics_file: str, pose_file: str,
     ids: str | None, sizes: str | None, door: str | None, out: str, report_file: str | None, seed: int,
 ) -> None:  # fmt: skip
-    """Build a scene from a depth camera's files and one mask per detected box.
+    """Build a scene from a depth camera's files and one mask per detected box (MASK_FILES: PNG or .npy,
+    non-zero where the box is).
 
     Gravity and the floor come from the cloud's horizontal planes, each box from its mask's
     top face (or front face) matched to the known sizes. Decide on the result with
@@ -83,8 +93,8 @@ def scene(
 
     known = _sizes(sizes)
     direction = _door(door)
-    names = [name.strip() for name in ids.split(",")] if ids else None
-    if names is not None and len(names) != len(mask_files):
+    names = [name.strip() for name in ids.split(",")] if ids else [_mask_id(path) for path in mask_files]
+    if len(names) != len(mask_files):
         raise UnstackError(f"--ids names {len(names)} boxes but {len(mask_files)} masks were given")
     target = Path(out)
     if target.suffix.lower() != ".json":

@@ -20,7 +20,11 @@ Examples
 from __future__ import annotations
 
 import dataclasses
+import io
+import json
+import os
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -28,7 +32,7 @@ import numpy as np
 from unstack.errors import UnstackError
 from unstack.scene import Scene
 
-__all__ = ["CameraView", "camera_view", "scene_sensor"]
+__all__ = ["CameraView", "camera_view", "save_camera_files", "scene_sensor"]
 
 
 @dataclass(frozen=True)
@@ -78,3 +82,30 @@ def camera_view(scene: Scene, *, noise_seed: int | None = None) -> CameraView:
         box.id: scan.box_image == k for k, box in enumerate(scene.boxes) if scan.pixel_counts[k] >= sensor.min_pixels
     }
     return CameraView(depth, sensor_intrinsics(sensor), sensor_pose(sensor), masks)
+
+
+def save_camera_files(view: CameraView, folder: str | os.PathLike[str]) -> list[Path]:
+    """Write a view as a camera's files: ``depth.png`` (16-bit, mm), ``intrinsics.json``,
+    ``pose.json`` (camera to world) and ``mask-<id>.png`` per seen box; the paths written."""
+    from PIL import Image
+
+    from unstack.atomic import atomic_write_bytes, atomic_write_text
+
+    target = Path(folder)
+    target.mkdir(parents=True, exist_ok=True)
+
+    def png(path: Path, array: np.ndarray) -> Path:
+        buffer = io.BytesIO()
+        Image.fromarray(array).save(buffer, format="PNG")
+        atomic_write_bytes(path, buffer.getvalue())
+        return path
+
+    millimetres = np.round(view.depth_m * 1000.0)
+    written = [png(target / "depth.png", np.clip(millimetres, 0, 65535).astype(np.uint16))]
+    intrinsics = {name: getattr(view.intrinsics, name) for name in ("fx", "fy", "cx", "cy", "width", "height")}
+    atomic_write_text(target / "intrinsics.json", json.dumps(intrinsics, indent=2) + "\n")
+    atomic_write_text(target / "pose.json", json.dumps({"camera_to_world": view.camera_to_world.tolist()}) + "\n")
+    written += [target / "intrinsics.json", target / "pose.json"]
+    for box_id, mask in view.masks.items():
+        written.append(png(target / f"mask-{box_id}.png", mask.astype(np.uint8) * 255))
+    return written
