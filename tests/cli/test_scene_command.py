@@ -58,3 +58,24 @@ def test_bad_input_is_one_line_and_no_file(
     run = unstack("scene", *camera_files, *extra, "--out", str(out))
     assert run.returncode == 2 and message in run.stderr and len(run.stderr.strip().splitlines()) == 1
     assert not out.exists()
+
+
+def test_a_cloud_and_detections_make_a_scene(tmp_path: Path) -> None:
+    rng = np.random.default_rng(0)
+    floor = np.column_stack([rng.uniform(-1, 1, 4000), rng.uniform(-1, 1, 4000), np.zeros(4000)])
+    np.save(tmp_path / "cloud.npy", floor)
+    (tmp_path / "boxes.json").write_text(json.dumps({"boxes": [
+        {"id": "low", "center": [0, 0, 0.15], "size": [0.4, 0.3, 0.3], "yaw_deg": 10},
+        {"id": "high", "center": [0, 0, 0.45], "size": [0.4, 0.3, 0.3], "yaw_deg": 10},
+    ]}))  # fmt: skip
+    out = tmp_path / "scene.json"
+    run = unstack("scene", "--cloud", str(tmp_path / "cloud.npy"), "--detections", str(tmp_path / "boxes.json"),
+                  "--out", str(out))  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert json.loads(out.read_text())["detected"] == ["low", "high"]
+
+
+def test_a_cloud_without_detections_is_one_line(tmp_path: Path) -> None:
+    np.save(tmp_path / "cloud.npy", np.zeros((200, 3)))
+    run = unstack("scene", "--cloud", str(tmp_path / "cloud.npy"), "--out", str(tmp_path / "scene.json"))
+    assert run.returncode == 2 and "--cloud needs --detections" in run.stderr

@@ -10,7 +10,9 @@ A robot cell has a depth camera and a box detector. This package turns their fil
 * :mod:`unstack.camera.boxes` fits one box per mask: its top plane, its yaw from the top face,
   its size matched to the known carton sizes, each box with its residual; a mask mostly
   covered by another is reported as a duplicate and left out;
-* :mod:`unstack.camera.build` assembles the scene and the report.
+* :mod:`unstack.camera.build` assembles the scene and the report;
+* :mod:`unstack.camera.clouds` does the same from a point cloud (``.npy``, ``.ply``, ``.pcd``)
+  and box detections (centre, size, yaw).
 
 Point-cloud handling is numpy and scipy (``scipy.spatial.ConvexHull`` for the top face's
 rectangle): every step is a few array operations on at most a few hundred thousand points,
@@ -25,6 +27,7 @@ Examples
 
 from unstack.camera.boxes import FittedBox, boxes_from_masks
 from unstack.camera.build import CameraScene, scene_from_depth
+from unstack.camera.clouds import load_cloud, load_detections, scene_from_cloud
 from unstack.camera.files import Intrinsics, load_depth, load_intrinsics, load_mask, load_pose
 from unstack.camera.planes import GravityFrame, depth_points, fit_plane, gravity_frame
 
@@ -37,9 +40,12 @@ __all__ = [
     "depth_points",
     "fit_plane",
     "gravity_frame",
+    "load_cloud",
     "load_depth",
+    "load_detections",
     "load_intrinsics",
     "load_mask",
     "load_pose",
+    "scene_from_cloud",
     "scene_from_depth",
 ]

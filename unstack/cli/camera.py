@@ -56,15 +56,19 @@ def _door(text: str | None) -> list[float] | None:
 
 
 @click.command()
-@click.argument("mask_files", nargs=-1, required=True, type=click.Path(dir_okay=False))
-@click.option("--depth", "depth_file", required=True, type=click.Path(dir_okay=False),
+@click.argument("mask_files", nargs=-1, type=click.Path(dir_okay=False))
+@click.option("--depth", "depth_file", default=None, type=click.Path(dir_okay=False),
               help="Depth image: a 16-bit PNG (mm) or a .npy of floats (m).")  # fmt: skip
 @click.option("--depth-units", type=click.Choice(["mm", "m"]), default=None,
               help="Units of the depth values (default: mm for a PNG, m for a .npy); checked.")  # fmt: skip
-@click.option("--intrinsics", "intrinsics_file", required=True, type=click.Path(dir_okay=False),
+@click.option("--intrinsics", "intrinsics_file", default=None, type=click.Path(dir_okay=False),
               help='JSON {"fx", "fy", "cx", "cy", "width", "height"} in pixels.')  # fmt: skip
-@click.option("--pose", "pose_file", required=True, type=click.Path(dir_okay=False),
+@click.option("--pose", "pose_file", default=None, type=click.Path(dir_okay=False),
               help="JSON 4 x 4 camera-to-world matrix (or an object holding one); z roughly up.")  # fmt: skip
+@click.option("--cloud", "cloud_file", default=None, type=click.Path(dir_okay=False),
+              help="Instead of a depth image and masks: a point cloud (.npy, .ply or .pcd), z roughly up.")  # fmt: skip
+@click.option("--detections", "detections_file", default=None, type=click.Path(dir_okay=False),
+              help='With --cloud: JSON boxes [{"id", "center", "size", "yaw_deg"}] in the cloud\'s frame.')  # fmt: skip
 @click.option("--ids", default=None,
               help="Comma-separated box ids, one per mask (default: the file names without mask-).")  # fmt: skip
 @click.option("--sizes", default=None, help="Known carton sizes, e.g. 0.255x0.155x0.1,0.34x0.25x0.095 (metres).")
@@ -75,15 +79,16 @@ def _door(text: str | None) -> list[float] | None:
               help="Also write the fit report (tilt, residuals, duplicates) as JSON.")  # fmt: skip
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Seeds the RANSAC fits.")
 def scene(
-    mask_files: tuple[str, ...], depth_file: str, depth_units: str | None, intrinsics_file: str, pose_file: str,
-    ids: str | None, sizes: str | None, door: str | None, out: str, report_file: str | None, seed: int,
+    mask_files: tuple[str, ...], depth_file: str | None, depth_units: str | None, intrinsics_file: str | None,
+    pose_file: str | None, cloud_file: str | None, detections_file: str | None, ids: str | None,
+    sizes: str | None, door: str | None, out: str, report_file: str | None, seed: int,
 ) -> None:  # fmt: skip
-    """Build a scene from a depth camera's files and one mask per detected box (MASK_FILES: PNG or .npy,
-    non-zero where the box is).
+    """Build a scene from a depth camera's files and one mask per detected box (MASK_FILES: PNG or
+    .npy, non-zero where the box is), or from a point cloud and box detections.
 
-    Gravity and the floor come from the cloud's horizontal planes, each box from its mask's
-    top face (or front face) matched to the known sizes. Decide on the result with
-    ``unstack decide OUT``.
+    Gravity and the floor come from the cloud's horizontal planes; each box from its mask's top
+    face (or front face) matched to the known sizes, or from its detection levelled in the
+    gravity frame. Decide on the result with ``unstack decide OUT``.
     """
     from rich.console import Console
     from rich.table import Table
@@ -92,31 +97,56 @@ def scene(
     from unstack.camera import load_depth, load_intrinsics, load_mask, load_pose, scene_from_depth
 
     known = _sizes(sizes)
-    direction = _door(door)
-    names = [name.strip() for name in ids.split(",")] if ids else [_mask_id(path) for path in mask_files]
-    if len(names) != len(mask_files):
-        raise UnstackError(f"--ids names {len(names)} boxes but {len(mask_files)} masks were given")
     target = Path(out)
     if target.suffix.lower() != ".json":
         raise UnstackError(f"--out: expected a .json file name, got {out!r}")
-    depth = load_depth(depth_file, units=depth_units)
-    intrinsics = load_intrinsics(intrinsics_file)
-    pose = load_pose(pose_file)
-    masks = [load_mask(path, depth.shape) for path in mask_files]
-    built = scene_from_depth(depth, intrinsics, pose, masks, ids=names, known_sizes=known, door=direction, seed=seed)
+    direction = _door(door)
+    if cloud_file is not None:
+        if mask_files or depth_file or intrinsics_file:
+            raise UnstackError("--cloud takes box detections (--detections), not a depth image, intrinsics or masks")
+        if detections_file is None:
+            raise UnstackError("--cloud needs --detections: the boxes a 3-D detector found in the cloud")
+        from unstack.camera import load_cloud, load_detections, scene_from_cloud
+
+        cloud = load_cloud(cloud_file)
+        if pose_file is not None:
+            from unstack.camera import load_pose
+
+            pose = load_pose(pose_file)
+            cloud = cloud @ pose[:3, :3].T + pose[:3, 3]
+        built = scene_from_cloud(cloud, load_detections(detections_file), door=direction, seed=seed)
+    else:
+        missing = [name for name, value in (("--depth", depth_file), ("--intrinsics", intrinsics_file),
+                                            ("--pose", pose_file)) if value is None]  # fmt: skip
+        if missing or not mask_files:
+            needed = ", ".join(missing + ([] if mask_files else ["mask files"]))
+            raise UnstackError(f"a depth image needs {needed} (or give --cloud and --detections instead)")
+        assert depth_file is not None and intrinsics_file is not None and pose_file is not None
+        names = [name.strip() for name in ids.split(",")] if ids else [_mask_id(path) for path in mask_files]
+        if len(names) != len(mask_files):
+            raise UnstackError(f"--ids names {len(names)} boxes but {len(mask_files)} masks were given")
+        depth = load_depth(depth_file, units=depth_units)
+        intrinsics = load_intrinsics(intrinsics_file)
+        pose = load_pose(pose_file)
+        masks = [load_mask(path, depth.shape) for path in mask_files]
+        built = scene_from_depth(
+            depth, intrinsics, pose, masks, ids=names, known_sizes=known, door=direction, seed=seed
+        )
     built.scene.save(target, points_file=f"{target.stem}.points.npy")
     if report_file is not None:
         atomic_write_text(Path(report_file), json.dumps(built.report(), indent=2) + "\n")
     console = Console()
-    table = Table(title=f"{len(built.fitted)} boxes from {len(masks)} masks (gravity tilted {built.frame.tilt_deg:.1f} "
-                  "degrees from the pose's z)")  # fmt: skip
+    table = Table(title=f"{len(built.scene.boxes)} boxes (gravity tilted {built.frame.tilt_deg:.1f} degrees from the "
+                  "input frame's z)")  # fmt: skip
     for column in ("box", "face", "size (m)", "position (m)", "residual (mm)", "face seen"):
         table.add_column(column, justify="right")
-    for item in built.fitted:
+    fits = {item.box.id: item for item in built.fitted}
+    for box in built.scene.boxes:
+        item = fits.get(box.id)
         table.add_row(
-            item.box.id, item.face, " x ".join(f"{edge:.3f}" for edge in item.box.size),
-            ", ".join(f"{value:.3f}" for value in item.box.position), f"{1000 * item.residual_m:.1f}",
-            f"{100 * item.fill:.0f} %",
+            box.id, item.face if item else "detected", " x ".join(f"{edge:.3f}" for edge in box.size),
+            ", ".join(f"{value:.3f}" for value in box.position), f"{1000 * item.residual_m:.1f}" if item else "-",
+            f"{100 * item.fill:.0f} %" if item else "-",
         )  # fmt: skip
     console.print(table)
     for duplicate, kept in built.duplicates.items():

@@ -1,0 +1,79 @@
+"""Scenes from a point cloud and box detections: PCD files read, a tilted frame levelled."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from unstack.camera import load_cloud, load_detections, scene_from_cloud
+from unstack.errors import InvalidFile
+from unstack.geometry import rotation_matrix
+
+
+def _floor_and_top(rng: np.random.Generator) -> np.ndarray:
+    floor = np.column_stack([rng.uniform(-1, 1, 4000), rng.uniform(-1, 1, 4000), np.zeros(4000)])
+    top = np.column_stack([rng.uniform(-0.2, 0.2, 800), rng.uniform(-0.15, 0.15, 800), np.full(800, 0.3)])
+    return np.vstack([floor, top])
+
+
+def _tilt(angle_deg: float) -> np.ndarray:
+    angle = np.radians(angle_deg)
+    return np.array([[1.0, 0.0, 0.0], [0.0, np.cos(angle), -np.sin(angle)], [0.0, np.sin(angle), np.cos(angle)]])
+
+
+@pytest.mark.parametrize("tilt_deg", [0.0, 9.0])
+def test_a_tilted_frame_is_levelled_and_the_box_stands_on_the_floor(tilt_deg: float) -> None:
+    turn = _tilt(tilt_deg)
+    cloud = _floor_and_top(np.random.default_rng(3)) @ turn.T + [0.0, 0.0, 0.5]
+    centre = (turn @ [0.0, 0.0, 0.15]) + [0.0, 0.0, 0.5]
+    built = scene_from_cloud(cloud, [{"id": "a", "center": centre.tolist(), "size": [0.4, 0.3, 0.3], "yaw_deg": 30}])
+    box = built.scene.box("a")
+    assert built.frame.tilt_deg == pytest.approx(tilt_deg, abs=0.2)
+    assert box.position[2] == pytest.approx(0.15, abs=0.005)
+    assert abs(rotation_matrix(box.orientation_xyzw)[2, 2]) == pytest.approx(1.0)  # level
+    assert box.size.tolist() == [0.4, 0.3, 0.3]
+
+
+def _write_pcd(path: Path, points: np.ndarray, data: str) -> None:
+    header = (
+        "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
+        f"WIDTH {len(points)}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {len(points)}\nDATA {data}\n"
+    )
+    values = np.column_stack([points, np.ones(len(points))]).astype("<f4")
+    body = (
+        values.tobytes()
+        if data == "binary"
+        else "\n".join(" ".join(f"{v:.6f}" for v in row) for row in values).encode()
+    )
+    path.write_bytes(header.encode() + body)
+
+
+@pytest.mark.parametrize("data", ["ascii", "binary"])
+def test_pcd_files_are_read_in_ascii_and_binary(tmp_path: Path, data: str) -> None:
+    points = np.random.default_rng(0).uniform(-1, 1, (50, 3))
+    _write_pcd(tmp_path / "cloud.pcd", points, data)
+    assert load_cloud(tmp_path / "cloud.pcd") == pytest.approx(points.astype("<f4").astype(np.float64), abs=1e-6)
+
+
+def test_compressed_pcd_is_refused_in_one_line(tmp_path: Path) -> None:
+    _write_pcd(tmp_path / "cloud.pcd", np.zeros((5, 3)), "binary_compressed")
+    with pytest.raises(InvalidFile, match="PCD data 'binary_compressed' is not read"):
+        load_cloud(tmp_path / "cloud.pcd")
+
+
+@pytest.mark.parametrize(
+    ("boxes", "message"),
+    [
+        ([{"id": "a", "center": [0, 0], "size": [1, 1, 1]}], r"\$\[0\]\.center: expected 3 finite numbers"),
+        ([{"id": "a", "center": [0, 0, 0], "size": [1, -1, 1]}], r"\$\[0\]\.size: expected positive edges"),
+        ([{"center": [0, 0, 0], "size": [1, 1, 1]}], r"\$\[0\]: expected an object with a non-empty string id"),
+        ({"boxes": []}, r"\$\.boxes: expected a non-empty list"),
+    ],
+)
+def test_bad_detections_name_the_json_path(tmp_path: Path, boxes: object, message: str) -> None:
+    (tmp_path / "boxes.json").write_text(json.dumps(boxes))
+    with pytest.raises(InvalidFile, match=message):
+        load_detections(tmp_path / "boxes.json")

@@ -1,0 +1,187 @@
+"""A point cloud and box detections, as a 3-D detector hands them over (issue 36, part 1b).
+
+* :func:`load_cloud` reads ``.npy`` and ``.ply`` (through :func:`unstack.scene.load_points`) and
+  ``.pcd`` (the Point Cloud Library's format, ASCII or binary; ``binary_compressed`` is refused
+  in one line: convert it with ``pcl_convert_pcd_ascii_binary``);
+* :func:`load_detections` reads boxes ``{"id", "center", "size", "yaw_deg"}`` (or
+  ``"orientation_xyzw"`` instead of the yaw) in the cloud's frame, a list or ``{"boxes": [...]}``;
+* :func:`scene_from_cloud` finds gravity and the floor from the cloud's horizontal planes
+  (:func:`unstack.camera.planes.gravity_frame`), moves cloud and boxes into that frame and
+  levels each box: a detector's frame tilted against gravity tilts its boxes with it, while a
+  carton stands level, so only each box's heading about the gravity frame's z is kept.
+
+Examples
+--------
+>>> rng = np.random.default_rng(0)
+>>> floor = np.column_stack([rng.uniform(-1, 1, 3000), rng.uniform(-1, 1, 3000), np.zeros(3000)])
+>>> built = scene_from_cloud(floor, [{"id": "a", "center": [0, 0, 0.15], "size": [0.4, 0.3, 0.3], "yaw_deg": 30}])
+>>> built.scene.detected, round(float(built.scene.box("a").position[2]), 2)
+(('a',), 0.15)
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from unstack.camera.build import CameraScene
+from unstack.camera.planes import gravity_frame
+from unstack.errors import InvalidFile, UnstackError
+from unstack.scene import Box, Scene
+
+__all__ = ["load_cloud", "load_detections", "scene_from_cloud"]
+
+_PCD_TYPES = {("F", 4): "<f4", ("F", 8): "<f8", ("I", 1): "<i1", ("I", 2): "<i2", ("I", 4): "<i4",
+              ("U", 1): "<u1", ("U", 2): "<u2", ("U", 4): "<u4"}  # fmt: skip
+
+
+def _load_pcd(file: Path) -> np.ndarray:
+    source = str(file)
+    raw = file.read_bytes()
+    header: dict[str, list[str]] = {}
+    offset = 0
+    while True:
+        end = raw.find(b"\n", offset)
+        if end < 0:
+            raise InvalidFile(source, "$", "expected a PCD header ending with a DATA line")
+        line = raw[offset:end].decode("ascii", errors="replace").strip()
+        offset = end + 1
+        if not line or line.startswith("#"):
+            continue
+        key, *values = line.split()
+        header[key.upper()] = values
+        if key.upper() == "DATA":
+            break
+    try:
+        fields = header["FIELDS"]
+        sizes = [int(value) for value in header["SIZE"]]
+        types = header["TYPE"]
+        counts = [int(value) for value in header.get("COUNT", ["1"] * len(fields))]
+        points = int(header["POINTS"][0])
+        data = header["DATA"][0].lower()
+    except (KeyError, IndexError, ValueError):
+        raise InvalidFile(source, "$", "expected a PCD header with FIELDS, SIZE, TYPE, POINTS and DATA") from None
+    if not {"x", "y", "z"} <= set(fields):
+        raise InvalidFile(source, "$", f"expected the fields x, y and z, got {' '.join(fields)}")
+    if data == "ascii":
+        table = np.loadtxt(raw[offset:].decode("ascii").splitlines(), ndmin=2)
+        columns = np.cumsum([0, *counts])
+        picked = [table[:, columns[fields.index(name)]] for name in ("x", "y", "z")]
+        return np.column_stack(picked)
+    if data != "binary":
+        raise InvalidFile(source, "$", f"PCD data {data!r} is not read; save the cloud as ascii or binary PCD")
+    try:
+        dtype = np.dtype([(name, _PCD_TYPES[(kind, size)], (count,)) if count > 1 else (name, _PCD_TYPES[(kind, size)])
+                          for name, kind, size, count in zip(fields, types, sizes, counts, strict=True)])  # fmt: skip
+    except KeyError:
+        raise InvalidFile(source, "$", "expected PCD fields of types F, I or U of 1-8 bytes") from None
+    records = np.frombuffer(raw, dtype=dtype, count=points, offset=offset)
+    return np.column_stack([records[name].astype(np.float64) for name in ("x", "y", "z")])
+
+
+def load_cloud(path: str | os.PathLike[str]) -> np.ndarray:
+    """A point cloud as (N, 3) float64 metres from ``.npy``, ``.ply`` or ``.pcd``; non-finite points dropped."""
+    from unstack.checks import check_points
+    from unstack.scene import load_points
+
+    file = Path(path)
+    if file.suffix.lower() != ".pcd":
+        cloud = np.asarray(load_points(file, source=str(file), json_path="$"))
+        return cloud
+    if not file.is_file():
+        raise InvalidFile(str(file), "$", "the point cloud file does not exist")
+    cloud = _load_pcd(file)
+    return check_points(cloud[np.all(np.isfinite(cloud), axis=1)], source=str(file), path="$")
+
+
+def load_detections(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
+    """Box detections from JSON (see the module docstring), checked field by field."""
+    file = Path(path)
+    source = str(file)
+    try:
+        data = json.loads(file.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InvalidFile(source, "$", "the detections file does not exist") from None
+    except (OSError, UnicodeDecodeError, ValueError) as error:
+        raise InvalidFile(source, "$", f"expected a JSON file: {error}") from None
+    base = "$"
+    if isinstance(data, dict):
+        data, base = data.get("boxes"), "$.boxes"
+    if not isinstance(data, list) or not data:
+        raise InvalidFile(source, base, "expected a non-empty list of boxes {id, center, size, yaw_deg}")
+    check_detections(data, source=source, base=base)
+    return data
+
+
+def check_detections(detections: Sequence[Any], *, source: str = "<detections>", base: str = "$") -> None:
+    """Raise :class:`~unstack.errors.InvalidFile` at the first detection that is not a box."""
+    seen = set()
+    for index, item in enumerate(detections):
+        where = f"{base}[{index}]"
+        if not isinstance(item, dict) or not isinstance(item.get("id"), str) or not item["id"]:
+            raise InvalidFile(source, where, "expected an object with a non-empty string id")
+        if item["id"] in seen:
+            raise InvalidFile(source, f"{where}.id", f"box id {item['id']!r} appears twice")
+        seen.add(item["id"])
+        for name, length in (("center", 3), ("size", 3)):
+            value = item.get(name)
+            if (
+                not isinstance(value, list)
+                or len(value) != length
+                or not all(
+                    isinstance(entry, int | float) and not isinstance(entry, bool) and np.isfinite(entry)
+                    for entry in value
+                )
+            ):
+                raise InvalidFile(source, f"{where}.{name}", f"expected {length} finite numbers (metres)")
+        if not all(edge > 0 for edge in item["size"]):
+            raise InvalidFile(source, f"{where}.size", "expected positive edges")
+        if "orientation_xyzw" in item:
+            quaternion = item["orientation_xyzw"]
+            if not isinstance(quaternion, list) or len(quaternion) != 4 or not np.linalg.norm(quaternion) > 0:
+                raise InvalidFile(source, f"{where}.orientation_xyzw", "expected a quaternion x, y, z, w")
+        elif not isinstance(item.get("yaw_deg", 0.0), int | float) or isinstance(item.get("yaw_deg"), bool):
+            raise InvalidFile(source, f"{where}.yaw_deg", "expected a number of degrees")
+
+
+def _heading(rotation: np.ndarray, size: np.ndarray) -> tuple[float, np.ndarray]:
+    """The yaw of a box's longest horizontal edge and its size (long, short, vertical) once levelled."""
+    vertical = int(np.argmax(np.abs(rotation[2])))  # the box axis standing most upright
+    horizontal = [axis for axis in range(3) if axis != vertical]
+    longest = max(horizontal, key=lambda axis: size[axis])
+    other = horizontal[0] if horizontal[1] == longest else horizontal[1]
+    direction = rotation[:, longest]
+    return float(np.arctan2(direction[1], direction[0])), np.array([size[longest], size[other], size[vertical]])
+
+
+def scene_from_cloud(
+    points: np.ndarray, detections: Sequence[dict[str, Any]], *, door: Sequence[float] | None = None, seed: int = 0
+) -> CameraScene:
+    """Build a scene from a cloud and box detections in the same frame (z roughly up)."""
+    from unstack.geometry import rotation_matrix
+
+    check_detections(detections)
+    cloud = np.asarray(points, dtype=np.float64)
+    if len(cloud) < 100:
+        raise UnstackError(f"the cloud holds {len(cloud)} points; at least 100 are needed for gravity and the floor")
+    frame = gravity_frame(cloud, door=None if door is None else np.asarray(door, dtype=np.float64), seed=seed)
+    boxes = []
+    for item in detections:
+        if "orientation_xyzw" in item:
+            quaternion = np.asarray(item["orientation_xyzw"], dtype=np.float64)
+            rotation = rotation_matrix(quaternion / np.linalg.norm(quaternion))
+        else:
+            yaw = np.radians(float(item.get("yaw_deg", 0.0)))
+            rotation = np.array([[np.cos(yaw), -np.sin(yaw), 0.0], [np.sin(yaw), np.cos(yaw), 0.0], [0.0, 0.0, 1.0]])
+        heading, size = _heading(frame.rotation @ rotation, np.asarray(item["size"], dtype=np.float64))
+        centre = frame.apply(np.asarray(item["center"], dtype=np.float64)[None])[0]
+        boxes.append(Box(item["id"], size, centre, [0.0, 0.0, np.sin(heading / 2), np.cos(heading / 2)]))
+    metadata = {"camera": {"tilt_deg": frame.tilt_deg, "gravity_rotation": frame.rotation.tolist(),
+                           "gravity_translation": frame.translation.tolist()}}  # fmt: skip
+    scene = Scene(boxes, frame.apply(cloud), [box.id for box in boxes], metadata=metadata, source="<cloud>")
+    return CameraScene(scene, frame, ())
