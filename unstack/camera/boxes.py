@@ -168,12 +168,15 @@ def _match_size(
     return np.asarray(chosen[2], dtype=np.float64), float(chosen[0]), chosen[3]
 
 
-def _front_face(points: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, float, np.ndarray] | None:
-    """The vertical face turned towards the door (-x) among ``points``: normal, offset, inliers."""
+def _front_face(
+    points: np.ndarray, rng: np.random.Generator, min_share: float = 0.0
+) -> tuple[np.ndarray, float, np.ndarray] | None:
+    """The vertical face turned towards the door (-x) among ``points``: normal, offset, inliers
+    (None unless it holds :data:`MIN_FACE_POINTS` and ``min_share`` of the points)."""
     if len(points) < MIN_FACE_POINTS:
         return None
     normal, offset, inliers = fit_plane(points, rng=rng, near_normal=np.array([-1.0, 0.0, 0.0]), tolerance_deg=75.0)
-    if inliers.sum() < max(MIN_FACE_POINTS, TOP_SHARE * len(points)) or abs(normal[2]) > np.sin(np.radians(25.0)):
+    if inliers.sum() < max(MIN_FACE_POINTS, min_share * len(points)) or abs(normal[2]) > np.sin(np.radians(25.0)):
         return None
     return normal, offset, inliers
 
@@ -214,7 +217,7 @@ def _fit_from_top(
     residual = float(np.sqrt(np.mean((face @ normal - offset) ** 2)))
     centre, yaw, extents = min_area_rectangle(face[:, :2])
     extents = extents + _spacing(face[:, :2])  # pixel samples stop half a spacing short of each edge
-    front = _front_face(points[~inliers], rng)
+    front = _front_face(points[~inliers], rng, TOP_SHARE)
     seen_height = 0.0
     if front is not None:
         front_heights = points[~inliers][front[2], 2]
@@ -275,9 +278,10 @@ def _fit_from_front(
     rng: np.random.Generator,
 ) -> FittedBox:
     """A box seen from the front only: its vertical face gives yaw, width and height."""
-    normal, offset, inliers = fit_plane(points, rng=rng, near_normal=np.array([-1.0, 0.0, 0.0]), tolerance_deg=75.0)
-    if inliers.sum() < MIN_FACE_POINTS or abs(normal[2]) > np.sin(np.radians(25.0)):
+    front = _front_face(points, rng)
+    if front is None:
         raise UnstackError(f"{box_id}: neither a top face nor a front face could be fitted to the mask's points")
+    normal, offset, inliers = front
     face = points[inliers]
     horizontal = np.array([normal[0], normal[1], 0.0])
     horizontal /= np.linalg.norm(horizontal)
