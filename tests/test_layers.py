@@ -167,3 +167,11 @@ def test_a_part_imports_none_of_its_forbidden_packages(part: str) -> None:
 
 
 GEOMETRY = ("box_corners", "bounding_boxes", "bounding_box_overlap_xy", "rotation_angles_deg", "footprint_overlap_area")
+
+
+def test_the_data_model_takes_no_scene_understanding() -> None:
+    """``scene`` refuses impossible input with the limits of ``checks`` and ``geometry``; it never
+    imports ``plausibility``, which warns about scenes (the circle scene -> plausibility -> geometry -> scene)."""
+    pairs = {(edge.source, edge.target) for edge in EDGES}
+    assert ("unstack.scene", "unstack.plausibility") not in pairs
+    assert ("unstack.scene", "unstack.checks") in pairs and ("unstack.plausibility", "unstack.checks") in pairs

@@ -22,7 +22,11 @@ import numpy as np
 from unstack.errors import InvalidFile, InvalidScene, InvalidSupports
 
 __all__ = [
+    "MAX_BOX_EDGE",
+    "MAX_COORDINATE",
+    "MIN_BOX_EDGE",
     "QUATERNION_NORM_TOLERANCE",
+    "REFUSED_OVERLAP",
     "check_ids",
     "check_points",
     "check_probability_matrix",
@@ -32,6 +36,16 @@ __all__ = [
 
 #: A quaternion whose norm is within this of 1 is normalised; further away it is an error.
 QUATERNION_NORM_TOLERANCE = 1e-3
+
+
+#: Shortest box edge accepted (metres): smaller is not a carton, or the unit is not metres.
+MIN_BOX_EDGE = 0.02
+#: Longest box edge accepted (metres): longer is not a carton, or the unit is millimetres.
+MAX_BOX_EDGE = 5.0
+#: Farthest coordinate accepted, boxes and cloud (metres from the origin along any axis).
+MAX_COORDINATE = 100.0
+#: Two boxes sharing more than this share of the smaller one's volume are refused.
+REFUSED_OVERLAP = 0.5
 
 
 def _matrix(value: Any, n_objects: int, source: str, path: str, error: type[InvalidFile]) -> np.ndarray:

@@ -23,15 +23,22 @@ Examples
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from unstack.geometry import bounding_boxes, box_corners, footprint, footprint_overlap_area, rotation_matrix
+from unstack.checks import MAX_BOX_EDGE, MAX_COORDINATE, MIN_BOX_EDGE, REFUSED_OVERLAP
+from unstack.geometry import (
+    bounding_boxes,
+    box_corners,
+    footprint,
+    footprint_overlap_area,
+    overlap_share,
+    overlapping_pairs,
+)
 
 if TYPE_CHECKING:
-    from unstack.scene import Box, Scene
+    from unstack.scene import Scene
 
 __all__ = [
     "BELOW_FLOOR",
@@ -46,15 +53,8 @@ __all__ = [
     "scene_warnings",
 ]
 
-#: Shortest box edge accepted (metres): smaller is not a carton, or the unit is not metres.
-MIN_BOX_EDGE = 0.02
-#: Longest box edge accepted (metres): longer is not a carton, or the unit is millimetres.
-MAX_BOX_EDGE = 5.0
-#: Farthest coordinate accepted, boxes and cloud (metres from the origin along any axis).
-MAX_COORDINATE = 100.0
-#: Two boxes sharing more than this share of the smaller one's volume are refused ...
-REFUSED_OVERLAP = 0.5
-#: ... and more than this share is warned about (a few millimetres of interpenetration of
+#: More than this share of the smaller box's volume shared with another is warned about (the
+#: refused share is :data:`unstack.checks.REFUSED_OVERLAP`) (a few millimetres of interpenetration of
 #: simulated or measured poses stay below it).
 WARNED_OVERLAP = 0.05
 #: A detected box whose bottom has nothing under it within this gap floats (metres).
@@ -63,52 +63,6 @@ FLOAT_GAP = 0.05
 BELOW_FLOOR = 0.02
 #: A cloud whose points are mostly farther than this from every box is "far" (metres).
 FAR_CLOUD = 0.5
-#: Grid steps per axis when measuring the overlap of two boxes whose axes are not parallel.
-_OVERLAP_STEPS = 12
-
-
-def overlap_share(first: Box, second: Box) -> float:
-    """Share of the smaller box's volume that lies inside the other: exact when the two boxes'
-    axes are parallel (every pile of cartons, up to a swap of axes), a grid estimate otherwise.
-
-    Examples
-    --------
-    >>> from unstack.scene import Box
-    >>> overlap_share(Box("a", [1, 1, 1], [0, 0, 0.5]), Box("b", [1, 1, 1], [0.5, 0, 0.5]))
-    0.5
-    >>> overlap_share(Box("a", [0.4, 0.4, 0.4], [0, 0, 0.2]), Box("b", [0.4, 0.4, 0.4], [0.22, 0, 0.2]))
-    0.45
-    """
-    small, large = (first, second) if np.prod(first.size) <= np.prod(second.size) else (second, first)
-    to_large = rotation_matrix(large.orientation_xyzw)
-    relative = to_large.T @ rotation_matrix(small.orientation_xyzw)  # the small box's axes in the large one's frame
-    axes = np.round(np.abs(relative))  # a rotation whose entries are 0 or +-1 permutes the axes
-    if np.allclose(np.abs(relative), axes, atol=1e-6):
-        centre = to_large.T @ (np.asarray(small.position) - large.position)
-        half = axes @ (np.asarray(small.size) / 2.0)
-        low = np.maximum(centre - half, -np.asarray(large.size) / 2.0)
-        high = np.minimum(centre + half, np.asarray(large.size) / 2.0)
-        return round(float(np.prod(np.clip(high - low, 0.0, None)) / np.prod(small.size)), 12)
-    steps = (np.arange(_OVERLAP_STEPS) + 0.5) / _OVERLAP_STEPS - 0.5
-    grid = np.stack(np.meshgrid(steps, steps, steps, indexing="ij"), axis=-1).reshape(-1, 3) * small.size
-    points = grid @ rotation_matrix(small.orientation_xyzw).T + small.position
-    local = (points - large.position) @ rotation_matrix(large.orientation_xyzw)
-    return float(np.mean(np.all(np.abs(local) <= large.size / 2.0, axis=1)))
-
-
-def overlapping_pairs(boxes: Sequence[Box], threshold: float) -> list[tuple[int, int, float]]:
-    """Pairs of box indices whose overlap share exceeds ``threshold``, with the share."""
-    bounds = bounding_boxes(boxes)
-    result = []
-    for i in range(len(boxes)):
-        meets = np.all(bounds[i + 1 :, :3] < bounds[i, 3:], axis=1) & np.all(
-            bounds[i + 1 :, 3:] > bounds[i, :3], axis=1
-        )
-        for j in np.flatnonzero(meets) + i + 1:
-            share = overlap_share(boxes[i], boxes[int(j)])
-            if share > threshold:
-                result.append((i, int(j), share))
-    return result
 
 
 def _floating(scene: Scene, bounds: np.ndarray, index: int) -> float | None:

@@ -25,8 +25,18 @@ from typing import Any
 import numpy as np
 
 from unstack.atomic import atomic_save_array, atomic_write_text
-from unstack.checks import check_ids, check_points, check_quaternion_xyzw, check_vector
+from unstack.checks import (
+    MAX_BOX_EDGE,
+    MAX_COORDINATE,
+    MIN_BOX_EDGE,
+    REFUSED_OVERLAP,
+    check_ids,
+    check_points,
+    check_quaternion_xyzw,
+    check_vector,
+)
 from unstack.errors import InvalidScene
+from unstack.geometry import overlapping_pairs
 from unstack.jsonio import Document, read_document, validate_document
 
 __all__ = ["MAX_CLOUD_FILE_BYTES", "MAX_POINTS", "SCENE_FORMAT", "Box", "Scene", "load_points", "load_scene"]
@@ -40,8 +50,6 @@ MAX_CLOUD_FILE_BYTES = 256 * 2**20
 
 def _check_edges(size: np.ndarray, source: str, path: str) -> np.ndarray:
     """Refuse box edges no carton has (the unit is metres)."""
-    from unstack.plausibility import MAX_BOX_EDGE, MIN_BOX_EDGE
-
     for k, edge in enumerate(size):
         if not MIN_BOX_EDGE <= edge <= MAX_BOX_EDGE:
             raise InvalidScene(
@@ -54,9 +62,7 @@ def _check_edges(size: np.ndarray, source: str, path: str) -> np.ndarray:
 
 
 def _check_coordinates(values: np.ndarray, source: str, path: str) -> np.ndarray:
-    """Refuse coordinates farther than :data:`unstack.plausibility.MAX_COORDINATE` from the origin."""
-    from unstack.plausibility import MAX_COORDINATE
-
+    """Refuse coordinates farther than :data:`unstack.checks.MAX_COORDINATE` from the origin."""
     far = np.argwhere(np.abs(values) > MAX_COORDINATE)
     if far.size:
         where = "".join(f"[{k}]" for k in far[0])
@@ -216,8 +222,6 @@ def _refuse_large_npy(file: Path, source: str, json_path: str) -> None:
 
 def _refuse_overlaps(boxes: tuple[Box, ...], source: str) -> None:
     """Two boxes cannot share more than half of the smaller one's volume."""
-    from unstack.plausibility import REFUSED_OVERLAP, overlapping_pairs
-
     pairs = overlapping_pairs(boxes, REFUSED_OVERLAP)
     if pairs:
         i, j, share = pairs[0]

@@ -59,7 +59,8 @@ class CameraScene:
 def _without_overlaps(fitted: list[FittedBox], unfitted: dict[str, str]) -> list[FittedBox]:
     """The fitted boxes, best fits first, leaving out each that overlaps an accepted one by more
     than a scene allows (:data:`~unstack.plausibility.REFUSED_OVERLAP`; its reason goes to ``unfitted``)."""
-    from unstack.plausibility import REFUSED_OVERLAP, overlapping_pairs
+    from unstack.checks import REFUSED_OVERLAP
+    from unstack.geometry import overlapping_pairs
 
     accepted: list[FittedBox] = []
     for item in sorted(fitted, key=lambda item: (-item.fill, item.size_error_m, item.box.id)):
