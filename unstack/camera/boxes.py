@@ -50,6 +50,10 @@ DUPLICATE_SHARE = 0.5
 MIN_FACE_POINTS = 30
 #: A mask is fitted from its top face when the top plane holds at least this share of its points.
 TOP_SHARE = 0.15
+#: A face covering less than this share of its rectangle was seen in part ...
+PARTIAL_FILL = 0.8
+#: ... as was one whose matched size reaches more than this beyond its measured edges (metres).
+PARTIAL_EDGE = 0.03
 #: An edge measured longer than a known size's costs this many times one measured shorter.
 OVERSIZE_WEIGHT = 4.0
 #: Known sizes whose top edges differ from the rectangle's by less than this (metres, summed)
@@ -74,6 +78,10 @@ class FittedBox:
         Summed difference between the face's measured edges and the matched known size's.
     points : int
         Points of the mask.
+    partial : bool
+        The face was seen in part (it covers less than :data:`PARTIAL_FILL` of its rectangle,
+        or the matched size reaches more than :data:`PARTIAL_EDGE` beyond what was seen): the
+        centre is placed from the part seen and may be off by up to the missing length.
     """
 
     box: Box
@@ -82,6 +90,7 @@ class FittedBox:
     fill: float
     size_error_m: float
     points: int
+    partial: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -91,6 +100,7 @@ class FittedBox:
             "fill": self.fill,
             "size_error_m": self.size_error_m,
             "points": self.points,
+            "partial": self.partial,
         }
 
 
@@ -245,8 +255,9 @@ def _fit_from_top(
     if turned:
         yaw += np.pi / 2
         size = np.array([size[1], size[0], size[2]])
+    partial = fill < PARTIAL_FILL or bool(np.any(np.sort(size[:2])[::-1] - extents > PARTIAL_EDGE))
     box = Box(box_id, size, [centre[0], centre[1], top - size[2] / 2], _yaw_quaternion(yaw))
-    return FittedBox(box, "top", residual, fill, size_error, len(points))
+    return FittedBox(box, "top", residual, fill, size_error, len(points), partial)
 
 
 def _spacing(xy: np.ndarray) -> float:
@@ -306,7 +317,8 @@ def _fit_from_front(
     yaw = float(np.arctan2(horizontal[1], horizontal[0]))
     size = np.array([depth, face_width, face_height])
     box = Box(box_id, size, [centre[0], centre[1], low + face_height / 2], _yaw_quaternion(yaw))
-    return FittedBox(box, "front", residual, 1.0, float(size_error), len(points))
+    partial = bool(face_width - width > PARTIAL_EDGE or face_height - (high - low) > PARTIAL_EDGE)
+    return FittedBox(box, "front", residual, 1.0, float(size_error), len(points), partial)
 
 
 def _faces(size: Sequence[float]) -> list[tuple[float, float, float]]:

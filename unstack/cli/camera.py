@@ -149,6 +149,9 @@ def scene(
             f"{100 * item.fill:.0f} %" if item else "-",
         )  # fmt: skip
     console.print(table)
+    partial = [item.box.id for item in built.fitted if item.partial]
+    if partial:
+        console.print(f"seen in part (the pose is placed from the part seen): {', '.join(partial)}")
     for duplicate, kept in built.duplicates.items():
         console.print(f"left out {duplicate}: its mask lies mostly inside {kept}'s (a duplicate detection)")
     for box_id, reason in built.unfitted.items():

@@ -558,11 +558,11 @@ def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, pi
     table.add_row(
         "yaw error (degrees)", f"{summary['yaw_error_deg_median']:.1f}", f"{summary['yaw_error_deg_p90']:.1f}"
     )
-    if summary["well_seen_boxes"]:
+    if summary["whole_boxes"]:
         table.add_row(
-            f"position error of the {summary['well_seen_boxes']} boxes seen by 1,500+ pixels (mm)",
-            f"{1000 * summary['well_seen_position_error_m_median']:.1f}",
-            f"{1000 * summary['well_seen_position_error_m_p90']:.1f}",
+            f"position error of the {summary['whole_boxes']} boxes whose face was seen whole (mm)",
+            f"{1000 * summary['whole_position_error_m_median']:.1f}",
+            f"{1000 * summary['whole_position_error_m_p90']:.1f}",
         )
     Console().print(table)
     click.echo(

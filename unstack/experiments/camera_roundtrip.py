@@ -3,10 +3,10 @@
 Each pile of a simulated data set is rendered as a robot's camera would hand it over
 (:func:`unstack.sim.camera_view.camera_view`: depth image, intrinsics, pose, one mask per
 seen box); :func:`unstack.camera.scene_from_depth` builds the scene back with the data set's
-carton sizes as the known sizes. Per fitted box (and for the boxes seen by at least
-:data:`WELL_SEEN_POINTS` pixels alone): the position error (metres), the yaw error
+carton sizes as the known sizes. Per fitted box: the position error (metres), the yaw error
 (degrees, modulo the top face's symmetry: 180 degrees, 90 for a square top), whether the
-size is the true one, and the fit's residual. Per pile: whether the default decision on the
+size is the true one, and the fit's residual; the errors also for the boxes whose face was
+seen whole alone (:attr:`unstack.camera.FittedBox.partial`, what the fit itself says). Per pile: whether the default decision on the
 built scene picks the same box as on the true poses (the same masks detected).
 
 Examples
@@ -26,11 +26,7 @@ import numpy as np
 
 from unstack.experiments.dispatch import run_unordered
 
-__all__ = ["WELL_SEEN_POINTS", "camera_roundtrip", "yaw_error_deg"]
-
-#: A box whose mask holds at least this many points with depth is "well seen" (the figures are
-#: also given for these alone: a sliver of a top or a side between two boxes fixes no pose).
-WELL_SEEN_POINTS = 1500
+__all__ = ["camera_roundtrip", "yaw_error_deg"]
 
 
 def yaw_error_deg(truth_xyzw: np.ndarray, fitted_xyzw: np.ndarray, square_top: bool) -> float:
@@ -129,7 +125,7 @@ def camera_roundtrip(
     boxes = [box for result in done for box in result["boxes"]]
     position = np.array([box["position_error_m"] for box in boxes])
     yaw = np.array([box["yaw_error_deg"] for box in boxes])
-    well_seen = np.array([box["points"] >= WELL_SEEN_POINTS for box in boxes], dtype=bool)
+    whole = np.array([not box["partial"] for box in boxes], dtype=bool)
     summary = {
         "piles": len(done),
         "masks": int(sum(result["masks"] for result in done)),
@@ -138,10 +134,10 @@ def camera_roundtrip(
         "position_error_m_p90": float(np.percentile(position, 90)),
         "yaw_error_deg_median": float(np.median(yaw)),
         "yaw_error_deg_p90": float(np.percentile(yaw, 90)),
-        "well_seen_boxes": int(well_seen.sum()),
-        "well_seen_position_error_m_median": float(np.median(position[well_seen])) if well_seen.any() else None,
-        "well_seen_position_error_m_p90": float(np.percentile(position[well_seen], 90)) if well_seen.any() else None,
-        "well_seen_yaw_error_deg_p90": float(np.percentile(yaw[well_seen], 90)) if well_seen.any() else None,
+        "whole_boxes": int(whole.sum()),
+        "whole_position_error_m_median": float(np.median(position[whole])) if whole.any() else None,
+        "whole_position_error_m_p90": float(np.percentile(position[whole], 90)) if whole.any() else None,
+        "whole_yaw_error_deg_p90": float(np.percentile(yaw[whole], 90)) if whole.any() else None,
         "size_right_share": float(np.mean([box["size_right"] for box in boxes])),
         "residual_m_median": float(np.median([box["residual_m"] for box in boxes])),
         "top_faces_share": float(np.mean([box["face"] == "top" for box in boxes])),
