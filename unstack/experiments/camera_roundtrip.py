@@ -6,8 +6,9 @@ seen box); :func:`unstack.camera.scene_from_depth` builds the scene back with th
 carton sizes as the known sizes. Per fitted box: the position error (metres), the yaw error
 (degrees, modulo the top face's symmetry: 180 degrees, 90 for a square top), whether the
 size is the true one, and the fit's residual; the errors also for the boxes whose face was
-seen whole alone (:attr:`unstack.camera.FittedBox.partial`, what the fit itself says). Per pile: whether the default decision on the
-built scene picks the same box as on the true poses (the same masks detected).
+seen whole alone (:attr:`unstack.camera.FittedBox.partial`, what the fit itself says). Per
+pile: whether the default decision on the built scene picks the same box as on the true
+poses (the same masks detected).
 
 Examples
 --------
