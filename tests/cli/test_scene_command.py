@@ -79,3 +79,11 @@ def test_a_cloud_without_detections_is_one_line(tmp_path: Path) -> None:
     np.save(tmp_path / "cloud.npy", np.zeros((200, 3)))
     run = unstack("scene", "--cloud", str(tmp_path / "cloud.npy"), "--out", str(tmp_path / "scene.json"))
     assert run.returncode == 2 and "--cloud needs --detections" in run.stderr
+
+
+def test_a_depth_image_and_detections_make_a_scene(camera_files: list[str], tmp_path: Path) -> None:
+    (tmp_path / "boxes.json").write_text(json.dumps([{"id": "a", "center": [0, 0, 0.15], "size": [0.4, 0.3, 0.3]}]))
+    depth_only = [argument for argument in camera_files if "mask-" not in argument]
+    run = unstack("scene", *depth_only, "--detections", str(tmp_path / "boxes.json"), "--out", str(tmp_path / "s.json"))
+    assert run.returncode == 0, run.stderr
+    assert json.loads((tmp_path / "s.json").read_text())["detected"] == ["a"]

@@ -34,6 +34,13 @@ def _sizes(text: str | None) -> list[tuple[float, float, float]] | None:
     return sizes
 
 
+def _require_depth(depth_file: str | None, intrinsics_file: str | None, pose_file: str | None, what: str) -> None:
+    missing = [name for name, value in (("--depth", depth_file), ("--intrinsics", intrinsics_file),
+                                        ("--pose", pose_file)) if value is None]  # fmt: skip
+    if missing:
+        raise UnstackError(f"{what} with a depth image need {', '.join(missing)} (or give --cloud and --detections)")
+
+
 def _mask_id(path: str) -> str:
     """A box id from a mask file's name: ``masks/mask-b07.png`` -> ``b07``."""
     stem = Path(path).stem
@@ -68,7 +75,7 @@ def _door(text: str | None) -> list[float] | None:
 @click.option("--cloud", "cloud_file", default=None, type=click.Path(dir_okay=False),
               help="Instead of a depth image and masks: a point cloud (.npy, .ply or .pcd), z roughly up.")  # fmt: skip
 @click.option("--detections", "detections_file", default=None, type=click.Path(dir_okay=False),
-              help='With --cloud: JSON boxes [{"id", "center", "size", "yaw_deg"}] in the cloud\'s frame.')  # fmt: skip
+              help='Instead of masks: JSON boxes [{"id", "center", "size", "yaw_deg"}] in the world frame.')  # fmt: skip
 @click.option("--ids", default=None,
               help="Comma-separated box ids, one per mask (default: the file names without mask-).")  # fmt: skip
 @click.option("--sizes", default=None, help="Known carton sizes, e.g. 0.255x0.155x0.1,0.34x0.25x0.095 (metres).")
@@ -101,26 +108,30 @@ def scene(
     if target.suffix.lower() != ".json":
         raise UnstackError(f"--out: expected a .json file name, got {out!r}")
     direction = _door(door)
-    if cloud_file is not None:
-        if mask_files or depth_file or intrinsics_file:
-            raise UnstackError("--cloud takes box detections (--detections), not a depth image, intrinsics or masks")
-        if detections_file is None:
-            raise UnstackError("--cloud needs --detections: the boxes a 3-D detector found in the cloud")
-        from unstack.camera import load_cloud, load_detections, scene_from_cloud
+    if detections_file is not None:  # boxes a detector found: the cloud, or the depth image's points, gives gravity
+        if mask_files:
+            raise UnstackError("give masks or --detections, not both")
+        from unstack.camera import depth_points, load_cloud, load_detections, scene_from_cloud
 
-        cloud = load_cloud(cloud_file)
-        if pose_file is not None:
-            from unstack.camera import load_pose
-
-            pose = load_pose(pose_file)
-            cloud = cloud @ pose[:3, :3].T + pose[:3, 3]
+        if cloud_file is not None:
+            if depth_file or intrinsics_file:
+                raise UnstackError("give --cloud or a depth image (--depth, --intrinsics, --pose), not both")
+            cloud = load_cloud(cloud_file)
+            if pose_file is not None:
+                pose = load_pose(pose_file)
+                cloud = cloud @ pose[:3, :3].T + pose[:3, 3]
+        else:
+            _require_depth(depth_file, intrinsics_file, pose_file, "--detections")
+            assert depth_file is not None and intrinsics_file is not None and pose_file is not None
+            cloud = depth_points(load_depth(depth_file, units=depth_units), load_intrinsics(intrinsics_file),
+                                 load_pose(pose_file))  # fmt: skip
         built = scene_from_cloud(cloud, load_detections(detections_file), door=direction, seed=seed)
+    elif cloud_file is not None:
+        raise UnstackError("--cloud needs --detections: the boxes a 3-D detector found in the cloud")
     else:
-        missing = [name for name, value in (("--depth", depth_file), ("--intrinsics", intrinsics_file),
-                                            ("--pose", pose_file)) if value is None]  # fmt: skip
-        if missing or not mask_files:
-            needed = ", ".join(missing + ([] if mask_files else ["mask files"]))
-            raise UnstackError(f"a depth image needs {needed} (or give --cloud and --detections instead)")
+        _require_depth(depth_file, intrinsics_file, pose_file, "mask files")
+        if not mask_files:
+            raise UnstackError("give one mask file per detected box, or --detections")
         assert depth_file is not None and intrinsics_file is not None and pose_file is not None
         names = [name.strip() for name in ids.split(",")] if ids else [_mask_id(path) for path in mask_files]
         if len(names) != len(mask_files):
