@@ -75,7 +75,7 @@ def _door(text: str | None) -> list[float] | None:
 @click.option("--cloud", "cloud_file", default=None, type=click.Path(dir_okay=False),
               help="Instead of a depth image and masks: a point cloud (.npy, .ply or .pcd), z roughly up.")  # fmt: skip
 @click.option("--detections", "detections_file", default=None, type=click.Path(dir_okay=False),
-              help='Instead of masks: JSON boxes [{"id", "center", "size", "yaw_deg"}] in the world frame.')  # fmt: skip
+              help='Instead of masks: JSON boxes [{"id", "center", "size", "yaw_deg"}] (world frame).')  # fmt: skip
 @click.option("--ids", default=None,
               help="Comma-separated box ids, one per mask (default: the file names without mask-).")  # fmt: skip
 @click.option("--sizes", default=None, help="Known carton sizes, e.g. 0.255x0.155x0.1,0.34x0.25x0.095 (metres).")
