@@ -209,7 +209,7 @@ def fit_box(
     normal, offset, inliers = fit_plane(points, rng=rng, near_normal=up)
     if inliers.sum() >= max(MIN_FACE_POINTS, TOP_SHARE * len(points)):
         return _fit_from_top(box_id, points, normal, offset, inliers, known_sizes, surfaces, rng)
-    return _fit_from_front(box_id, points, known_sizes, surfaces, rng)
+    return _fit_from_front(box_id, points, known_sizes, rng)
 
 
 def _fit_from_top(
@@ -285,7 +285,6 @@ def _fit_from_front(
     box_id: str,
     points: np.ndarray,
     known_sizes: Sequence[Sequence[float]] | None,
-    surfaces: Sequence[float],
     rng: np.random.Generator,
 ) -> FittedBox:
     """A box seen from the front only: its vertical face gives yaw, width and height."""

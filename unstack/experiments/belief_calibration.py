@@ -53,16 +53,15 @@ def _calibrate_pile(path: Path, number: int, options: dict[str, Any]) -> tuple[i
         expected = belief_removals(current, worlds=options["worlds"], seed=options["seed"])
         resting = {box_id: float(bounding_boxes([current.box(box_id)])[0, 2]) for box_id in current.detected}
 
-        def calmest(moves: Callable[[str], float]) -> str:
-            return min(current.detected, key=lambda box_id: (moves(box_id), -resting[box_id], box_id))
-
         highest = max(current.detected, key=lambda box_id: (resting[box_id], box_id))
         means = {box_id: expected[box_id].expected_moved for box_id in current.detected}
         picks = {
             "highest": highest,
             "belief": choose_by_expected_moves(means, resting, "fewest"),
             "belief_veto": choose_by_expected_moves(means, resting, "veto"),
-            "lookahead": calmest(lambda box_id: outcomes[box_id].boxes_moved),
+            "lookahead": choose_by_expected_moves(
+                {box_id: float(outcomes[box_id].boxes_moved) for box_id in current.detected}, resting, "fewest"
+            ),
         }
         pairs.extend((expected[box_id].expected_moved, outcomes[box_id].boxes_moved) for box_id in current.detected)
         states.append({rule: outcomes[box_id].boxes_moved for rule, box_id in picks.items()})
