@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from unstack.reasoner.reasons import REASON_MIN_PROBABILITY, pick_reasons
 from unstack.scene import Scene
 from unstack.supports import Supports
 
@@ -53,43 +54,6 @@ MOVES_VETO = 0.5
 #: compiled walk of 8 boxes takes about a second, sampling them 30 ms, and the disturbance
 #: model reads marginals as features, not as the cost itself.
 MOVES_EXACT_MAX_BOXES = 7
-#: Support relations below this conditional probability are not named as a reason.
-REASON_MIN_PROBABILITY = 0.2
-#: At most this many relations are named per box.
-REASONS_PER_BOX = 3
-
-
-def pick_reasons(supports: Supports, marginals: np.ndarray, moves: np.ndarray) -> list[dict[str, Any]]:
-    """What drives each box's cost: the boxes it holds up (conditional P), its hidden load.
-
-    Returns, per object: ``box``, ``expected_moves``, ``holds_up`` (up to
-    :data:`REASONS_PER_BOX` ``[box, P]`` pairs with P at least :data:`REASON_MIN_PROBABILITY`,
-    largest first), ``hidden_load`` and ``held_by`` (the box most likely holding it up, with P).
-
-    Examples
-    --------
-    >>> supports = Supports(["a", "b"], [[0, 0.8], [0.1, 0]], hidden_load=[0.0, 0.5])
-    >>> pick_reasons(supports, np.array([[0, 0.8], [0.1, 0]]), np.array([1.2, 0.4]))[0]["holds_up"]
-    [['b', 0.8]]
-    """
-    objects = supports.objects
-    hidden = np.zeros(len(objects)) if supports.hidden_load is None else np.asarray(supports.hidden_load)
-    reasons = []
-    for k, box_id in enumerate(objects):
-        row = [(objects[j], float(marginals[k, j])) for j in range(len(objects)) if j != k]
-        held = [(objects[j], float(marginals[j, k])) for j in range(len(objects)) if j != k]
-        strongest = sorted((pair for pair in row if pair[1] >= REASON_MIN_PROBABILITY), key=lambda pair: -pair[1])
-        holder = max(held, key=lambda pair: pair[1], default=None)
-        reasons.append(
-            {
-                "box": box_id,
-                "expected_moves": round(float(moves[k]), 4),
-                "holds_up": [[other, round(p, 3)] for other, p in strongest[:REASONS_PER_BOX]],
-                "hidden_load": round(float(hidden[k]), 3),
-                "held_by": None if holder is None else [holder[0], round(holder[1], 3)],
-            }
-        )
-    return reasons
 
 
 def choose_on_moves(

@@ -242,3 +242,16 @@ def test_near_ties_on_supports_without_heights_exit_2() -> None:
     result = unstack("decide", PILE5, "--near-ties", "0.1")
     assert result.returncode == 2 and result.stderr.count("\n") == 1
     assert "carry no heights" in result.stderr and "stack5.supports.json" in result.stderr
+
+
+def test_decide_says_why_for_the_pick_and_the_runner_up(tmp_path: Path) -> None:
+    path = tmp_path / "two.supports.json"
+    path.write_text(
+        json.dumps(
+            {"format": "unstack.supports/1", "objects": ["top", "bottom"], "probabilities": [[0, 0.1], [0.9, 0]]}
+        )
+    )
+    result = unstack("decide", str(path))
+    assert result.returncode == 0, result.stderr
+    assert "pick top: expected to move 0.10 boxes (it rests on bottom: P 0.90)" in result.stdout
+    assert "runner-up bottom: expected to move 0.90 boxes (bottom holds up top: P 0.90)" in result.stdout

@@ -31,6 +31,12 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     knows the true pile: tries every candidate's removal in the physics engine (in the world
     itself, undone after each try: :func:`unstack.sim.unloading.probe_removals`) and takes the
     one that moves the fewest boxes, ties to the box resting highest (the floor no policy can pass; slow).
+``rebuilt``
+    an oracle between the look-ahead and the robot: every box of the true pile (seen or
+    not) at its pose and mass in a fresh world, settled, each candidate's removal tried
+    there (:func:`unstack.sim.unloading.rebuilt_removals`); the fewest moved, ties to the box
+    resting highest. It knows the pile's poses but not its state: what it loses against the
+    look-ahead no perception of poses can win.
 ``moves``
     the learned cost of what a pick moves (:mod:`unstack.moves`): the default model's
     probabilities and the reasoner's marginals through the disturbance model; the fewest.
@@ -72,7 +78,8 @@ __all__ = ["CONTAINER_MAKERS", "CONTAINER_SAMPLES", "container_experiment", "con
 
 CONTAINER_MAKERS = (
     "unstack", "min_cost", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random", "lookahead",
-    "moves", "moves_veto", "belief", "belief_veto",
+    "moves", "moves_veto", "belief", "belief_veto", "rebuilt",
+    "rebuilt_typical", "belief_seen",
 )  # fmt: skip
 #: Makers whose policy is told what every candidate's removal does in the engine (the true pile).
 PROBING_MAKERS = ("lookahead",)
@@ -148,6 +155,26 @@ def container_policies(
         resting = {box_id: float(bounding_boxes([scene.box(box_id)])[0, 2]) for box_id in scene.detected}
         return min(scene.detected, key=lambda box_id: (outcomes[box_id].boxes_moved, -resting[box_id], box_id))
 
+    def rebuilding(true_masses: bool) -> Callable[[Scene], str]:
+        def policy(scene: Scene) -> str:
+            from unstack.sim.unloading import rebuilt_removals
+
+            return lookahead(scene, rebuilt_removals(scene, true_masses=true_masses))
+
+        return policy
+
+    def belief_seen(scene: Scene) -> str:
+        import dataclasses
+
+        from unstack.geometry import bounding_boxes
+        from unstack.sim.belief import belief_removals, choose_by_expected_moves, seen_boxes
+
+        seen = sorted(set(seen_boxes(scene)) | set(scene.detected), key=scene.box_ids.index)
+        outcomes = belief_removals(dataclasses.replace(scene, detected=tuple(seen)), scene.detected, seed=seed)
+        resting = {box_id: float(bounding_boxes([scene.box(box_id)])[0, 2]) for box_id in scene.detected}
+        expected = {box_id: outcome.expected_moved for box_id, outcome in outcomes.items()}
+        return choose_by_expected_moves(expected, resting, "fewest")
+
     loaded: list[Any] = []
 
     def moving(rule: str) -> Callable[[Scene], str]:
@@ -190,6 +217,9 @@ def container_policies(
         "moves_veto": moving("veto"),
         "belief": believing("fewest"),
         "belief_veto": believing("veto"),
+        "rebuilt": rebuilding(True),
+        "rebuilt_typical": rebuilding(False),
+        "belief_seen": belief_seen,
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:

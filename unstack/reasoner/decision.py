@@ -47,6 +47,7 @@ from unstack.reasoner.confidence import choice_probability
 from unstack.reasoner.costs import COSTS, DEFAULT_COST, cost_weights, expected_costs, own_costs
 from unstack.reasoner.marginals import EXACT_MAX_BOXES
 from unstack.reasoner.pruning import Evidence, propagate_evidence
+from unstack.reasoner.reasons import REASON_COSTS, pick_reasons
 from unstack.reasoner.reuse import WARM_BURN_IN, WorkCache
 from unstack.reasoner.sampling import SampledMarginals
 from unstack.supports import Supports
@@ -137,8 +138,10 @@ class Decision:
     near_tie_margin : float
         The near-tie margin the choice was made with (0: Eq. 13's minimum).
     reasons : tuple of dict
-        With the ``moves`` cost (:mod:`unstack.moves`): per box, its expected boxes moved and
-        what drives it (the boxes it holds up with their conditional P, its hidden load).
+        With a cost that counts boxes (:data:`~unstack.reasoner.reasons.REASON_COSTS`): per
+        box, the boxes it is expected to move as the cost counts them and what drives that
+        (the boxes it holds up with their conditional P, its hidden load, the box most likely
+        holding it up; :func:`~unstack.reasoner.reasons.pick_reasons`).
     disturbance_model : str
         With the ``moves`` cost: the disturbance model file the expected moves came from.
     model : str
@@ -253,6 +256,7 @@ class Decision:
             data["choice_probability"] = self.choice_probability
         if self.reasons:
             data["reasons"] = [dict(reason) for reason in self.reasons]
+        if self.disturbance_model:
             data["disturbance_model"] = self.disturbance_model
         if self.sampling is not None:
             data["sampling"] = self.sampling
@@ -612,6 +616,7 @@ def decide(
         warnings=_model_warnings(supports) + ((sampling["warning"],) if sampling and "warning" in sampling else ()),
         sampling_seconds=sum(result.sampled.seconds for result in results if result.sampled is not None),
         near_tie_margin=margin,
+        reasons=tuple(pick_reasons(supports, marginals, costs)) if cost in REASON_COSTS else (),
     )
 
 

@@ -62,6 +62,7 @@ __all__ = [
     "belief_choice",
     "belief_removals",
     "choose_by_expected_moves",
+    "seen_boxes",
     "unseen_supports",
 ]
 
@@ -85,6 +86,10 @@ BELIEF_RULES = ("fewest", "veto")
 BELIEF_VETO = 1.0
 #: Belief worlds per decision (:func:`belief_removals`).
 BELIEF_WORLDS = 4
+#: A box with at least this many cloud points on it (within :data:`SEEN_MARGIN`) is seen.
+SEEN_POINTS = 20
+#: How far from a box's surface (metres) a cloud point still lies on it.
+SEEN_MARGIN = 0.005
 
 
 @dataclass(frozen=True)
@@ -198,6 +203,28 @@ def belief_blocks(scene: Scene, detected: Sequence[str] | None = None) -> list[B
         center = np.array([*((upper + lower) / 2), bounds[k, 5] + CLEARANCE + size[2] / 2])
         carried.append(BeliefBlock(size, center, ids[k]))
     return fixed + carried
+
+
+def seen_boxes(scene: Scene) -> list[str]:
+    """The boxes of the scene the point cloud shows: at least :data:`SEEN_POINTS` points on each.
+
+    A detector that reports every box in view reports these; the scene's ``detected`` may be
+    fewer (the container experiment hands its policies the reachable ones).
+
+    Examples
+    --------
+    >>> from unstack.scene import Box, Scene
+    >>> from unstack.clouds import surface_cloud
+    >>> front = Box("front", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2])
+    >>> behind = Box("behind", [0.4, 0.4, 0.4], [1.4, 0.0, 0.2])
+    >>> seen_boxes(Scene([front, behind], surface_cloud([front], viewpoint=[-2.0, 0.0, 0.2], seed=0), ["front"]))
+    ['front']
+    """
+    from unstack.geometry import points_in_box
+
+    return [
+        box.id for box in scene.boxes if int(points_in_box(scene.points, box, margin=SEEN_MARGIN).sum()) >= SEEN_POINTS
+    ]
 
 
 def _settings(scene: Scene, settings: Any) -> Any:

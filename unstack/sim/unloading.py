@@ -39,6 +39,7 @@ __all__ = [
     "fallen_boxes",
     "probe_removals",
     "reachable_boxes",
+    "rebuilt_removals",
     "unload_container",
 ]
 
@@ -466,6 +467,47 @@ def probe_removals(
         world.client.restoreState(stateId=state)
         world.client.removeState(state)
     return outcomes
+
+
+def rebuilt_removals(
+    scene: Scene, candidates: Sequence[str] | None = None, *, true_masses: bool = True
+) -> dict[str, UnloadStep]:
+    """What taking out each candidate would do in a fresh world rebuilt from the scene's poses.
+
+    Every box of ``scene`` (detected or not) is put in a new physics world at its pose, with
+    its mass (the settings' mean where it has none), the world settles for
+    :data:`RESETTLE_SECONDS`, and each candidate's removal is tried there as
+    :func:`probe_removals` tries it. This is an oracle that knows the whole pile's poses and
+    masses but not its state (velocities, contacts, a creep under way): beside the physics
+    look-ahead (the world itself) it measures how much of the look-ahead's edge any
+    perception of poses could reach.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene with every box of the pile (the container experiment hands its policies one)
+        and simulation settings in its metadata.
+    candidates : sequence of str, optional
+        Boxes to try (default: the scene's detected boxes).
+    true_masses : bool
+        Each box with its own mass; False: every box of the settings' mean mass (what a
+        robot that sees every pose but weighs nothing would build).
+
+    Returns
+    -------
+    dict of str to UnloadStep
+    """
+    from unstack.sim.world import PhysicsWorld
+
+    settings = _scene_settings(scene)
+    tried = list(scene.detected if candidates is None else candidates)
+    with PhysicsWorld(settings, door=False) as world:
+        typical = float(np.mean(settings.pile.mass_range))
+        for box in scene.boxes:
+            mass = box.mass if box.mass is not None and true_masses else typical
+            world.add_box(box.size, box.position, box.orientation_xyzw, mass=mass)
+        world.step(RESETTLE_SECONDS)
+        return probe_removals(scene, world, scene.box_ids, tried)
 
 
 def fallen_boxes(before: np.ndarray, before_turn: np.ndarray, after: np.ndarray, after_turn: np.ndarray) -> np.ndarray:
