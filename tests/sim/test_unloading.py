@@ -211,3 +211,24 @@ def test_a_box_blocked_in_front_and_on_top_is_out_of_reach() -> None:
     boxes = [blocked, in_front, on_top, beside]
     assert reachable_boxes(boxes, ["blocked", "in_front", "on_top", "beside"]) == ["in_front", "on_top", "beside"]
     assert reachable_boxes(boxes, ["blocked"], "any") == ["blocked"]
+
+
+def test_a_rebuilt_pile_moves_what_the_ground_truth_says_a_removal_moves(pile: Scene) -> None:
+    from unstack.sim.unloading import rebuilt_removals
+
+    outcomes = rebuilt_removals(pile, pile.box_ids)
+    assert set(outcomes) == set(pile.box_ids)
+    truth = pile.ground_truth
+    assert truth is not None and truth.any(), "the fixture pile has a box that holds another up"
+    for i, box_id in enumerate(pile.box_ids):
+        held_up = {pile.box_ids[j] for j in np.flatnonzero(truth[i])}
+        assert held_up <= set(outcomes[box_id].moved), (box_id, held_up, outcomes[box_id].moved)
+    typical = rebuilt_removals(pile, pile.box_ids, true_masses=False)
+    assert set(typical) == set(pile.box_ids)
+
+
+def test_rebuilding_names_only_boxes_of_the_scene(pile: Scene) -> None:
+    from unstack.sim.unloading import rebuilt_removals
+
+    with pytest.raises(UnstackError, match=r"candidates \['nowhere'\] are not boxes of the scene"):
+        rebuilt_removals(pile, ["nowhere"])

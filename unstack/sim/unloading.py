@@ -501,6 +501,9 @@ def rebuilt_removals(
 
     settings = _scene_settings(scene)
     tried = list(scene.detected if candidates is None else candidates)
+    unknown = [box_id for box_id in tried if box_id not in scene.box_ids]
+    if unknown:
+        raise UnstackError(f"{scene.source}: candidates {unknown} are not boxes of the scene")
     with PhysicsWorld(settings, door=False) as world:
         typical = float(np.mean(settings.pile.mass_range))
         for box in scene.boxes:
