@@ -3,7 +3,7 @@
 For the first ``--piles`` piles of each data set, ``--isets`` random ISets of ``--r`` detected
 boxes are drawn (seeded by the pile's number); every box of an ISet is scored: the truth is
 the number of boxes outside the ISet that it supports (removal ground truth), the estimate
-:func:`unstack.hidden_load.hidden_load` with the ISet as the detected boxes. Printed per data
+:func:`unstack.understanding.hidden_load.hidden_load` with the ISet as the detected boxes. Printed per data
 set: the Pearson correlation, the share of loaded boxes (truth at least 1) whose estimate is
 above 0.5 and the share of unloaded boxes whose estimate is above 0.5 (false alarms).
 
@@ -19,8 +19,8 @@ import argparse
 import numpy as np
 
 from unstack.datasets import require_configurations
-from unstack.hidden_load import hidden_load
 from unstack.scene import load_scene
+from unstack.understanding.hidden_load import hidden_load
 
 
 def score(data: str, piles: int, isets: int, r: int) -> dict[str, float]:

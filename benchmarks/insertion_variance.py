@@ -48,7 +48,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from intrinsic_variance import autocorrelation_time
 
 from unstack.learning.model_file import default_model_path, load_model
-from unstack.learning.probabilities import scene_support_probabilities
+from unstack.pipeline import scene_support_probabilities
 from unstack.reasoner.insertion import insertion_row_marginals
 from unstack.reasoner.sampling import sample_worlds, sampled_marginals
 from unstack.scene import load_scene

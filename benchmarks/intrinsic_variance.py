@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from unstack.learning.model_file import default_model_path, load_model
-from unstack.learning.probabilities import scene_support_probabilities
+from unstack.pipeline import scene_support_probabilities
 from unstack.reasoner.sampling import sample_worlds
 from unstack.scene import load_scene
 

@@ -142,7 +142,7 @@ def part_blocks(sizes: list[int], seeds: int, time_limit: float) -> list[dict[st
 def scene_matrices(dataset: Path) -> dict[str, np.ndarray]:
     """The shipped model's support probabilities for every box of every configuration."""
     from unstack.learning.model_file import default_model_path, load_model
-    from unstack.learning.probabilities import scene_support_probabilities
+    from unstack.pipeline import scene_support_probabilities
     from unstack.scene import load_scene
 
     model = load_model(default_model_path())

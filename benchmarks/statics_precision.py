@@ -2,9 +2,9 @@
 
 For every pile of the given data sets (``unstack simulate`` folders, with removal labels) and
 several detected sets per pile (every box, and random sets of 5 and 10), the leaning rule of
-:mod:`unstack.statics` is run on the detected boxes. Each finding "X holds Y up" is checked
+:mod:`unstack.understanding.statics` is run on the detected boxes. Each finding "X holds Y up" is checked
 against the removal label (did Y move when X was taken away?): the share that holds is the
-rule's precision, the figure :data:`unstack.statics.LEAN_SUPPORT_PROBABILITY` stands for.
+rule's precision, the figure :data:`unstack.understanding.statics.LEAN_SUPPORT_PROBABILITY` stands for.
 Then the default decision is made with and without statics, and the box each picks is
 scored by the ground truth: how many boxes it really holds up (directly or not), and whether
 it holds any.
@@ -27,10 +27,10 @@ import numpy as np
 
 from unstack.atomic import atomic_write_text
 from unstack.learning.model_file import default_model_path, load_model
-from unstack.learning.probabilities import scene_support_probabilities
+from unstack.pipeline import scene_support_probabilities
 from unstack.reasoner.decision import decide
 from unstack.scene import load_scene
-from unstack.statics import LEAN_SUPPORT_PROBABILITY, leaning_supports
+from unstack.understanding.statics import LEAN_SUPPORT_PROBABILITY, leaning_supports
 
 
 def _detected_sets(n: int, sets: int, rng: np.random.Generator) -> list[list[int]]:

@@ -4,10 +4,13 @@ Every ``import`` counts, at module level or inside a function (imports under
 ``if TYPE_CHECKING:`` count for the layers but not for cycles, since they never run).
 
 - the data model (``scene``, ``supports``, formats, checks, errors, geometry, atomic
-  writes, data-set folders, ... -- the modules directly under ``unstack/``) at the bottom;
-- ``reasoner``, ``learning``, ``sim`` and ``pictures`` above it, none importing another;
-- the public API (``unstack``, ``api``, ``describe``, ``moves``, ``validation``, ``warmup``) above those;
-- ``experiments`` above that; ``cli`` on top.
+  writes, data-set folders, camera files, ... -- the modules directly under ``unstack/``) at the bottom;
+- scene understanding (``understanding``: plausibility, statics, hidden load, clouds, the
+  detector model) above it;
+- ``reasoner``, ``learning``, ``sim`` and ``pictures`` above that, none importing another;
+- the recipe scene -> probabilities (``pipeline``) above those;
+- the public API (``unstack``, ``api``, ``describe``, ``moves``, ``validation``, ``warmup``) above that;
+- ``experiments`` above the API; ``cli`` on top.
 """
 
 from __future__ import annotations
@@ -78,15 +81,19 @@ def layer(module: str) -> tuple[int, str]:
     """``(level, group)``: a module may import its own group and any lower level."""
     parts = module.split(".")
     if module in API:
-        return 2, "api"
+        return 4, "api"
     if len(parts) == 2 and parts[1] == "__main__":
-        return 4, "cli"
+        return 6, "cli"
+    if len(parts) >= 2 and parts[1] == "understanding":
+        return 1, "understanding"
     if len(parts) >= 2 and parts[1] in MIDDLE:
-        return 1, parts[1]
+        return 2, parts[1]
+    if len(parts) >= 2 and parts[1] == "pipeline":
+        return 3, "pipeline"
     if len(parts) >= 2 and parts[1] == "experiments":
-        return 3, "experiments"
+        return 5, "experiments"
     if len(parts) >= 2 and parts[1] == "cli":
-        return 4, "cli"
+        return 6, "cli"
     return 0, "data model"
 
 
@@ -116,6 +123,13 @@ def test_the_graph_is_read_from_the_code_with_function_level_imports() -> None:
         ("unstack.experiments.unloading", "unstack.sim.unloading", True),
         ("unstack.cli.main", "unstack.api", True),
         ("unstack.api", "unstack.cli.main", False),
+        ("unstack.understanding.statics", "unstack.learning.features", False),
+        ("unstack.scene", "unstack.understanding.plausibility", False),
+        ("unstack.learning.training_data", "unstack.understanding.detector", True),
+        ("unstack.learning.features", "unstack.pipeline", False),
+        ("unstack.pipeline", "unstack.learning.features", True),
+        ("unstack.pipeline", "unstack.understanding.statics", True),
+        ("unstack.reasoner.decision", "unstack.pipeline", False),
     ],
 )
 def test_the_rule_tells_a_wrong_arrow_from_a_right_one(source: str, target: str, expected: bool) -> None:
@@ -173,5 +187,32 @@ def test_the_data_model_takes_no_scene_understanding() -> None:
     """``scene`` refuses impossible input with the limits of ``checks`` and ``geometry``; it never
     imports ``plausibility``, which warns about scenes (the circle scene -> plausibility -> geometry -> scene)."""
     pairs = {(edge.source, edge.target) for edge in EDGES}
-    assert ("unstack.scene", "unstack.plausibility") not in pairs
-    assert ("unstack.scene", "unstack.checks") in pairs and ("unstack.plausibility", "unstack.checks") in pairs
+    assert ("unstack.scene", "unstack.understanding.plausibility") not in pairs
+    assert ("unstack.scene", "unstack.checks") in pairs and (
+        "unstack.understanding.plausibility",
+        "unstack.checks",
+    ) in pairs
+
+
+def test_the_architecture_page_names_every_part_in_its_layer() -> None:
+    """docs/architecture.md lists every module directly under ``unstack/`` and every subpackage."""
+    page = (PACKAGE.parent / "docs" / "architecture.md").read_text(encoding="utf-8")
+    table = page.split("| layer | modules |", 1)[1]
+    names = {path.stem for path in PACKAGE.glob("*.py") if path.stem != "__init__"} - {"__main__"}
+    names |= {f"{path.name}/" for path in PACKAGE.iterdir() if (path / "__init__.py").exists()} - {"schemas/"}
+    missing = sorted(name for name in names if f"`{name}`" not in table)
+    assert not missing, missing
+    rows = {line.split("|")[1].strip(): line for line in table.strip().splitlines()[1:]}
+    for module in ("plausibility", "statics", "hidden_load", "clouds", "detector"):
+        assert f"`{module}`" in rows["scene understanding"]
+        assert (PACKAGE / "understanding" / f"{module}.py").exists()
+
+
+def test_the_reasoner_takes_nothing_from_scene_understanding_or_the_pipeline() -> None:
+    wrong = [
+        f"{edge.source} -> {edge.target}"
+        for edge in EDGES
+        if edge.source.startswith("unstack.reasoner")
+        and edge.target.startswith(("unstack.understanding", "unstack.pipeline"))
+    ]
+    assert not wrong, wrong

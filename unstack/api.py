@@ -193,7 +193,7 @@ def support_probabilities(scene: Scene, model: ModelArgument = None, *, statics:
     statics : bool
         Raise the probability that a box holds up another where statics says the other
         cannot stand without it -- a box leaning on it, a box across a gap on it
-        (:mod:`unstack.statics`; each raise is a warning); ``False``: the model's
+        (:mod:`unstack.understanding.statics`; each raise is a warning); ``False``: the model's
         probabilities alone.
 
     Returns
@@ -216,7 +216,7 @@ def support_probabilities(scene: Scene, model: ModelArgument = None, *, statics:
     """
     if not isinstance(scene, Scene):
         raise InvalidArgument(f"expected a Scene, got {type(scene).__name__}")
-    from unstack.learning.probabilities import scene_support_probabilities
+    from unstack.pipeline import scene_support_probabilities
 
     if not isinstance(statics, bool):
         raise InvalidArgument(f"statics must be True or False, got {statics!r}")

@@ -45,7 +45,7 @@ class Supports:
         Box masses in kg, for the mass-weighted cost.
     hidden_load : array-like, shape (n,), optional
         Expected number of *undetected* boxes resting on each box (what the point cloud
-        shows on it that no detected box explains; see :mod:`unstack.hidden_load`). The
+        shows on it that no detected box explains; see :mod:`unstack.understanding.hidden_load`). The
         ``load`` cost counts it; 0 when not given.
     heights : array-like, shape (n,), optional
         The height each box rests at: its lowest point above the floor in metres (a scene's

@@ -33,7 +33,7 @@ class Validated:
     detail : str
         What it holds, such as ``5 objects``.
     warnings : tuple of str
-        What is doubtful about a valid scene (:func:`unstack.plausibility.scene_warnings`).
+        What is doubtful about a valid scene (:func:`unstack.understanding.plausibility.scene_warnings`).
     """
 
     source: str
@@ -79,8 +79,8 @@ def validate(path: str | os.PathLike[str]) -> Validated:
         _propagate(supports)
         detail = f"{supports.n_objects} objects"
     elif tag == "unstack.scene/1":
-        from unstack.plausibility import scene_warnings
         from unstack.scene import Scene
+        from unstack.understanding.plausibility import scene_warnings
 
         scene = Scene.from_document(document)
         detail = f"{len(scene.boxes)} boxes, {len(scene.detected)} detected, {len(scene.points):,} points"

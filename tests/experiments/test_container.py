@@ -8,11 +8,11 @@ from pathlib import Path
 import pytest
 
 from tests.conftest import unstack
-from unstack.clouds import surface_cloud
 from unstack.errors import UnstackError
 from unstack.experiments.container import CONTAINER_MAKERS, container_experiment, container_policies
 from unstack.learning.model_file import default_model_path, load_model
 from unstack.scene import Box, Scene
+from unstack.understanding.clouds import surface_cloud
 
 pytestmark = pytest.mark.slow  # physics runs of every decision maker
 

@@ -7,7 +7,7 @@ import pytest
 from unstack.experiments.canonical_scenes import CANONICAL_KINDS, build_case
 from unstack.experiments.generalisation import CLOUDS, canonical_scene, check_decision, physical_check
 from unstack.learning.model_file import default_model_path, load_model
-from unstack.learning.probabilities import scene_support_probabilities
+from unstack.pipeline import scene_support_probabilities
 from unstack.reasoner.decision import decide
 
 pytestmark = pytest.mark.slow  # decides every canonical scene with the shipped model
@@ -48,7 +48,7 @@ def test_a_box_leant_on_is_not_taken_for_being_taller(default_model, seed: int) 
 
 @pytest.mark.parametrize("cloud", CLOUDS)
 def test_with_statics_the_box_leant_on_costs_what_it_holds_up(default_model, cloud: str) -> None:  # type: ignore[no-untyped-def]
-    from unstack.statics import LEAN_SUPPORT_PROBABILITY
+    from unstack.understanding.statics import LEAN_SUPPORT_PROBABILITY
 
     for seed in SEEDS:
         scene = canonical_scene(build_case("leaning", seed=seed), cloud=cloud, seed=seed)
@@ -76,7 +76,7 @@ def test_a_box_under_undetected_load_costs_at_least_half_a_box_more_than_a_free_
 
 @pytest.mark.parametrize("seed", SEEDS)
 def test_the_container_walls_are_not_load_on_the_boxes_against_them(seed: int) -> None:
-    from unstack.hidden_load import hidden_load
+    from unstack.understanding.hidden_load import hidden_load
 
     case = build_case("against_the_walls", seed=seed, in_container=True)
     scene = canonical_scene(case, cloud="sensor", seed=seed)

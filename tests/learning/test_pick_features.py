@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from unstack.clouds import surface_cloud
 from unstack.errors import InvalidArgument
 from unstack.learning.pick_features import PICK_FEATURES, pick_features
 from unstack.scene import Box, Scene
 from unstack.supports import Supports
+from unstack.understanding.clouds import surface_cloud
 
 
 def column(rows: np.ndarray, name: str) -> np.ndarray:

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from unstack.clouds import surface_cloud
 from unstack.errors import UnstackError
 from unstack.scene import Box, Scene
 from unstack.sim.belief import BeliefBlock, belief_blocks, belief_choice, belief_removals, choose_by_expected_moves
+from unstack.understanding.clouds import surface_cloud
 
 VIEWPOINT = [-2.0, 0.0, 1.5]
 

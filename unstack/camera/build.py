@@ -58,7 +58,7 @@ class CameraScene:
 
 def _without_overlaps(fitted: list[FittedBox], unfitted: dict[str, str]) -> list[FittedBox]:
     """The fitted boxes, best fits first, leaving out each that overlaps an accepted one by more
-    than a scene allows (:data:`~unstack.plausibility.REFUSED_OVERLAP`; its reason goes to ``unfitted``)."""
+    than a scene allows (:data:`~unstack.checks.REFUSED_OVERLAP`; its reason goes to ``unfitted``)."""
     from unstack.checks import REFUSED_OVERLAP
     from unstack.geometry import overlapping_pairs
 

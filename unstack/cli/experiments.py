@@ -484,7 +484,7 @@ def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int
     from unstack.cli.main import load_model_option
     from unstack.experiments.canonical_scenes import CANONICAL_KINDS, build_case
     from unstack.experiments.generalisation import physical_check, picked, run_suite, suite_figure, summary_rows
-    from unstack.learning.probabilities import scene_support_probabilities
+    from unstack.pipeline import scene_support_probabilities
     from unstack.reasoner.decision import decide
 
     folder = _out(out)

@@ -80,7 +80,7 @@ def _load(file: str) -> tuple[Any, Path]:
 
     document = read_document(file)
     if validate_document(document, ["unstack.supports/1", "unstack.scene/1"]) == "unstack.scene/1":
-        from unstack.plausibility import scene_warnings
+        from unstack.understanding.plausibility import scene_warnings
 
         scene = Scene.from_document(document)
         for warning in scene_warnings(scene):  # what decide would say about the scene

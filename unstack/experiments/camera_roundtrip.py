@@ -57,7 +57,7 @@ def _long_edge_quaternion(box: Any) -> np.ndarray:
 
 def _roundtrip_pile(path: Path, number: int, model: Any, samples: int) -> tuple[int, dict[str, Any]]:
     from unstack.camera import scene_from_depth
-    from unstack.learning.probabilities import scene_support_probabilities
+    from unstack.pipeline import scene_support_probabilities
     from unstack.reasoner.decision import decide
     from unstack.scene import Scene, load_scene
     from unstack.sim.camera_view import camera_view

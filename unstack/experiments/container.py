@@ -115,7 +115,7 @@ def container_policies(
     rng = np.random.default_rng(seed)
 
     def decision(scene: Scene, cost: str, margin: float | None = None) -> Any:
-        from unstack.learning.probabilities import scene_support_probabilities
+        from unstack.pipeline import scene_support_probabilities
         from unstack.reasoner.decision import decide
 
         supports = scene_support_probabilities(scene, model)
@@ -185,8 +185,8 @@ def container_policies(
 
     def moves(scene: Scene, rule: str) -> str:
         from unstack.learning.disturbance import load_disturbance_model
-        from unstack.learning.probabilities import scene_support_probabilities
         from unstack.moves import decide_on_moves
+        from unstack.pipeline import scene_support_probabilities
 
         if not loaded:  # once per set of policies, at the first pick
             given = disturbance

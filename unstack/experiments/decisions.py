@@ -151,12 +151,12 @@ def free_pick(boxes: list[Any]) -> int:
 def iset_outcome(scene: Any, ids: list[str], model: Any, *, statics: bool = True) -> IsetOutcome:
     """Decide one ISet of a simulated scene with ``model`` and every decision maker; score the picks.
 
-    ``statics``: as in :func:`~unstack.learning.probabilities.scene_support_probabilities` (the
+    ``statics``: as in :func:`~unstack.pipeline.scene_support_probabilities` (the
     default pipeline); the scores compare the picks with the simulator's ground truth either way.
     """
     from unstack.height_veto import hybrid_choice
     from unstack.learning.metrics import classification_report
-    from unstack.learning.probabilities import scene_support_probabilities
+    from unstack.pipeline import scene_support_probabilities
     from unstack.reasoner.decision import NEAR_TIE_MARGIN, choose, decide
 
     supports = scene_support_probabilities(scene, model, boxes=ids, statics=statics)
@@ -259,7 +259,7 @@ def evaluate_decisions(
 
     ``draw``: how the ISets are drawn (see :data:`unstack.learning.training_data.ISET_DRAWS`).
     ``statics``: let a box that cannot stand without another make it its supporter
-    (:mod:`unstack.statics`, the default); ``False``: the model's probabilities alone. It does
+    (:mod:`unstack.understanding.statics`, the default); ``False``: the model's probabilities alone. It does
     not change which ISets are drawn, so runs with and without it pair ISet by ISet.
     """
     from unstack.datasets import require_configurations

@@ -2,7 +2,7 @@
 
 Every canonical scene (:mod:`unstack.experiments.canonical_scenes`) is scanned twice: by the
 project's range sensor (pybullet's renderer from the door, :mod:`unstack.sim.sensor`) and by
-:func:`unstack.clouds.surface_cloud` (faces sampled at another density, from a moved
+:func:`unstack.understanding.clouds.surface_cloud` (faces sampled at another density, from a moved
 viewpoint, with depth noise and missing faces). A decision is *right* when its choice is a
 pickable box (it holds up nothing) and its expected costs respect the scene's bounds: a box
 that carries a load of k boxes (a box resting on m boxes weighs 1/m on each, with what rests
@@ -73,7 +73,7 @@ def _sensor_cloud(case: CanonicalCase, seed: int) -> np.ndarray:
 
 
 def _surface(case: CanonicalCase, seed: int) -> np.ndarray:
-    from unstack.clouds import surface_cloud
+    from unstack.understanding.clouds import surface_cloud
 
     rng = np.random.default_rng(seed)
     viewpoint = np.array([-1.8, 0.0, 1.6]) + rng.uniform(-0.4, 0.4, size=3)

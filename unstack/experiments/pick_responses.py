@@ -220,8 +220,8 @@ def state_rows(
     """The pick features of one state seen through ``view`` (:data:`VIEWS`), with every
     candidate's outcome and the reasoner's expected costs."""
     from unstack.learning.pick_features import pick_features
-    from unstack.learning.probabilities import scene_support_probabilities
     from unstack.moves import MOVES_EXACT_MAX_BOXES
+    from unstack.pipeline import scene_support_probabilities
     from unstack.reasoner.decision import decide
 
     draw = np.random.SeedSequence(seed, spawn_key=(int(header["step"]), len(header["ids"])))

@@ -88,8 +88,8 @@ def closed_loop_policies(
     statics: bool = True,
 ) -> dict[str, Callable[[Any], str]]:
     """The closed-loop decision makers: each maps the freshly sensed scene to the box to take
-    (``statics``: as in :func:`~unstack.learning.probabilities.scene_support_probabilities`)."""
-    from unstack.learning.probabilities import scene_support_probabilities
+    (``statics``: as in :func:`~unstack.pipeline.scene_support_probabilities`)."""
+    from unstack.pipeline import scene_support_probabilities
     from unstack.reasoner.decision import decide
 
     def reasoner(scene: Any) -> str:
@@ -114,10 +114,10 @@ def unloading_orders(
     statics: bool = True,
 ) -> dict[str, list[str]]:
     """The order of the scene's detected boxes for every decision maker (``statics``: as in
-    :func:`~unstack.learning.probabilities.scene_support_probabilities`; the baselines do not
+    :func:`~unstack.pipeline.scene_support_probabilities`; the baselines do not
     use the probabilities except ``priors``)."""
     from unstack.experiments.decisions import free_pick
-    from unstack.learning.probabilities import scene_support_probabilities
+    from unstack.pipeline import scene_support_probabilities
     from unstack.reasoner.decision import choose
     from unstack.reasoner.plan import unloading_plan
 
@@ -236,7 +236,7 @@ def unloading_experiment(
     ``closed_loop``: also run the :data:`CLOSED_LOOP_MAKERS` (about three times slower).
     ``cost``: the cost of unstack's decisions (:data:`unstack.reasoner.costs.COSTS`).
     ``statics``: let a box that cannot stand without another make it its supporter
-    (:mod:`unstack.statics`, the default pipeline); ``False``: the model's probabilities alone.
+    (:mod:`unstack.understanding.statics`, the default pipeline); ``False``: the model's probabilities alone.
     ``n_jobs``: piles run in parallel processes; ``client``: on the workers of a
     ``distributed.Client`` instead (the results do not depend on either).
     """

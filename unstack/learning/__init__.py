@@ -32,7 +32,6 @@ _HOMES = {
     "default_model_path": "model_file",
     "load_model": "model_file",
     "save_model": "model_file",
-    "scene_support_probabilities": "probabilities",
     "SupportExamples": "training_data",
     "dataset_examples": "training_data",
     "scene_examples": "training_data",
@@ -63,5 +62,4 @@ __all__ = [
     "pair_features",
     "save_model",
     "scene_examples",
-    "scene_support_probabilities",
 ]

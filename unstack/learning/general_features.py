@@ -24,7 +24,7 @@ material stacked on X) were measured against the generalisation suite
 (``unstack experiment generalisation``): models trained with them picked right as often but
 kept the suite's cost bounds less often (37 of 64 decisions against 46-58 of 64 without
 them, trained on the same piles); what the cloud alone can tell -- load nobody detected --
-is counted by :mod:`unstack.hidden_load` in the decision's cost instead.
+is counted by :mod:`unstack.understanding.hidden_load` in the decision's cost instead.
 
 Examples
 --------

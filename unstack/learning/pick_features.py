@@ -10,7 +10,7 @@ point cloud, and the reasoner's output on them (expected costs and conditional m
 * what the reasoner believes: its expected cost (:mod:`unstack.reasoner.costs`), the
   expected number of detected boxes it supports and the largest such marginal, how much the
   detected boxes hold it up, the hidden load the cloud shows on it
-  (:mod:`unstack.hidden_load`);
+  (:mod:`unstack.understanding.hidden_load`);
 * what touches it: detected boxes resting on it and under it, detected boxes beside it
   (a gap under :data:`CONTACT_GAP` and a shared height band), the share of its top they cover;
 * what the cloud shows around it: points over its top (all, and those no detected box

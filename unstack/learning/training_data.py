@@ -26,10 +26,10 @@ from pathlib import Path
 
 import numpy as np
 
-from unstack.detector import detector_poses
 from unstack.errors import UnstackError
 from unstack.learning.features import FeatureSettings, pair_features
 from unstack.scene import Scene, load_scene
+from unstack.understanding.detector import detector_poses
 
 __all__ = [
     "ISET_DRAWS",
@@ -164,7 +164,7 @@ def scene_examples(
     """Examples of one scene with ground truth (``draw``: see :data:`ISET_DRAWS`).
 
     With ``vary_clouds`` each ISet sees the cloud as another sensor might
-    (:func:`unstack.clouds.vary_cloud`: sparser, noisier, with holes). With ``pose_noise``
+    (:func:`unstack.understanding.clouds.vary_cloud`: sparser, noisier, with holes). With ``pose_noise``
     (metres) each ISet's boxes are seen as a box detector reports them
     (:func:`detector_poses`): a simulated pile's boxes interpenetrate by fractions of a
     millimetre, a detector's are a centimetre off either way.
@@ -179,7 +179,7 @@ def scene_examples(
         pairs = [(index[x], index[y]) for x in iset for y in iset if x != y]
         points = scene.points
         if vary_clouds:
-            from unstack.clouds import vary_cloud
+            from unstack.understanding.clouds import vary_cloud
 
             points = vary_cloud(points, rng)
         boxes = detector_poses(scene.boxes, pose_noise, rng) if pose_noise > 0 else scene.boxes

@@ -9,7 +9,7 @@ the supported boxes, so its expectation needs only the conditional marginals:
 * ``"load"`` (the default): every box counted with the undetected load resting on it,
   ``w_Y = 1 + h_Y`` and ``own_j = h_j``, where ``h`` is :attr:`Supports.hidden_load`
   (what the cloud shows on a box that no detected box explains, see
-  :mod:`unstack.hidden_load`). Without a hidden load it equals ``"count"``.
+  :mod:`unstack.understanding.hidden_load`). Without a hidden load it equals ``"count"``.
 
 Examples
 --------

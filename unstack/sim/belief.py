@@ -7,7 +7,7 @@ and a point cloud. This module builds a physics world from that alone (issue 34,
 * every detected box at its reported pose, as a dynamic body of the typical mass (the
   settings' mean; a detector reports no masses);
 * the cloud points no detected box explains and no container wall holds
-  (:func:`unstack.hidden_load.unexplained_points`) are binned into columns of
+  (:func:`unstack.understanding.hidden_load.unexplained_points`) are binned into columns of
   :data:`CELL` metres across; in each column, the points between two detected boxes (or
   between the floor and the lowest detected box, or above the highest) are one stretch of
   unseen material, filled down to what lies under it: a detected box's top or the floor;
@@ -36,7 +36,7 @@ moves the fewest on average, ties to the box resting highest.
 Examples
 --------
 >>> from unstack.scene import Box, Scene
->>> from unstack.clouds import surface_cloud
+>>> from unstack.understanding.clouds import surface_cloud
 >>> boxes = [Box("low", [0.4, 0.4, 0.3], [1.0, 0.0, 0.15]), Box("high", [0.4, 0.4, 0.3], [1.0, 0.0, 0.45])]
 >>> scene = Scene(boxes, surface_cloud(boxes, viewpoint=[-2.0, 0.0, 1.5], seed=0), ["low"])
 >>> [block.resting_on for block in belief_blocks(scene)]   # "high" is not detected: load on "low"
@@ -160,7 +160,7 @@ def belief_blocks(scene: Scene, detected: Sequence[str] | None = None) -> list[B
         detected box that carries one.
     """
     from unstack.geometry import bounding_boxes
-    from unstack.hidden_load import unexplained_points
+    from unstack.understanding.hidden_load import unexplained_points
 
     ids = list(scene.detected if detected is None else detected)
     boxes = [scene.box(box_id) for box_id in ids]
@@ -221,7 +221,7 @@ def seen_boxes(scene: Scene) -> list[str]:
     Examples
     --------
     >>> from unstack.scene import Box, Scene
-    >>> from unstack.clouds import surface_cloud
+    >>> from unstack.understanding.clouds import surface_cloud
     >>> front = Box("front", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2])
     >>> behind = Box("behind", [0.4, 0.4, 0.4], [1.4, 0.0, 0.2])
     >>> seen_boxes(Scene([front, behind], surface_cloud([front], viewpoint=[-2.0, 0.0, 0.2], seed=0), ["front"]))
@@ -474,7 +474,7 @@ def belief_choice(
     Examples
     --------
     >>> from unstack.scene import Box, Scene
-    >>> from unstack.clouds import surface_cloud
+    >>> from unstack.understanding.clouds import surface_cloud
     >>> boxes = [Box("low", [0.4, 0.4, 0.3], [1.0, 0.0, 0.15]), Box("high", [0.4, 0.4, 0.3], [1.0, 0.0, 0.45])]
     >>> belief_choice(Scene(boxes, surface_cloud(boxes, viewpoint=[-2.0, 0.0, 1.5], seed=0), ["low", "high"]))
     'high'

@@ -272,7 +272,7 @@ def unload_container(
     at least ``sensor.min_pixels`` of it. A box hidden behind others is detected once the boxes
     in front are gone. The detected boxes the gripper can reach (:func:`reachable_boxes`) are
     the candidates; ``policy`` gets a scene whose ``detected`` are those candidates, with the
-    poses a detector reports (:func:`unstack.detector.detector_poses` with ``detector_noise``
+    poses a detector reports (:func:`unstack.understanding.detector.detector_poses` with ``detector_noise``
     metres; 0 gives the true poses), and the point cloud of the scan. The run stops when the
     container is empty, after ``max_picks`` picks, or when no box is both detected and
     reachable (:attr:`UnloadRun.stopped` says which).
@@ -284,7 +284,7 @@ def unload_container(
     policy : callable
         ``policy(current_scene) -> box id`` among ``current_scene.detected``.
     detector_noise : float
-        Position error of the detector (metres; yaw errors follow, see :mod:`unstack.detector`).
+        Position error of the detector (metres; yaw errors follow, see :mod:`unstack.understanding.detector`).
     detector_misses : float
         Share of the seen boxes the detector misses, drawn box by box at every scan (a real
         detector's misses: only the cloud shows such a box). When every reachable box was
@@ -302,8 +302,8 @@ def unload_container(
     -------
     UnloadRun
     """
-    from unstack.detector import detector_poses
     from unstack.sim.sensor import scan_pile
+    from unstack.understanding.detector import detector_poses
 
     if reach not in REACH_RULES:
         raise UnstackError(f"unknown reach rule {reach!r}; expected one of {', '.join(REACH_RULES)}")

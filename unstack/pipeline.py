@@ -1,5 +1,10 @@
-"""From a scene to support probabilities: features of every ordered pair of detected boxes,
-then the model's P(SUPP).
+"""The one recipe from a scene to support probabilities: the model meets scene understanding.
+
+Features of every ordered pair of detected boxes, then the model's P(SUPP); the scene's
+plausibility warnings and the model's out-of-distribution warnings; statics' raises for a
+box another leans on; the hidden load the cloud shows on each detected box; the heights the
+boxes rest at. It sits above learning and scene understanding and below the public API
+(``docs/architecture.md``): the only module where a learned model meets a scene.
 
 A learned probability is never hard evidence: values are clipped into
 ``[PROBABILITY_FLOOR, 1 - PROBABILITY_FLOOR]`` so that only a planner's explicit 0 or 1
@@ -76,15 +81,15 @@ def scene_support_probabilities(
     statics : bool
         Raise ``P(X supports Y)`` where ``Y`` cannot stand without ``X`` (it leans on it, or
         rests across a gap on it and another)
-        (:mod:`unstack.statics`; each raise is a warning and is listed in
+        (:mod:`unstack.understanding.statics`; each raise is a warning and is listed in
         ``metadata["leaning"]``); ``False``: the model's probabilities alone.
 
     Returns
     -------
     Supports
         With masses when every detected box has one, the hidden load of every box
-        (:mod:`unstack.hidden_load`), and in ``metadata["warnings"]`` what is doubtful:
-        the scene's plausibility warnings (:func:`unstack.plausibility.scene_warnings`)
+        (:mod:`unstack.understanding.hidden_load`), and in ``metadata["warnings"]`` what is doubtful:
+        the scene's plausibility warnings (:func:`unstack.understanding.plausibility.scene_warnings`)
         and features outside the model's training range (out of distribution).
     """
     index = {box_id: k for k, box_id in enumerate(scene.box_ids)}
@@ -93,7 +98,7 @@ def scene_support_probabilities(
     n = len(detected)
     pairs = [(detected[i], detected[j]) for i in range(n) for j in range(n) if i != j]
     probabilities = np.zeros((n, n))
-    from unstack.plausibility import scene_warnings
+    from unstack.understanding.plausibility import scene_warnings
 
     doubts = scene_warnings(scene)
     if pairs:
@@ -106,7 +111,7 @@ def scene_support_probabilities(
         )
     leaning: list[dict[str, object]] = []
     if statics and n > 1:
-        from unstack.statics import leaning_supports, raise_leaning_supports
+        from unstack.understanding.statics import leaning_supports, raise_leaning_supports
 
         found = leaning_supports(scene, objects)
         probabilities, raised = raise_leaning_supports(probabilities, objects, found)
@@ -115,7 +120,7 @@ def scene_support_probabilities(
             {"leaning": f.leaning, "supporter": f.supporter, "overhang_m": round(f.overhang, 4), "on_floor": f.on_floor}
             for f in found
         ]
-    from unstack.hidden_load import hidden_load
+    from unstack.understanding.hidden_load import hidden_load
 
     masses = [scene.boxes[k].mass for k in detected]
     metadata = {

@@ -8,12 +8,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from unstack.clouds import surface_cloud
 from unstack.experiments.canonical_scenes import CANONICAL_KINDS, build_case
 from unstack.experiments.generalisation import canonical_scene
 from unstack.geometry import box_corners
 from unstack.scene import Box, Scene
-from unstack.statics import LEAN_SUPPORT_PROBABILITY, Leaning, leaning_supports, raise_leaning_supports
+from unstack.understanding.clouds import surface_cloud
+from unstack.understanding.statics import LEAN_SUPPORT_PROBABILITY, Leaning, leaning_supports, raise_leaning_supports
 
 
 def _tipped(size: list[float], degrees: float, front_face: float, wall_top: float) -> Box:

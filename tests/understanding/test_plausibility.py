@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from unstack.errors import InvalidScene
-from unstack.plausibility import scene_warnings
 from unstack.scene import Box, Scene
+from unstack.understanding.plausibility import scene_warnings
 
 
 @pytest.mark.parametrize(
@@ -88,7 +88,7 @@ def test_a_scene_in_millimetres_is_one_line_and_exit_code_2(tmp_path: Path) -> N
 
 @pytest.mark.parametrize(("shift", "share"), [(0.18, 0.55), (0.22, 0.45), (0.2, 0.5), (0.4, 0.0)])
 def test_the_overlap_of_parallel_boxes_is_exact(shift: float, share: float) -> None:
-    from unstack.plausibility import overlap_share
+    from unstack.understanding.plausibility import overlap_share
 
     turned = [0.0, 0.0, np.sin(np.pi / 4), np.cos(np.pi / 4)]  # a quarter turn about z: axes still parallel
     first = Box("a", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2])
@@ -105,7 +105,7 @@ def test_boxes_sharing_55_percent_are_refused_and_45_percent_warned_about() -> N
 
 
 def test_the_overlap_of_a_turned_box_is_estimated_on_a_grid() -> None:
-    from unstack.plausibility import overlap_share
+    from unstack.understanding.plausibility import overlap_share
 
     eighth = [0.0, 0.0, np.sin(np.pi / 8), np.cos(np.pi / 8)]  # 45 degrees about z, same centre
     share = overlap_share(

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from unstack.clouds import surface_cloud, vary_cloud
 from unstack.errors import UnstackError
 from unstack.geometry import points_in_box
 from unstack.scene import Box
+from unstack.understanding.clouds import surface_cloud, vary_cloud
 
 
 def test_only_faces_towards_the_viewpoint_are_sampled() -> None:

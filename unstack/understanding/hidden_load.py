@@ -29,7 +29,7 @@ generalisation page of the docs.
 Examples
 --------
 >>> from unstack.scene import Box, Scene
->>> from unstack.clouds import surface_cloud
+>>> from unstack.understanding.clouds import surface_cloud
 >>> boxes = [Box("loaded", [0.4, 0.4, 0.3], [1.0, -0.4, 0.15]), Box("unseen", [0.4, 0.4, 0.3], [1.0, -0.4, 0.45]),
 ...          Box("free", [0.4, 0.4, 0.3], [1.0, 0.4, 0.15])]
 >>> scene = Scene(boxes, surface_cloud(boxes, viewpoint=[-2.0, 0.0, 1.5], seed=0), ["loaded", "free"])

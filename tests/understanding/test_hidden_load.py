@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from unstack.clouds import surface_cloud, vary_cloud
-from unstack.hidden_load import container_planes, hidden_load
 from unstack.scene import Box, Scene
+from unstack.understanding.clouds import surface_cloud, vary_cloud
+from unstack.understanding.hidden_load import container_planes, hidden_load
 
 
 def _loaded_and_free(rng: np.random.Generator) -> list[Box]:
