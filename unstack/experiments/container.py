@@ -37,6 +37,13 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     there (:func:`unstack.sim.unloading.rebuilt_removals`); the fewest moved, ties to the box
     resting highest. It knows the pile's poses but not its state: what it loses against the
     look-ahead no perception of poses can win.
+``rebuilt_typical``, ``rebuilt_draws``
+    the same oracle of poses without the masses: every box of the settings' mean mass, or
+    the mean over :data:`~unstack.sim.belief.BELIEF_WORLDS` worlds of masses drawn from the
+    settings' range -- what a robot that sees every box but weighs none could know.
+``belief_seen``
+    the belief (``belief``) with every box the cloud shows (:func:`unstack.sim.belief.seen_boxes`)
+    as a box at its pose, not only the candidates: a detector that reports every box in view.
 ``moves``
     the learned cost of what a pick moves (:mod:`unstack.moves`): the default model's
     probabilities and the reasoner's marginals through the disturbance model; the fewest.
@@ -79,7 +86,7 @@ __all__ = ["CONTAINER_MAKERS", "CONTAINER_SAMPLES", "container_experiment", "con
 CONTAINER_MAKERS = (
     "unstack", "min_cost", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random", "lookahead",
     "moves", "moves_veto", "belief", "belief_veto", "rebuilt",
-    "rebuilt_typical", "belief_seen",
+    "rebuilt_typical", "rebuilt_draws", "belief_seen",
 )  # fmt: skip
 #: Makers whose policy is told what every candidate's removal does in the engine (the true pile).
 PROBING_MAKERS = ("lookahead",)
@@ -163,6 +170,22 @@ def container_policies(
 
         return policy
 
+    def rebuilt_draws(scene: Scene) -> str:
+        from unstack.geometry import bounding_boxes
+        from unstack.sim.belief import BELIEF_WORLDS, choose_by_expected_moves
+        from unstack.sim.settings import SimulationSettings
+        from unstack.sim.unloading import rebuilt_removals
+
+        low, high = SimulationSettings.from_dict(scene.metadata["settings"]).pile.mass_range
+        draws = np.random.default_rng(seed)
+        moved = {box_id: 0.0 for box_id in scene.detected}
+        for _ in range(BELIEF_WORLDS):
+            masses = {box.id: float(draws.uniform(low, high)) for box in scene.boxes}
+            for box_id, outcome in rebuilt_removals(scene, masses=masses).items():
+                moved[box_id] += outcome.boxes_moved / BELIEF_WORLDS
+        resting = {box_id: float(bounding_boxes([scene.box(box_id)])[0, 2]) for box_id in scene.detected}
+        return choose_by_expected_moves(moved, resting, "fewest")
+
     def belief_seen(scene: Scene) -> str:
         import dataclasses
 
@@ -219,6 +242,7 @@ def container_policies(
         "belief_veto": believing("veto"),
         "rebuilt": rebuilding(True),
         "rebuilt_typical": rebuilding(False),
+        "rebuilt_draws": rebuilt_draws,
         "belief_seen": belief_seen,
     }
     unknown = [maker for maker in makers if maker not in every]

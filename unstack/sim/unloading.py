@@ -470,7 +470,11 @@ def probe_removals(
 
 
 def rebuilt_removals(
-    scene: Scene, candidates: Sequence[str] | None = None, *, true_masses: bool = True
+    scene: Scene,
+    candidates: Sequence[str] | None = None,
+    *,
+    true_masses: bool = True,
+    masses: dict[str, float] | None = None,
 ) -> dict[str, UnloadStep]:
     """What taking out each candidate would do in a fresh world rebuilt from the scene's poses.
 
@@ -492,6 +496,8 @@ def rebuilt_removals(
     true_masses : bool
         Each box with its own mass; False: every box of the settings' mean mass (what a
         robot that sees every pose but weighs nothing would build).
+    masses : dict of str to float, optional
+        The mass of each box (kg), instead of either (a draw of what the robot does not know).
 
     Returns
     -------
@@ -508,6 +514,7 @@ def rebuilt_removals(
         typical = float(np.mean(settings.pile.mass_range))
         for box in scene.boxes:
             mass = box.mass if box.mass is not None and true_masses else typical
+            mass = mass if masses is None else masses[box.id]
             world.add_box(box.size, box.position, box.orientation_xyzw, mass=mass)
         world.step(RESETTLE_SECONDS)
         return probe_removals(scene, world, scene.box_ids, tried)
