@@ -84,15 +84,8 @@ HOLD_ROUNDS = 3
 BELIEF_RULES = ("fewest", "veto")
 #: The ``veto`` rule passes over the highest box when its removal is expected to move this many.
 BELIEF_VETO = 1.0
-#: A box fixed in place counts as moved by a removal when the removed box comes this close to
-#: it (metres): it leant on the removed box.
-LEAN_GAP = 0.01
 #: Belief worlds per decision (:func:`belief_removals`).
 BELIEF_WORLDS = 4
-#: The unseen support under a falling box fills only the cells where its underside lies within
-#: this of its lowest point (metres): all of a level box's footprint, the low edge of a tilted
-#: one -- a tilted box stands on its low edge and leans with its high side on a neighbour.
-LOW_EDGE = 0.05
 #: A box with at least this many cloud points on it (within :data:`SEEN_MARGIN`) is seen.
 SEEN_POINTS = 20
 #: How far from a box's surface (metres) a cloud point still lies on it.
@@ -300,10 +293,9 @@ def unseen_supports(box: Box, others: Sequence[Box]) -> list[BeliefBlock]:
     ys = np.arange(np.floor(bound[1] / CELL), np.ceil(bound[4] / CELL)) * CELL + CELL / 2
     centres = np.array([(x, y) for x in xs for y in ys]).reshape(-1, 2)
     bottoms = _bottom_heights(box, centres)
-    lowest = float(np.nanmin(bottoms)) if np.isfinite(bottoms).any() else np.inf
     blocks = []
     for centre, bottom in zip(centres, bottoms, strict=True):
-        if not np.isfinite(bottom) or bottom < 0.02 or bottom > lowest + LOW_EDGE:
+        if not np.isfinite(bottom) or bottom < 0.02:
             continue
         low, high = centre - CELL / 2, centre + CELL / 2
         under = np.all(others_bounds[:, :2] < high, axis=1) & np.all(others_bounds[:, 3:5] > low, axis=1)
@@ -397,9 +389,7 @@ def _try_removals(
                 watched_names = [name for name in names if name != box_id and name not in held]
                 watched = [bodies[name] for name in watched_names]
                 leaning = tuple(
-                    name
-                    for name in sorted(held - {box_id})
-                    if client.getClosestPoints(bodies[box_id], bodies[name], LEAN_GAP)
+                    name for name in sorted(held - {box_id}) if client.getContactPoints(bodies[box_id], bodies[name])
                 )
                 before = world.poses(watched)
                 client.resetBasePositionAndOrientation(bodies[box_id], PARKING.tolist(), [0.0, 0.0, 0.0, 1.0])
