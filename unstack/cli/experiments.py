@@ -33,9 +33,9 @@ def experiment() -> None:
     """
 
 
-#: The paper's sizes (§V): 200 simulated configurations for Fig. 5a, 493 test ISets for Fig. 4.
+#: The paper's size of Fig. 5a (§V): 200 simulated configurations (its 493 test ISets for Fig. 4
+#: are :data:`unstack.experiments.decisions.PAPER_TEST_ISETS`).
 PAPER_CONFIGURATIONS = 200
-PAPER_TEST_ISETS = 493
 
 
 def _out(out: str) -> Path:
@@ -201,7 +201,13 @@ def decisions(
     """Fig. 4 and beyond: MSE(cost), first pick right and physical disturbance of every decision maker."""
     from unstack.cli.main import load_model_option
     from unstack.datasets import require_configurations
-    from unstack.experiments.decisions import DECISION_MAKERS, evaluate_decisions, paired_between_runs, plot_fig4
+    from unstack.experiments.decisions import (
+        DECISION_MAKERS,
+        PAPER_TEST_ISETS,
+        evaluate_decisions,
+        paired_between_runs,
+        plot_fig4,
+    )
     from unstack.jsonio import read_document
 
     if full:

@@ -64,6 +64,7 @@ from unstack.sim.settings import DISPLACEMENT_THRESHOLD
 
 __all__ = [
     "DECISION_MAKERS",
+    "PAPER_TEST_ISETS",
     "IsetOutcome",
     "decision_scores",
     "evaluate_decisions",
@@ -244,12 +245,16 @@ def _binned(isets: list[IsetOutcome], scores: dict[str, dict[str, np.ndarray]]) 
     return result
 
 
+#: The paper's decision test (§V, Fig. 4): 493 test ISets.
+PAPER_TEST_ISETS = 493
+
+
 def evaluate_decisions(
     data_dir: str | os.PathLike[str],
     model: Any,
     *,
     r: int = 5,
-    isets: int = 493,
+    isets: int = PAPER_TEST_ISETS,
     seed: int = 0,
     progress: Callable[[int, int], None] | None = None,
     draw: str = "random",
