@@ -61,20 +61,23 @@ def pick_reasons(supports: Supports, marginals: np.ndarray, expected: np.ndarray
     ([['top', 0.9]], ['bottom', 0.9])
     """
     objects = supports.objects
-    hidden = np.zeros(len(objects)) if supports.hidden_load is None else np.asarray(supports.hidden_load)
+    n = len(objects)
+    hidden = np.zeros(n) if supports.hidden_load is None else np.asarray(supports.hidden_load, dtype=np.float64)
+    others = np.asarray(marginals, dtype=np.float64).copy()
+    np.fill_diagonal(others, -np.inf)  # a box is never its own reason
+    strongest = np.argsort(-others, axis=1, kind="stable")[:, :REASONS_PER_BOX]
+    holders = np.argmax(others, axis=0) if n > 1 else np.zeros(n, dtype=np.int64)
     reasons = []
     for k, box_id in enumerate(objects):
-        row = [(objects[j], float(marginals[k, j])) for j in range(len(objects)) if j != k]
-        held = [(objects[j], float(marginals[j, k])) for j in range(len(objects)) if j != k]
-        strongest = sorted((pair for pair in row if pair[1] >= REASON_MIN_PROBABILITY), key=lambda pair: -pair[1])
-        holder = max(held, key=lambda pair: pair[1], default=None)
+        named = [j for j in strongest[k] if others[k, j] >= REASON_MIN_PROBABILITY]
+        holder = int(holders[k])
         reasons.append(
             {
                 "box": box_id,
                 "expected_moves": round(max(float(expected[k]), 0.0), 4),
-                "holds_up": [[other, round(p, 3)] for other, p in strongest[:REASONS_PER_BOX]],
+                "holds_up": [[objects[j], round(float(others[k, j]), 3)] for j in named],
                 "hidden_load": round(float(hidden[k]), 3),
-                "held_by": None if holder is None else [holder[0], round(holder[1], 3)],
+                "held_by": None if n < 2 else [objects[holder], round(float(others[holder, k]), 3)],
             }
         )
     return reasons
