@@ -18,7 +18,7 @@ import argparse
 
 import numpy as np
 
-from unstack.datasets import require_configurations
+from unstack.dataset_folders import require_configurations
 from unstack.scene import load_scene
 from unstack.understanding.hidden_load import hidden_load
 

@@ -119,7 +119,7 @@ def test_the_graph_is_read_from_the_code_with_function_level_imports() -> None:
         ("unstack.reasoner.decision", "unstack.learning.model_file", False),
         ("unstack.pictures.render", "unstack.reasoner.decision", False),
         ("unstack.scene", "unstack.api", False),
-        ("unstack.learning.training_data", "unstack.datasets", True),
+        ("unstack.learning.training_data", "unstack.dataset_folders", True),
         ("unstack.experiments.unloading", "unstack.sim.unloading", True),
         ("unstack.cli.main", "unstack.api", True),
         ("unstack.api", "unstack.cli.main", False),

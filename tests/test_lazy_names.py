@@ -30,5 +30,5 @@ def test_every_name_of_the_stub_resolves_to_the_module_it_names(package: str) ->
 def test_an_unknown_name_is_an_attribute_error() -> None:
     import unstack.reasoner
 
-    with pytest.raises(AttributeError, match="No unstack.reasoner attribute nothing_here"):
+    with pytest.raises(AttributeError, match=r"No unstack\.reasoner attribute nothing_here"):
         unstack.reasoner.nothing_here  # noqa: B018

@@ -46,7 +46,7 @@ def test_plots_keep_the_hosts_backend_and_skip_pyplot(tmp_path: Path) -> None:
     code = f"""
 import sys, matplotlib
 matplotlib.use("svg")
-from unstack.figures import pyplot, save_figure
+from unstack.plotting import pyplot, save_figure
 plt = pyplot()
 figure, axes = plt.subplots(1, 2, figsize=(3, 2))
 axes[0].plot([0, 1], [1, 0])

@@ -1,88 +1,16 @@
-"""Data-set folders, read side: the names, the manifest and the finished scene files.
+"""Deprecated name of :mod:`unstack.dataset_folders` (renamed because it reads data-set folders;
+the simulator writes them, :mod:`unstack.sim.dataset`).
 
-A data set folder (written by :func:`unstack.sim.dataset.simulate_dataset`, read by the
-learner and the experiments) holds::
-
-    manifest.json                  unstack.dataset/1: settings, seed, size, versions, statistics
-    config-0000.json               unstack.scene/1 (written last: its presence means "done")
-    config-0000.points.npy         the point cloud (N x 3 float64)
-    config-0000.point_boxes.npy    box index of every point (-1: container)
-    timings.jsonl                  CPU seconds per phase and configuration (one line each)
-
-This module belongs to the data model: learning reads data sets through it and never
-imports the simulator.
-
-Examples
---------
->>> config_name(7)
-'config-0007'
->>> import tempfile
->>> list_configurations(tempfile.mkdtemp())
-[]
+Importing it warns and gives the same names; the old name goes with version 0.2.
 """
 
-from __future__ import annotations
+import warnings
 
-import os
-from pathlib import Path
-from typing import Any
+from unstack.dataset_folders import *  # noqa: F403
+from unstack.dataset_folders import __all__  # noqa: F401
 
-from unstack.errors import UnstackError
-
-__all__ = [
-    "DATASET_FORMAT",
-    "MANIFEST",
-    "TIMINGS",
-    "config_name",
-    "list_configurations",
-    "read_manifest",
-    "require_configurations",
-]
-
-DATASET_FORMAT = "unstack.dataset/1"
-MANIFEST = "manifest.json"
-TIMINGS = "timings.jsonl"
-
-
-def config_name(index: int) -> str:
-    """File stem of configuration ``index`` in a data set folder.
-
-    Examples
-    --------
-    >>> config_name(12)
-    'config-0012'
-    """
-    return f"config-{index:04d}"
-
-
-def list_configurations(folder: str | os.PathLike[str]) -> list[Path]:
-    """The finished scene files of a data set folder, in index order."""
-    return sorted(Path(folder).glob("config-[0-9][0-9][0-9][0-9].json"))
-
-
-def require_configurations(folder: str | os.PathLike[str]) -> list[Path]:
-    """:func:`list_configurations`, or an error naming the folder when it holds none.
-
-    Examples
-    --------
-    >>> require_configurations("/x")
-    Traceback (most recent call last):
-    ...
-    unstack.errors.UnstackError: /x: expected a data set folder with config-NNNN.json scene files, found none
-    """
-    files = list_configurations(folder)
-    if not files:
-        raise UnstackError(f"{folder}: expected a data set folder with config-NNNN.json scene files, found none")
-    return files
-
-
-def read_manifest(folder: str | os.PathLike[str]) -> dict[str, Any] | None:
-    """The folder's manifest (validated as ``unstack.dataset/1``), or ``None`` if it has none."""
-    path = Path(folder) / MANIFEST
-    if not path.exists():
-        return None
-    from unstack.jsonio import read_document, validate_document
-
-    document = read_document(path)
-    validate_document(document, [DATASET_FORMAT])
-    return document.data
+warnings.warn(
+    "unstack.datasets is renamed unstack.dataset_folders; the old name goes with version 0.2",
+    DeprecationWarning,
+    stacklevel=2,
+)

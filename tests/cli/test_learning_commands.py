@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import REPO, unstack
-from unstack.datasets import list_configurations
+from unstack.dataset_folders import list_configurations
 from unstack.jsonio import load_schema
 
 pytestmark = pytest.mark.slow  # trains and evaluates models in subprocesses

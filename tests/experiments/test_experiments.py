@@ -167,7 +167,7 @@ def test_fig5a_on_simulated_piles(small_dataset: Path, tmp_path: Path, split: st
 def test_real7_scores_every_iset(small_dataset: Path) -> None:
     from itertools import combinations
 
-    from unstack.datasets import list_configurations
+    from unstack.dataset_folders import list_configurations
     from unstack.experiments.real7 import real7
     from unstack.scene import load_scene
 

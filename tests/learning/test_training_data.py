@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from unstack.datasets import list_configurations
+from unstack.dataset_folders import list_configurations
 from unstack.errors import UnstackError
 from unstack.learning.training_data import dataset_examples, dataset_fingerprint, sample_isets, scene_examples
 from unstack.scene import load_scene

@@ -7,7 +7,7 @@ from typing import Any
 
 import pytest
 
-from unstack.figures import curve_labels
+from unstack.plotting import curve_labels
 
 
 def test_curve_labels_name_the_twin() -> None:
@@ -21,11 +21,11 @@ def _steps(moved: list[int]) -> dict[str, Any]:
 
 
 def test_the_unloading_figure_shows_every_curve(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
-    import unstack.figures
+    import unstack.plotting
     from unstack.experiments.unloading import plot_unloading
 
     drawn: list[Any] = []
-    monkeypatch.setattr(unstack.figures, "save_figure", lambda figure, output: drawn.append(figure))
+    monkeypatch.setattr(unstack.plotting, "save_figure", lambda figure, output: drawn.append(figure))
     runs = {"reasoner": [1, 2, 1], "highest": [0, 1, 1], "free": [0, 1, 1], "random": [3, 3, 3]}
     result = {
         "makers": list(runs),

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from unstack.camera import depth_points, scene_from_depth
-from unstack.datasets import list_configurations
+from unstack.dataset_folders import list_configurations
 from unstack.scene import load_scene
 from unstack.sim.camera_view import camera_view
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from tests.sim.conftest import small_settings
-from unstack.datasets import list_configurations, read_manifest
+from unstack.dataset_folders import list_configurations, read_manifest
 from unstack.scene import load_scene
 from unstack.sim.dataset import DatasetConflict, SchedulerUnavailable, simulate_dataset
 from unstack.sim.settings import SimulationSettings

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from unstack.datasets import list_configurations
+from unstack.dataset_folders import list_configurations
 from unstack.errors import UnstackError
 from unstack.scene import Scene, load_scene
 from unstack.sim.unloading import execute_policy, execute_unloading, reachable_boxes, unload_container

@@ -123,7 +123,7 @@ def fig5a(
     full: bool,
 ) -> None:
     """Fig. 5a: the validation confusion matrix of the SVM on a simulated data set, beside the paper's."""
-    from unstack.datasets import require_configurations
+    from unstack.dataset_folders import require_configurations
     from unstack.experiments.fig5a import fig5a as run
     from unstack.experiments.fig5a import plot_fig5a
 
@@ -200,7 +200,7 @@ def decisions(
 ) -> None:
     """Fig. 4 and beyond: MSE(cost), first pick right and physical disturbance of every decision maker."""
     from unstack.cli.main import load_model_option
-    from unstack.datasets import require_configurations
+    from unstack.dataset_folders import require_configurations
     from unstack.experiments.decisions import (
         DECISION_MAKERS,
         PAPER_TEST_ISETS,
@@ -261,7 +261,7 @@ def decisions(
 def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) -> None:
     """The paper's real setting in simulation: every ISet of r = 3, 4, 5 of each 7-box pile."""
     from unstack.cli.main import load_model_option
-    from unstack.datasets import require_configurations
+    from unstack.dataset_folders import require_configurations
     from unstack.experiments.real7 import real7 as run
     from unstack.experiments.real7 import summary_rows
 
@@ -326,7 +326,7 @@ def unload(
     run started again with the same piles, model, time limit and seed reuses them.
     """
     from unstack.cli.main import load_model_option
-    from unstack.datasets import require_configurations
+    from unstack.dataset_folders import require_configurations
     from unstack.experiments.unloading import plot_unloading, unloading_experiment
 
     found = len(require_configurations(data_dir))
@@ -426,7 +426,7 @@ def container(
     pile's result.
     """
     from unstack.cli.main import load_model_option
-    from unstack.datasets import require_configurations
+    from unstack.dataset_folders import require_configurations
     from unstack.experiments.container import container_experiment, container_policies
 
     require_configurations(data_dir)
@@ -545,7 +545,7 @@ def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, pi
     share of piles whose decision on the built scene is the one on the true poses.
     """
     from unstack.cli.main import load_model_option
-    from unstack.datasets import require_configurations
+    from unstack.dataset_folders import require_configurations
     from unstack.experiments.camera_roundtrip import camera_roundtrip
 
     require_configurations(data_dir)
@@ -599,7 +599,7 @@ def belief_calibration_command(
     the true pile and in the belief built from what the robot sees. Prints Spearman's rank
     correlation, the means per predicted bin, and what each rule's pick would have moved.
     """
-    from unstack.datasets import require_configurations
+    from unstack.dataset_folders import require_configurations
     from unstack.experiments.belief_calibration import belief_calibration
 
     require_configurations(data_dir)

@@ -92,7 +92,7 @@ def _examples(
 ) -> Any:
     """:func:`unstack.learning.training.pooled_examples` with a progress bar."""
     from unstack.cli.progress import progress_bar
-    from unstack.datasets import require_configurations
+    from unstack.dataset_folders import require_configurations
     from unstack.learning.training import pooled_examples
 
     folders = (data_dirs,) if isinstance(data_dirs, str) else data_dirs

@@ -114,7 +114,7 @@ def simulate(
             out, settings, configs=configs, seed=seed, jobs=jobs, scheduler=scheduler, progress=report
         )
     from unstack.cli.text import counted
-    from unstack.datasets import read_manifest
+    from unstack.dataset_folders import read_manifest
 
     statistics = (read_manifest(summary.folder) or {}).get("statistics", {})
     click.echo(

@@ -109,7 +109,7 @@ def belief_calibration(
         ``calibration`` (Spearman, bins), ``picks`` (boxes the pick of each rule would have
         moved, summed over the states) and per pile the same.
     """
-    from unstack.datasets import require_configurations
+    from unstack.dataset_folders import require_configurations
     from unstack.learning.disturbance import calibration
     from unstack.sim.belief import BELIEF_WORLDS
 

@@ -111,7 +111,7 @@ def camera_roundtrip(
         of sizes right, median residual, share of piles whose decision on the built scene is
         the one on the true poses; ``piles``: every box of every pile.
     """
-    from unstack.datasets import require_configurations
+    from unstack.dataset_folders import require_configurations
 
     files = require_configurations(data_dir)[:piles]
     results: list[dict[str, Any] | None] = [None] * len(files)

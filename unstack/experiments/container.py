@@ -317,7 +317,7 @@ def container_experiment(
     import json
 
     from unstack.atomic import atomic_write_text
-    from unstack.datasets import require_configurations
+    from unstack.dataset_folders import require_configurations
     from unstack.experiments.decisions import paired_difference
 
     container_policies(model, seed=seed, makers=makers)  # unknown makers fail before any work

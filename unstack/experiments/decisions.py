@@ -267,7 +267,7 @@ def evaluate_decisions(
     (:mod:`unstack.understanding.statics`, the default); ``False``: the model's probabilities alone. It does
     not change which ISets are drawn, so runs with and without it pair ISet by ISet.
     """
-    from unstack.datasets import require_configurations
+    from unstack.dataset_folders import require_configurations
     from unstack.learning.training_data import detected_positions, sample_isets
     from unstack.scene import load_scene
 
@@ -392,7 +392,7 @@ def paired_between_runs(
 
 def plot_fig4(result: dict[str, Any], output: str | os.PathLike[str]) -> None:
     """The paper's Fig. 4: MSE(cost) per bin for unstack and the random decision maker, with histograms."""
-    from unstack.figures import curve_labels, pyplot
+    from unstack.plotting import curve_labels, pyplot
 
     plt = pyplot()
 
@@ -422,6 +422,6 @@ def plot_fig4(result: dict[str, Any], output: str | os.PathLike[str]) -> None:
         axes[1, column].set_ylabel("% of ISets")
     figure.suptitle(f"{result['isets']} test ISets of {result['r']} boxes from {Path(result['data']).name}")
     figure.tight_layout()
-    from unstack.figures import save_figure
+    from unstack.plotting import save_figure
 
     save_figure(figure, output)

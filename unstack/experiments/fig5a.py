@@ -120,7 +120,7 @@ def paper_point(truth: np.ndarray, probability: np.ndarray) -> dict[str, float]:
 
 def plot_fig5a(result: dict[str, Any], output: str | os.PathLike[str]) -> None:
     """The validation ROC curve (SUPP recall against not-SUPP recall) with the paper's Fig. 5a point."""
-    from unstack.figures import pyplot, save_figure
+    from unstack.plotting import pyplot, save_figure
 
     plt = pyplot()
     roc = result["validation_roc"]

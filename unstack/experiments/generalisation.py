@@ -304,7 +304,7 @@ def suite_figure(cases: Sequence[tuple[CanonicalCase, SuiteResult]], output: str
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from unstack.figures import save_figure
+    from unstack.plotting import save_figure
 
     columns = 4
     rows = math.ceil(len(cases) / columns)

@@ -175,7 +175,7 @@ def collect_pick_responses(
     list of dict
         Per pile: scene, boxes, states saved, boxes moved by the behaviour, why it stopped.
     """
-    from unstack.datasets import require_configurations
+    from unstack.dataset_folders import require_configurations
 
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)

@@ -37,7 +37,7 @@ def real7(
 ) -> dict[str, Any]:
     """Score every ISet of each r of every pile's boxes (all boxes of the pile, as the paper);
     ``piles`` limits the number of piles (the first ones)."""
-    from unstack.datasets import require_configurations
+    from unstack.dataset_folders import require_configurations
     from unstack.scene import load_scene
 
     files = require_configurations(data_dir)

@@ -243,7 +243,7 @@ def unloading_experiment(
     import json
 
     from unstack.atomic import atomic_write_text
-    from unstack.datasets import require_configurations
+    from unstack.dataset_folders import require_configurations
 
     if samples is None and time_limit is None:
         samples = UNLOAD_SAMPLES
@@ -308,7 +308,7 @@ def unloading_experiment(
 
 def plot_unloading(result: dict[str, Any], output: str | os.PathLike[str]) -> None:
     """Boxes moved so far against the share of the detected boxes unloaded, per decision maker."""
-    from unstack.figures import CURVE_STYLES, curve_labels, pyplot, save_figure
+    from unstack.plotting import CURVE_STYLES, curve_labels, pyplot, save_figure
 
     plt = pyplot()
     figure, axis = plt.subplots(figsize=(7, 4.5))

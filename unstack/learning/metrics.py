@@ -170,7 +170,7 @@ def classification_report(truth: Any, probability: Any) -> dict[str, Any]:
 def save_reliability_diagram(report: dict[str, Any], output: str | os.PathLike[str], *, title: str = "") -> None:
     """Draw the reliability diagram of a :func:`classification_report` into a PNG (atomically)."""
 
-    from unstack.figures import pyplot
+    from unstack.plotting import pyplot
 
     plt = pyplot()
 
@@ -187,6 +187,6 @@ def save_reliability_diagram(report: dict[str, Any], output: str | os.PathLike[s
     bottom.set_xlabel("predicted P(SUPP)")
     bottom.set_ylabel("relations")
     figure.tight_layout()
-    from unstack.figures import save_figure
+    from unstack.plotting import save_figure
 
     save_figure(figure, output)

@@ -67,7 +67,7 @@ def pooled_examples(
     UnstackError
         A folder holds no configuration, or no ISet of two detected boxes was drawn.
     """
-    from unstack.datasets import require_configurations
+    from unstack.dataset_folders import require_configurations
     from unstack.learning.training_data import dataset_examples
 
     sizes = [len(require_configurations(folder)) for folder in data_dirs]
@@ -100,7 +100,7 @@ def training_provenance(
     ``options`` (the ISet draw, seeds, split...) are recorded as given. One folder is
     recorded as plain values, several as lists.
     """
-    from unstack.datasets import read_manifest
+    from unstack.dataset_folders import read_manifest
     from unstack.learning.training_data import dataset_fingerprint
 
     manifests = [read_manifest(folder) or {} for folder in data_dirs]

@@ -227,7 +227,7 @@ def _one_file(
 
 def dataset_fingerprint(folder: str | os.PathLike[str]) -> str:
     """SHA-256 of a data set's manifest and scene files (what a model was trained on)."""
-    from unstack.datasets import list_configurations
+    from unstack.dataset_folders import list_configurations
 
     digest = hashlib.sha256()
     manifest = Path(folder) / "manifest.json"
@@ -261,7 +261,7 @@ def dataset_examples(
     """
     from joblib import Parallel, delayed
 
-    from unstack.datasets import require_configurations
+    from unstack.dataset_folders import require_configurations
 
     files = require_configurations(folder)
     settings = settings or FeatureSettings()

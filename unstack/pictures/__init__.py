@@ -1,6 +1,6 @@
 """Pictures of a decision: matplotlib renders of a pile or a support graph, and an interactive 3D page.
 
-Only the data model is imported here (scene, supports, geometry, figures, atomic, errors):
+Only the data model is imported here (scene, supports, geometry, plotting, atomic, errors):
 the caller decides and hands the numbers in as :class:`DecisionValues`.
 
 Examples

@@ -89,7 +89,7 @@ def draw_support_graph(values: DecisionValues, *, threshold: float = 0.5, title:
     from matplotlib.patches import Circle
 
     from unstack.errors import InvalidArgument
-    from unstack.figures import figure as new_figure
+    from unstack.plotting import figure as new_figure
 
     threshold = check_threshold(threshold)
     if values.probabilities is None:

@@ -5,7 +5,7 @@ drawn figure (text extents from the renderer), so the figure's layout must be fi
 
 Examples
 --------
->>> from unstack.figures import subplots
+>>> from unstack.plotting import subplots
 >>> drawn, axes = subplots(figsize=(3, 3))
 >>> axes.set_xlim(0, 1); axes.set_ylim(0, 1)  # doctest: +ELLIPSIS
 (...)

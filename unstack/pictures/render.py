@@ -270,7 +270,7 @@ def draw_scene(
         An unknown colouring, one without its data, a threshold outside [0, 1], or values
         whose boxes are not in the scene.
     """
-    from unstack.figures import figure as new_figure
+    from unstack.plotting import figure as new_figure
 
     if colour not in COLOURINGS:
         raise InvalidArgument(f"colour must be one of {', '.join(COLOURINGS)}, got {colour!r}")

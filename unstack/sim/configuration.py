@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from unstack.datasets import config_name
+from unstack.dataset_folders import config_name
 from unstack.provenance import package_versions
 from unstack.scene import Box, Scene
 from unstack.sim.ground_truth import RemovalResponse, removal_responses, support_labels, transitivity_violations

@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 
 from unstack.atomic import atomic_save_array, atomic_write_text
-from unstack.datasets import DATASET_FORMAT, MANIFEST, TIMINGS, config_name, list_configurations, read_manifest
+from unstack.dataset_folders import DATASET_FORMAT, MANIFEST, TIMINGS, config_name, list_configurations, read_manifest
 from unstack.errors import UnstackError
 from unstack.sim.configuration import SimulatedConfiguration, simulate_configuration
 from unstack.sim.settings import SimulationSettings, json_ready
