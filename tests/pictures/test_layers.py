@@ -11,7 +11,7 @@ ALLOWED = {
     "scene",
     "supports",
     "geometry",
-    "figures",
+    "plotting",
     "atomic",
     "errors",
     "checks",
