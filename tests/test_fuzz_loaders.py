@@ -166,29 +166,3 @@ def test_the_seeds_of_the_fuzzer_are_valid(tmp_path: Path, document: dict[str, A
     file = tmp_path / "valid.json"
     file.write_text(json.dumps(document))
     unstack.validate(file)
-
-
-@FUZZ
-@given(mutated())
-def test_the_small_validator_agrees_with_jsonschema(text: str) -> None:
-    from jsonschema import Draft202012Validator
-
-    from unstack.jsonio import FORMATS, load_schema
-    from unstack.schema_check import iter_errors
-
-    try:
-        document = json.loads(text)
-    except ValueError:
-        return
-    if (
-        not isinstance(document, dict)
-        or not isinstance(document.get("format"), str)
-        or document["format"] not in FORMATS
-    ):
-        return
-    schema = load_schema(document["format"])
-    ours = {(tuple(map(str, e.absolute_path)), e.validator) for e in iter_errors(schema, document)}
-    theirs = {
-        (tuple(map(str, e.absolute_path)), e.validator) for e in Draft202012Validator(schema).iter_errors(document)
-    }
-    assert ours == theirs

@@ -323,8 +323,6 @@ def validate_document(
     InvalidFile
         The document violates its schema (the first problem, by JSON path).
     """
-    from unstack.schema_check import iter_errors
-
     accepted = list(expected) if expected is not None else list(FORMATS)
     tag = document.data.get("format")
     if tag is None:
@@ -356,7 +354,11 @@ def validate_document(
         if document.size > LARGE_DOCUMENT:
             where = format_json_path(_data_path(document.data, error.path[1:]))
             raise error_class(document.source, where, error.message.split(" ", 1)[-1]) from None
-    errors = sorted(iter_errors(load_schema(tag), document.data), key=lambda e: list(e.absolute_path))
+    from jsonschema import Draft202012Validator  # only for an invalid document: it words the message
+
+    errors = sorted(
+        Draft202012Validator(load_schema(tag)).iter_errors(document.data), key=lambda e: list(e.absolute_path)
+    )
     if errors:
         first = errors[0]
         if first.validator in {"oneOf", "anyOf"} and first.context:

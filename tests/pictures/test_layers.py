@@ -17,7 +17,6 @@ ALLOWED = {
     "checks",
     "jsonio",
     "pictures",
-    "schema_check",
 }
 
 
