@@ -21,12 +21,15 @@ from __future__ import annotations
 
 import argparse
 import json
-import statistics
-import time
+import sys
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from alternating import median_seconds, scenes_with_detected
+
 import unstack
-from unstack.scene import Scene, load_scene
+from unstack.scene import load_scene
 from unstack.sim.belief import belief_removals
 
 
@@ -41,25 +44,14 @@ def main() -> None:
     piles = [load_scene(path) for path in sorted(arguments.data.glob("config-*.json"))[: arguments.piles]]
     result: dict[str, dict[str, float]] = {}
     for size in (int(text) for text in arguments.sizes.split(",")):
-        scenes = [Scene(p.boxes, p.points, p.box_ids[:size], metadata=p.metadata, source=p.source) for p in piles]
-        scenes = [scene for scene in scenes if len(scene.detected) == size]
+        scenes = scenes_with_detected(piles, size)
         if not scenes:
             print(f"{size} detected boxes: no pile of the data set has that many")
             continue
-        seconds: dict[str, list[float]] = {"belief": [], "load": []}
         calls = {"belief": lambda scene: belief_removals(scene), "load": lambda scene: unstack.decide(scene, seed=0)}
-        for scene in scenes:
-            for call in calls.values():
-                call(scene)  # warm-up: kernels compiled, models loaded, pybullet imported
-            for _ in range(arguments.repeat):
-                for name, call in calls.items():
-                    start = time.perf_counter()
-                    call(scene)
-                    seconds[name].append(time.perf_counter() - start)
-        medians = {name: statistics.median(times) for name, times in seconds.items()}
-        result[str(size)] = {**{f"{name}_median_s": value for name, value in medians.items()},
-                             "ratio_belief_to_load": medians["belief"] / medians["load"], "scenes": len(scenes),
-                             "calls": len(seconds["belief"])}  # fmt: skip
+        timed = median_seconds(scenes, calls, arguments.repeat)
+        medians = {name: timed[f"{name}_median_s"] for name in calls}
+        result[str(size)] = {**timed, "ratio_belief_to_load": medians["belief"] / medians["load"]}
         print(
             f"{size} detected boxes, {len(scenes)} scenes x {arguments.repeat}: belief {medians['belief']:.2f} s, "
             f"load {1000 * medians['load']:.0f} ms median (belief / load {medians['belief'] / medians['load']:.1f})"

@@ -20,12 +20,15 @@ from __future__ import annotations
 
 import argparse
 import json
-import statistics
-import time
+import sys
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from alternating import median_seconds, scenes_with_detected
+
 import unstack
-from unstack.scene import Scene, load_scene
+from unstack.scene import load_scene
 
 
 def main() -> None:
@@ -39,21 +42,13 @@ def main() -> None:
     piles = [load_scene(path) for path in sorted(arguments.data.glob("config-*.json"))[: arguments.piles]]
     result: dict[str, dict[str, float]] = {}
     for size in (int(text) for text in arguments.sizes.split(",")):
-        scenes = [Scene(p.boxes, p.points, p.box_ids[:size], metadata=p.metadata, source=p.source) for p in piles]
-        scenes = [scene for scene in scenes if len(scene.detected) == size]
-        seconds: dict[str, list[float]] = {"moves": [], "load": []}
-        for scene in scenes:
-            for cost in seconds:
-                unstack.decide(scene, cost=cost, seed=0)  # warm-up: kernels compiled, models loaded
-            for _ in range(arguments.repeat):
-                for cost, times in seconds.items():
-                    start = time.perf_counter()
-                    unstack.decide(scene, cost=cost, seed=0)
-                    times.append(time.perf_counter() - start)
-        medians = {cost: statistics.median(times) for cost, times in seconds.items()}
-        result[str(size)] = {**{f"{cost}_median_s": value for cost, value in medians.items()},
-                             "ratio_moves_to_load": medians["moves"] / medians["load"], "scenes": len(scenes),
-                             "calls": len(seconds["moves"])}  # fmt: skip
+        scenes = scenes_with_detected(piles, size)
+        calls = {
+            cost: (lambda scene, cost=cost: unstack.decide(scene, cost=cost, seed=0)) for cost in ("moves", "load")
+        }
+        timed = median_seconds(scenes, calls, arguments.repeat)
+        medians = {cost: timed[f"{cost}_median_s"] for cost in calls}
+        result[str(size)] = {**timed, "ratio_moves_to_load": medians["moves"] / medians["load"]}
         moves_ms, load_ms = medians["moves"] * 1000, medians["load"] * 1000
         print(
             f"{size} detected boxes, {len(scenes)} scenes x {arguments.repeat}: "
