@@ -122,3 +122,21 @@ def test_ranking_and_json_of_a_scene_decision(examples: Path) -> None:
     assert [cost for _, cost, _ in ranking[1:]] == sorted(cost for _, cost, _ in ranking[1:])
     document = json.loads(json.dumps(decision.to_dict()))
     assert document["choice"] == decision.choice and isinstance(document["warnings"], list)
+
+
+@pytest.mark.slow  # the default model and the SAT listing of 6,942 worlds
+def test_the_payoff_of_a_scene_agrees_with_the_decision_on_eq_11(examples: Path) -> None:
+    from unstack.api import payoff
+
+    scene = unstack.load(examples / "pile5.scene.json")
+    table = payoff(scene)
+    decision = unstack.decide(scene, cost="count", method="exact")
+    assert len(table.worlds) == 6942 and table.objects == decision.objects
+    np.testing.assert_allclose(table.expected_costs(), decision.expected_costs, atol=1e-9)
+
+
+def test_a_payoff_of_supports_takes_no_model() -> None:
+    from unstack.api import payoff
+
+    with pytest.raises(InvalidArgument, match="the model would be ignored"):
+        payoff(unstack.Supports(["a", "b"], [[0, 0.2], [0.7, 0]]), "general")

@@ -3,7 +3,8 @@
 ``load_model`` names a shipped model or reads a model file; ``support_probabilities`` turns
 a scene into support probabilities with a model (the default one when none is given);
 ``decide`` and ``plan`` take a scene or support probabilities and return a
-:class:`~unstack.reasoner.decision.Decision` or a :class:`~unstack.reasoner.plan.Plan`.
+:class:`~unstack.reasoner.decision.Decision` or a :class:`~unstack.reasoner.plan.Plan`;
+``payoff`` lists the consistent worlds of a small scene with the cost of each action (Table II).
 
 Light by design: deciding on support probabilities imports neither scikit-learn nor the
 learning package; they load only when a scene needs probabilities. The shipped models are
@@ -37,7 +38,7 @@ from unstack.supports import Supports
 if TYPE_CHECKING:
     from unstack.learning.model_file import SupportModel
 
-__all__ = ["decide", "load_model", "model_label", "model_names", "plan", "support_probabilities"]
+__all__ = ["decide", "load_model", "model_label", "model_names", "payoff", "plan", "support_probabilities"]
 
 ModelArgument = Union[None, str, os.PathLike[str], "SupportModel"]
 
@@ -240,6 +241,36 @@ def _supports(scene_or_supports: Any, model: Any, statics: bool = True) -> Suppo
     if isinstance(scene_or_supports, Scene):
         return support_probabilities(scene_or_supports, model, statics=statics)
     raise InvalidArgument(f"expected a Scene or Supports, got {type(scene_or_supports).__name__}")
+
+
+def payoff(scene_or_supports: Scene | Supports, model: ModelArgument = None, *, cost: str = "count") -> Any:
+    """The payoff matrix (Table II): every consistent world, its probability and each action's cost.
+
+    Parameters
+    ----------
+    scene_or_supports : Scene or Supports
+        A scene (its probabilities come from ``model``) or support probabilities.
+    model : str, path-like or SupportModel, optional
+        For a scene only (default: the default model).
+    cost : {"count", "mass"}
+        Eq. 11's count of supported boxes, or their mass.
+
+    Returns
+    -------
+    PayoffMatrix
+        Lists the worlds with a SAT solver: for small scenes (up to
+        :data:`~unstack.reasoner.worlds.SAT_MAX_BOXES` boxes).
+
+    Examples
+    --------
+    >>> import unstack
+    >>> table = payoff(unstack.Supports(["top", "bottom"], [[0, 0.1], [0.9, 0]]))
+    >>> len(table.worlds), table.expected_costs().round(2).tolist()
+    (4, [0.1, 0.9])
+    """
+    from unstack.reasoner.payoff import payoff_matrix
+
+    return payoff_matrix(_supports(scene_or_supports, model), cost=cost)
 
 
 def decide(

@@ -278,13 +278,10 @@ def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str, 
 
     Lists worlds with a SAT solver, so it is for small scenes (up to 6 boxes).
     """
-    import unstack
-    from unstack.reasoner.payoff import payoff_matrix
+    from unstack.api import payoff
 
     _check_output(output)
-    loaded = _load_input(file, model)
-    supports = loaded if isinstance(loaded, unstack.Supports) else unstack.support_probabilities(loaded, model)
-    table = payoff_matrix(supports, cost=cost)
+    table = payoff(_load_input(file, model), model, cost=cost)
     document = table.to_dict()
     _write_output(output, document)
 
