@@ -41,6 +41,9 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     the same oracle of poses without the masses: every box of the settings' mean mass, or
     the mean over :data:`~unstack.sim.belief.BELIEF_WORLDS` worlds of masses drawn from the
     settings' range -- what a robot that sees every box but weighs none could know.
+``rebuilt_hidden_fixed``
+    ``rebuilt`` with the boxes the cloud does not show (:func:`unstack.sim.belief.seen_boxes`)
+    fixed in place: the space they fill is known, what they would do is not.
 ``belief_seen``
     the belief (``belief``) with every box the cloud shows (:func:`unstack.sim.belief.seen_boxes`)
     as a box at its pose, not only the candidates: a detector that reports every box in view.
@@ -86,7 +89,7 @@ __all__ = ["CONTAINER_MAKERS", "CONTAINER_SAMPLES", "container_experiment", "con
 CONTAINER_MAKERS = (
     "unstack", "min_cost", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random", "lookahead",
     "moves", "moves_veto", "belief", "belief_veto", "rebuilt",
-    "rebuilt_typical", "rebuilt_draws", "belief_seen",
+    "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen",
 )  # fmt: skip
 #: Makers whose policy is told what every candidate's removal does in the engine (the true pile).
 PROBING_MAKERS = ("lookahead",)
@@ -170,6 +173,14 @@ def container_policies(
 
         return policy
 
+    def rebuilt_hidden_fixed(scene: Scene) -> str:
+        from unstack.sim.belief import seen_boxes
+        from unstack.sim.unloading import rebuilt_removals
+
+        seen = set(seen_boxes(scene)) | set(scene.detected)
+        hidden = [box.id for box in scene.boxes if box.id not in seen]
+        return lookahead(scene, rebuilt_removals(scene, fixed=hidden))
+
     def rebuilt_draws(scene: Scene) -> str:
         from unstack.geometry import bounding_boxes
         from unstack.sim.belief import BELIEF_WORLDS, choose_by_expected_moves
@@ -243,6 +254,7 @@ def container_policies(
         "rebuilt": rebuilding(True),
         "rebuilt_typical": rebuilding(False),
         "rebuilt_draws": rebuilt_draws,
+        "rebuilt_hidden_fixed": rebuilt_hidden_fixed,
         "belief_seen": belief_seen,
     }
     unknown = [maker for maker in makers if maker not in every]

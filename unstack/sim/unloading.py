@@ -475,6 +475,7 @@ def rebuilt_removals(
     *,
     true_masses: bool = True,
     masses: dict[str, float] | None = None,
+    fixed: Sequence[str] = (),
 ) -> dict[str, UnloadStep]:
     """What taking out each candidate would do in a fresh world rebuilt from the scene's poses.
 
@@ -498,6 +499,8 @@ def rebuilt_removals(
         robot that sees every pose but weighs nothing would build).
     masses : dict of str to float, optional
         The mass of each box (kg), instead of either (a draw of what the robot does not know).
+    fixed : sequence of str
+        Boxes put in as static bodies: the space they fill is known, what they would do is not.
 
     Returns
     -------
@@ -515,6 +518,7 @@ def rebuilt_removals(
         for box in scene.boxes:
             mass = box.mass if box.mass is not None and true_masses else typical
             mass = mass if masses is None else masses[box.id]
+            mass = 0.0 if box.id in fixed else mass
             world.add_box(box.size, box.position, box.orientation_xyzw, mass=mass)
         world.step(RESETTLE_SECONDS)
         return probe_removals(scene, world, scene.box_ids, tried)
