@@ -33,21 +33,8 @@ def _values(loaded: Any, decision_file: str | None, with_plan: bool, model: str 
         return values
     if with_plan:
         result = unstack.plan(loaded, model=model, seed=seed)
-        decision = result.steps[0].decision
-        order: list[str] | None = result.order
-    else:
-        decision = unstack.decide(loaded, model=model, seed=seed)
-        order = None
-    return DecisionValues(
-        decision.objects,
-        decision.expected_costs,
-        decision.expected_cost_errors,
-        choice=decision.choice,
-        order=order,
-        probabilities=decision.marginals,
-        cost_name=f"expected cost ({decision.cost})",
-        source=loaded.source,
-    )
+        return DecisionValues.from_decision(result.steps[0].decision, order=result.order, source=loaded.source)
+    return DecisionValues.from_decision(unstack.decide(loaded, model=model, seed=seed), source=loaded.source)
 
 
 def _camera(scene: Any) -> Any:

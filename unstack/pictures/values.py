@@ -120,6 +120,29 @@ class DecisionValues:
         ):
             object.__setattr__(self, name, value)
 
+    @classmethod
+    def from_decision(cls, decision: Any, *, order: Sequence[str] | None = None, source: str = "<decision>") -> Any:
+        """The numbers of a :class:`~unstack.reasoner.decision.Decision` (and a plan's order) to draw.
+
+        Examples
+        --------
+        >>> from unstack.reasoner.decision import decide
+        >>> from unstack.supports import Supports
+        >>> values = DecisionValues.from_decision(decide(Supports(["top", "bottom"], [[0, 0.1], [0.9, 0]])))
+        >>> values.choice, values.cost_name
+        ('top', 'expected cost (load)')
+        """
+        return cls(
+            decision.objects,
+            decision.expected_costs,
+            decision.expected_cost_errors,
+            choice=decision.choice,
+            order=order,
+            probabilities=decision.marginals,
+            cost_name=f"expected cost ({decision.cost})",
+            source=source,
+        )
+
     def index(self, box: str) -> int:
         """Position of ``box`` in :attr:`objects`."""
         return self.objects.index(box)
