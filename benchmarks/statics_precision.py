@@ -4,7 +4,7 @@ For every pile of the given data sets (``unstack simulate`` folders, with remova
 several detected sets per pile (every box, and random sets of 5 and 10), the leaning rule of
 :mod:`unstack.understanding.statics` is run on the detected boxes. Each finding "X holds Y up" is checked
 against the removal label (did Y move when X was taken away?): the share that holds is the
-rule's precision, the figure :data:`unstack.understanding.statics.LEAN_SUPPORT_PROBABILITY` stands for.
+rule's precision, the figure :data:`unstack.understanding.statics.TIP_SUPPORT_PROBABILITY` stands for.
 Then the default decision is made with and without statics, and the box each picks is
 scored by the ground truth: how many boxes it really holds up (directly or not), and whether
 it holds any.
@@ -30,7 +30,7 @@ from unstack.learning.model_file import default_model_path, load_model
 from unstack.pipeline import scene_support_probabilities
 from unstack.reasoner.decision import decide
 from unstack.scene import load_scene
-from unstack.understanding.statics import LEAN_SUPPORT_PROBABILITY, leaning_supports
+from unstack.understanding.statics import TIP_SUPPORT_PROBABILITY, tip_supports
 
 
 def _detected_sets(n: int, sets: int, rng: np.random.Generator) -> list[list[int]]:
@@ -60,14 +60,14 @@ def run_folder(folder: Path, model: Any, sets: int, rng: np.random.Generator) ->
         ids = list(scene.box_ids)
         for detected in _detected_sets(len(ids), sets, rng):
             names = [ids[k] for k in detected]
-            found = leaning_supports(scene, names)
+            found = tip_supports(scene, names)
             plain = scene_support_probabilities(scene, model, boxes=names, statics=False)
             for finding in found:
-                supporter, leaning = ids.index(finding.supporter), ids.index(finding.leaning)
+                supporter, leaning = ids.index(finding.supporter), ids.index(finding.held)
                 findings += 1
                 true += int(truth[supporter, leaning])
-                before.append(float(plain.probabilities[names.index(finding.supporter), names.index(finding.leaning)]))
-                if before[-1] < LEAN_SUPPORT_PROBABILITY:  # the pairs whose probability the rule raises
+                before.append(float(plain.probabilities[names.index(finding.supporter), names.index(finding.held)]))
+                if before[-1] < TIP_SUPPORT_PROBABILITY:  # the pairs whose probability the rule raises
                     raised += 1
                     raised_true += int(truth[supporter, leaning])
             if not found:

@@ -16,3 +16,28 @@ def test_an_old_module_name_warns_and_gives_the_same_names(old: str, new: str) -
     successor = importlib.import_module(f"unstack.{new}")
     assert module.__all__ == successor.__all__
     assert all(getattr(module, name) is getattr(successor, name) for name in successor.__all__)
+
+
+@pytest.mark.parametrize(
+    ("old", "new"),
+    [
+        ("Leaning", "TipSupport"),
+        ("leaning_supports", "tip_supports"),
+        ("raise_leaning_supports", "raise_tip_supports"),
+        ("LEAN_SUPPORT_PROBABILITY", "TIP_SUPPORT_PROBABILITY"),
+    ],
+)
+def test_an_old_statics_name_warns_and_is_the_new_one(old: str, new: str) -> None:
+    from unstack.understanding import statics
+
+    with pytest.warns(DeprecationWarning, match=rf"statics\.{old} is renamed {new}"):
+        value = getattr(statics, old)
+    assert value is getattr(statics, new)
+
+
+def test_a_tip_support_still_answers_to_leaning_with_a_warning() -> None:
+    from unstack.understanding.statics import TipSupport
+
+    found = TipSupport("lean", "upright", 0.04, True)
+    with pytest.warns(DeprecationWarning, match=r"TipSupport\.leaning is renamed TipSupport\.held"):
+        assert found.leaning == "lean"

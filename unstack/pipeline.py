@@ -82,7 +82,7 @@ def scene_support_probabilities(
         Raise ``P(X supports Y)`` where ``Y`` cannot stand without ``X`` (it leans on it, or
         rests across a gap on it and another)
         (:mod:`unstack.understanding.statics`; each raise is a warning and is listed in
-        ``metadata["leaning"]``); ``False``: the model's probabilities alone.
+        ``metadata["tip_supports"]``); ``False``: the model's probabilities alone.
 
     Returns
     -------
@@ -109,15 +109,15 @@ def scene_support_probabilities(
         doubts += _out_of_distribution(
             scene.source, model, features, [(objects[i], objects[j]) for i, j in zip(rows, columns, strict=True)]
         )
-    leaning: list[dict[str, object]] = []
+    held_up: list[dict[str, object]] = []
     if statics and n > 1:
-        from unstack.understanding.statics import leaning_supports, raise_leaning_supports
+        from unstack.understanding.statics import raise_tip_supports, tip_supports
 
-        found = leaning_supports(scene, objects)
-        probabilities, raised = raise_leaning_supports(probabilities, objects, found)
+        found = tip_supports(scene, objects)
+        probabilities, raised = raise_tip_supports(probabilities, objects, found)
         doubts += [f"{scene.source}: {sentence}" for sentence in raised]
-        leaning = [
-            {"leaning": f.leaning, "supporter": f.supporter, "overhang_m": round(f.overhang, 4), "on_floor": f.on_floor}
+        held_up = [
+            {"held": f.held, "supporter": f.supporter, "overhang_m": round(f.overhang, 4), "on_floor": f.on_floor}
             for f in found
         ]
     from unstack.understanding.hidden_load import hidden_load
@@ -131,7 +131,7 @@ def scene_support_probabilities(
         "clipped_to": [PROBABILITY_FLOOR, 1.0 - PROBABILITY_FLOOR],
         "warnings": doubts,
         "statics": statics,
-        "leaning": leaning,
+        "tip_supports": held_up,
     }
     return Supports(
         objects,

@@ -157,7 +157,7 @@ def test_no_statics_keeps_the_models_probabilities(tmp_path: Path) -> None:
     kept = json.loads((tmp_path / "without.json").read_text())
     upright, lean = (raised["objects"].index(name) for name in ("upright", "lean"))
     assert raised["probabilities"][upright][lean] == 0.65 > kept["probabilities"][upright][lean]
-    assert raised["metadata"]["leaning"][0]["supporter"] == "upright" and kept["metadata"]["leaning"] == []
+    assert raised["metadata"]["tip_supports"][0]["supporter"] == "upright" and kept["metadata"]["tip_supports"] == []
     assert without.stderr == ""
 
 

@@ -31,7 +31,7 @@ def test_the_default_model_picks_a_box_that_holds_up_nothing(default_model, kind
         assert decision.choice in case.pickable, (seed, decision.choice, case.pickable)
 
 
-#: Leaning scenes on which near ties by the box centre's height took the box leant on (the
+#: TipSupport scenes on which near ties by the box centre's height took the box leant on (the
 #: model gave it EC 0.056 against the free box's 0.019; seeds 0-99 of the suite, before the
 #: leaning box was made to touch the box it leans on).
 LEANT_ON_BEFORE = (17, 50, 63, 69, 80)
@@ -48,15 +48,15 @@ def test_a_box_leant_on_is_not_taken_for_being_taller(default_model, seed: int) 
 
 @pytest.mark.parametrize("cloud", CLOUDS)
 def test_with_statics_the_box_leant_on_costs_what_it_holds_up(default_model, cloud: str) -> None:  # type: ignore[no-untyped-def]
-    from unstack.understanding.statics import LEAN_SUPPORT_PROBABILITY
+    from unstack.understanding.statics import TIP_SUPPORT_PROBABILITY
 
     for seed in SEEDS:
         scene = canonical_scene(build_case("leaning", seed=seed), cloud=cloud, seed=seed)
         supports = scene_support_probabilities(scene, default_model)
         costs = dict(zip(*(lambda d: (d.objects, d.expected_costs))(decide(supports)), strict=True))
-        assert costs["upright"] >= LEAN_SUPPORT_PROBABILITY - 0.01 > 0.5 > costs["free"]
+        assert costs["upright"] >= TIP_SUPPORT_PROBABILITY - 0.01 > 0.5 > costs["free"]
         assert any("without 'upright'" in warning for warning in supports.metadata["warnings"])
-        assert supports.metadata["leaning"][0]["supporter"] == "upright"
+        assert supports.metadata["tip_supports"][0]["supporter"] == "upright"
 
 
 @pytest.mark.parametrize("cloud", CLOUDS)

@@ -13,7 +13,7 @@ from unstack.experiments.generalisation import canonical_scene
 from unstack.geometry import box_corners
 from unstack.scene import Box, Scene
 from unstack.understanding.clouds import surface_cloud
-from unstack.understanding.statics import LEAN_SUPPORT_PROBABILITY, Leaning, leaning_supports, raise_leaning_supports
+from unstack.understanding.statics import TIP_SUPPORT_PROBABILITY, TipSupport, raise_tip_supports, tip_supports
 
 
 def _tipped(size: list[float], degrees: float, front_face: float, wall_top: float) -> Box:
@@ -43,25 +43,25 @@ def _offset(degrees: float, thickness: float = 0.15, height: float = 0.6) -> flo
 
 @pytest.mark.parametrize("degrees", [18.0, 22.0, 30.0])
 def test_a_box_tipped_past_its_corner_leans_on_the_box_it_touches(degrees: float) -> None:
-    found = leaning_supports(_leaning_scene(degrees))
-    assert [(f.supporter, f.leaning, f.on_floor) for f in found] == [("upright", "lean", True)]
+    found = tip_supports(_leaning_scene(degrees))
+    assert [(f.supporter, f.held, f.on_floor) for f in found] == [("upright", "lean", True)]
     assert found[0].overhang == pytest.approx(_offset(degrees), abs=0.008)
 
 
 @pytest.mark.parametrize("degrees", [5.0, 12.0])
 def test_a_box_whose_centre_stays_over_its_edge_leans_on_nothing(degrees: float) -> None:
     assert _offset(degrees) < 0.01  # tipped less than its corner's angle: it would right itself
-    assert leaning_supports(_leaning_scene(degrees)) == []
+    assert tip_supports(_leaning_scene(degrees)) == []
 
 
 def test_a_box_leaning_on_a_lower_box_touches_its_top_edge_and_leans_on_it() -> None:
-    found = leaning_supports(_leaning_scene(22.0, lean_height=0.7, wall_height=0.5))
-    assert [(f.supporter, f.leaning) for f in found] == [("upright", "lean")]
+    found = tip_supports(_leaning_scene(22.0, lean_height=0.7, wall_height=0.5))
+    assert [(f.supporter, f.held) for f in found] == [("upright", "lean")]
 
 
 def test_a_box_nobody_detected_is_no_supporter() -> None:
     scene = _leaning_scene(22.0)
-    assert leaning_supports(scene, ["lean", "free"]) == []
+    assert tip_supports(scene, ["lean", "free"]) == []
 
 
 def test_a_box_resting_on_the_leaning_one_does_not_hold_it_up() -> None:
@@ -71,7 +71,7 @@ def test_a_box_resting_on_the_leaning_one_does_not_hold_it_up() -> None:
     top = corners[np.argsort(corners[:, 2])[-4:]]  # the face the box rests on tips down towards -x
     rider = Box("rider", [0.12, 0.3, 0.12], [float(top[:, 0].mean()) - 0.1, 0.0, float(top[:, 2].max()) + 0.07])
     scene = Scene([*scene.boxes, rider], np.zeros((0, 3)), ["upright", "lean", "free", "rider"])
-    assert [(f.supporter, f.leaning) for f in leaning_supports(scene)] == [("upright", "lean")]
+    assert [(f.supporter, f.held) for f in tip_supports(scene)] == [("upright", "lean")]
 
 
 def test_a_tilted_box_resting_across_two_boxes_is_held_by_each() -> None:
@@ -83,13 +83,13 @@ def test_a_tilted_box_resting_across_two_boxes_is_held_by_each() -> None:
     along, up = np.array([np.cos(angle), np.sin(angle)]), np.array([-np.sin(angle), np.cos(angle)])
     centre = start + 0.3 * along + 0.05 * up
     plank = Box("plank", [0.4, 0.6, 0.1], [1.0, *centre], Rotation.from_euler("x", angle).as_quat())
-    found = leaning_supports(Scene([left, right, plank], np.zeros((0, 3)), ["left", "right", "plank"]))
-    assert [(f.supporter, f.leaning) for f in found] == [
+    found = tip_supports(Scene([left, right, plank], np.zeros((0, 3)), ["left", "right", "plank"]))
+    assert [(f.supporter, f.held) for f in found] == [
         ("left", "plank"),
         ("right", "plank"),
     ]  # without either it tips
     # the lower box not detected (and no cloud): the plank would tip, but nothing detected holds it
-    assert leaning_supports(Scene([left, right, plank], np.zeros((0, 3)), ["right", "plank"])) == []
+    assert tip_supports(Scene([left, right, plank], np.zeros((0, 3)), ["right", "plank"])) == []
 
 
 def _raised_box_against_a_column(under_share: float) -> Scene:
@@ -105,14 +105,14 @@ def _raised_box_against_a_column(under_share: float) -> Scene:
 
 
 def test_a_cloud_under_the_box_is_part_of_its_base() -> None:
-    assert leaning_supports(_raised_box_against_a_column(1.0)) == []  # held from below all along
-    found = leaning_supports(_raised_box_against_a_column(0.3))  # only its far part rests on something
-    assert [(f.supporter, f.leaning, f.on_floor) for f in found] == [("column", "held", False)]
+    assert tip_supports(_raised_box_against_a_column(1.0)) == []  # held from below all along
+    found = tip_supports(_raised_box_against_a_column(0.3))  # only its far part rests on something
+    assert [(f.supporter, f.held, f.on_floor) for f in found] == [("column", "held", False)]
 
 
 def test_a_box_with_nothing_known_under_it_is_left_to_the_floating_warning() -> None:
     scene = _raised_box_against_a_column(1.0)
-    assert leaning_supports(Scene(scene.boxes, np.zeros((0, 3)), scene.detected)) == []
+    assert tip_supports(Scene(scene.boxes, np.zeros((0, 3)), scene.detected)) == []
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -121,21 +121,21 @@ def test_every_leaning_scene_of_the_suite_is_found_on_both_clouds(seed: int) -> 
     for cloud in ("sensor", "surface"):
         if cloud == "sensor" and seed > 1:
             continue  # the range sensor needs pybullet's renderer: two seeds are enough
-        found = leaning_supports(canonical_scene(case, cloud=cloud, seed=seed))
-        assert [(f.supporter, f.leaning) for f in found] == [("upright", "lean")]
+        found = tip_supports(canonical_scene(case, cloud=cloud, seed=seed))
+        assert [(f.supporter, f.held) for f in found] == [("upright", "lean")]
 
 
 @pytest.mark.parametrize("kind", list(CANONICAL_KINDS))
 def test_every_finding_on_the_suite_is_a_box_the_other_rests_on(kind: str) -> None:
     for seed in range(3):
         case = build_case(kind, seed=seed)
-        for finding in leaning_supports(canonical_scene(case, cloud="surface", seed=seed)):
-            assert finding.supporter in case.rests_on[finding.leaning], (seed, finding)
+        for finding in tip_supports(canonical_scene(case, cloud="surface", seed=seed)):
+            assert finding.supporter in case.rests_on[finding.held], (seed, finding)
 
 
 def test_a_box_across_a_gap_is_held_by_both_boxes_under_it() -> None:
     case = build_case("pyramid", seed=0)
-    found = {(f.supporter, f.leaning) for f in leaning_supports(canonical_scene(case, cloud="surface", seed=0))}
+    found = {(f.supporter, f.held) for f in tip_supports(canonical_scene(case, cloud="surface", seed=0))}
     across = {(under, name) for name, unders in case.rests_on.items() if len(unders) == 2 for under in unders}
     assert across and across <= found
 
@@ -145,7 +145,7 @@ def test_a_box_on_one_box_alone_is_left_to_the_model(kind: str, seed: int) -> No
     """Scenes whose noisy surface cloud has a few points under a stacked box: they do not make
     the box under it "necessary" (on simulated piles such raises were mostly wrong)."""
     case = build_case(kind, seed=seed)
-    assert leaning_supports(canonical_scene(case, cloud="surface", seed=seed)) == []
+    assert tip_supports(canonical_scene(case, cloud="surface", seed=seed)) == []
 
 
 @settings(max_examples=25, deadline=None)
@@ -168,10 +168,9 @@ def test_turning_and_moving_the_whole_scene_changes_nothing(
         )
         for box in scene.boxes
     ]
-    before = [(f.supporter, f.leaning, round(f.overhang, 3)) for f in leaning_supports(scene)]
+    before = [(f.supporter, f.held, round(f.overhang, 3)) for f in tip_supports(scene)]
     after = [
-        (f.supporter, f.leaning, round(f.overhang, 3))
-        for f in leaning_supports(Scene(moved, scene.points, scene.detected))
+        (f.supporter, f.held, round(f.overhang, 3)) for f in tip_supports(Scene(moved, scene.points, scene.detected))
     ]
     assert [pair[:2] for pair in after] == [pair[:2] for pair in before]
     assert [pair[2] for pair in after] == pytest.approx([pair[2] for pair in before], abs=0.004)
@@ -179,10 +178,10 @@ def test_turning_and_moving_the_whole_scene_changes_nothing(
 
 def test_the_raise_only_ever_raises_and_names_each_pair() -> None:
     probabilities = np.array([[0.0, 0.9, 0.1], [0.2, 0.0, 0.3], [0.05, 0.01, 0.0]])
-    found = [Leaning("b", "a", 0.03, True), Leaning("c", "a", 0.02, False)]
-    raised, said = raise_leaning_supports(probabilities, ["a", "b", "c"], found)
+    found = [TipSupport("b", "a", 0.03, True), TipSupport("c", "a", 0.02, False)]
+    raised, said = raise_tip_supports(probabilities, ["a", "b", "c"], found)
     assert raised[0, 1] == 0.9  # already above: kept
-    assert raised[0, 2] == LEAN_SUPPORT_PROBABILITY
+    assert raised[0, 2] == TIP_SUPPORT_PROBABILITY
     assert np.array_equal(np.delete(raised.ravel(), 2), np.delete(probabilities.ravel(), 2))
     assert said == ["box 'c' cannot stand on what is under it without 'a' (its centre of mass lies 0.02 m beyond): "
                     "P(a supports c) raised from 0.10 to 0.65"]  # fmt: skip
@@ -193,4 +192,4 @@ def test_a_surface_cloud_of_the_scene_does_not_change_the_finding() -> None:
     scene = _leaning_scene(22.0)
     cloud = surface_cloud(list(scene.boxes), viewpoint=[-2.0, 0.0, 1.5], spacing=0.015, depth_noise=0.004, seed=3)
     scanned = Scene(scene.boxes, cloud, scene.detected)
-    assert [(f.supporter, f.leaning) for f in leaning_supports(scanned)] == [("upright", "lean")]
+    assert [(f.supporter, f.held) for f in tip_supports(scanned)] == [("upright", "lean")]

@@ -20,7 +20,7 @@ without a model. For each detected box ``Y``:
   base, that box's contacts beyond its edge): a box across a gap between two, a box on its
   edge whose top rests on another's top edge, a plank from one box to another;
 * for each box that holds ``Y`` up, ``P(X supports Y)`` is raised to at least
-  :data:`LEAN_SUPPORT_PROBABILITY`, never lowered. A box that rests on one box alone is not
+  :data:`TIP_SUPPORT_PROBABILITY`, never lowered. A box that rests on one box alone is not
   raised: on simulated piles the model's low probabilities there were mostly right.
 
 Contacts are found on a grid of points over ``Y``'s faces: a point touches ``X`` when it
@@ -42,13 +42,14 @@ Examples
 >>> lean = Box("lean", lean.size, [1.2 - corners[:, 0].max() - 0.002, 0.0, -corners[:, 2].min() + 0.001],
 ...            lean.orientation_xyzw)
 >>> upright = Box("upright", [0.4, 0.5, 0.65], [1.4, 0.0, 0.326])
->>> found = leaning_supports(Scene([upright, lean], np.zeros((0, 3)), ["upright", "lean"]))
->>> [(f.supporter, f.leaning, round(f.overhang, 2), f.on_floor) for f in found]
+>>> found = tip_supports(Scene([upright, lean], np.zeros((0, 3)), ["upright", "lean"]))
+>>> [(f.supporter, f.held, round(f.overhang, 2), f.on_floor) for f in found]
 [('upright', 'lean', 0.04, True)]
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -59,13 +60,32 @@ from unstack.scene import Box, Scene
 
 __all__ = [
     "CONTACT_GAP",
-    "LEAN_SUPPORT_PROBABILITY",
     "MIN_OVERHANG",
     "MIN_TILT_DEG",
-    "Leaning",
-    "leaning_supports",
-    "raise_leaning_supports",
+    "TIP_SUPPORT_PROBABILITY",
+    "TipSupport",
+    "raise_tip_supports",
+    "tip_supports",
 ]
+
+#: Names before the rule's names said what it finds (a box kept from tipping, not only one
+#: leaning); they warn and go with version 0.2.
+_RENAMED = {
+    "Leaning": "TipSupport",
+    "leaning_supports": "tip_supports",
+    "raise_leaning_supports": "raise_tip_supports",
+    "LEAN_SUPPORT_PROBABILITY": "TIP_SUPPORT_PROBABILITY",
+}
+
+
+def __getattr__(name: str) -> object:
+    if name in _RENAMED:
+        warnings.warn(
+            f"unstack.understanding.statics.{name} is renamed {_RENAMED[name]}", DeprecationWarning, stacklevel=2
+        )
+        return globals()[_RENAMED[name]]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 #: Boxes tilted less than this (degrees from standing on a face) are examined only for what
 #: their base needs, not for leaning: their overhang is more often a pose error.
@@ -87,17 +107,17 @@ MIN_RISE = 0.05
 #: The support probability a box found to hold another gets at least: of the findings whose
 #: probability the rule raises, the share in which removing that box moved the other on the
 #: simulated piles the rule was tuned on (68 of 101; 66 of 110 on fresh piles: generalisation page).
-LEAN_SUPPORT_PROBABILITY = 0.65
+TIP_SUPPORT_PROBABILITY = 0.65
 
 
 @dataclass(frozen=True)
-class Leaning:
+class TipSupport:
     """A detected box that cannot stand without another detected box, and that box.
 
     Attributes
     ----------
-    leaning : str
-        The box that would tip over.
+    held : str
+        The box that would tip over without ``supporter``.
     supporter : str
         The box it leans on or rests on.
     overhang : float
@@ -107,16 +127,22 @@ class Leaning:
         Whether that base is the floor alone.
     """
 
-    leaning: str
+    held: str
     supporter: str
     overhang: float
     on_floor: bool
+
+    @property
+    def leaning(self) -> str:
+        """Deprecated name of :attr:`held` (it goes with version 0.2)."""
+        warnings.warn("TipSupport.leaning is renamed TipSupport.held", DeprecationWarning, stacklevel=2)
+        return self.held
 
     def describe(self) -> str:
         """One sentence for a warning."""
         base = "the floor" if self.on_floor else "what is under it"
         return (
-            f"box {self.leaning!r} cannot stand on {base} without {self.supporter!r} "
+            f"box {self.held!r} cannot stand on {base} without {self.supporter!r} "
             f"(its centre of mass lies {self.overhang:.2f} m beyond)"
         )
 
@@ -236,7 +262,7 @@ def _cloud_under(points: np.ndarray, box: Box, bound: np.ndarray, others: Sequen
     return candidates[under, :2]
 
 
-def leaning_supports(scene: Scene, objects: Sequence[str] | None = None) -> list[Leaning]:
+def tip_supports(scene: Scene, objects: Sequence[str] | None = None) -> list[TipSupport]:
     """The detected boxes that cannot stand without another detected box, and those boxes.
 
     Parameters
@@ -249,7 +275,7 @@ def leaning_supports(scene: Scene, objects: Sequence[str] | None = None) -> list
 
     Returns
     -------
-    list of Leaning
+    list of TipSupport
         In the order of ``objects`` (leaning box first, then its supporters).
     """
     names = list(scene.detected if objects is None else objects)
@@ -257,7 +283,7 @@ def leaning_supports(scene: Scene, objects: Sequence[str] | None = None) -> list
     boxes = [scene.boxes[index[name]] for name in names]
     bounds = bounding_boxes(boxes) if boxes else np.zeros((0, 6))
     cloud = scene.points[np.argsort(scene.points[:, 0], kind="stable")]  # sorted once, sliced per box
-    found: list[Leaning] = []
+    found: list[TipSupport] = []
     for row, box in enumerate(boxes):
         tilted = tilt_deg(box) >= MIN_TILT_DEG
         samples, normals, on_bounds, rotation = _face_samples(box, downward_only=not tilted)
@@ -293,7 +319,7 @@ def leaning_supports(scene: Scene, objects: Sequence[str] | None = None) -> list
                     & ((contacts[:, :2] - edge) @ direction > 0.0)
                 )
                 if np.any(holds):
-                    found.append(Leaning(names[row], names[supporter], overhang, on_floor))
+                    found.append(TipSupport(names[row], names[supporter], overhang, on_floor))
             continue
         for supporter in (key for key, part in base.items() if key >= 0 and len(part)):
             # it stands, but would it without this box? (a box on its edge resting on another's top edge)
@@ -305,7 +331,7 @@ def leaning_supports(scene: Scene, objects: Sequence[str] | None = None) -> list
             overhang, edge, direction, on_floor = without
             contacts = base[supporter]
             if np.any((contacts - edge) @ direction > 0.0):
-                found.append(Leaning(names[row], names[supporter], overhang, on_floor))
+                found.append(TipSupport(names[row], names[supporter], overhang, on_floor))
     return found
 
 
@@ -328,16 +354,16 @@ def _tipping(
     return overhang, edge, (box.position[:2] - edge) / overhang, set(parts) == {_FLOOR}
 
 
-def raise_leaning_supports(
-    probabilities: np.ndarray, objects: Sequence[str], found: Sequence[Leaning]
+def raise_tip_supports(
+    probabilities: np.ndarray, objects: Sequence[str], found: Sequence[TipSupport]
 ) -> tuple[np.ndarray, list[str]]:
-    """``P(X supports Y)`` raised to at least :data:`LEAN_SUPPORT_PROBABILITY` for each
+    """``P(X supports Y)`` raised to at least :data:`TIP_SUPPORT_PROBABILITY` for each
     finding, and one sentence per raised pair.
 
     Examples
     --------
     >>> p = np.array([[0.0, 0.05], [0.01, 0.0]])
-    >>> raised, said = raise_leaning_supports(p, ["upright", "lean"], [Leaning("lean", "upright", 0.04, True)])
+    >>> raised, said = raise_tip_supports(p, ["upright", "lean"], [TipSupport("lean", "upright", 0.04, True)])
     >>> raised[0, 1], said[0].endswith("raised from 0.05 to 0.65")
     (np.float64(0.65), True)
     """
@@ -345,12 +371,12 @@ def raise_leaning_supports(
     raised = np.array(probabilities, dtype=np.float64, copy=True)
     said: list[str] = []
     for finding in found:
-        supporter, leaning = position[finding.supporter], position[finding.leaning]
-        before = float(raised[supporter, leaning])
-        if before < LEAN_SUPPORT_PROBABILITY:
-            raised[supporter, leaning] = LEAN_SUPPORT_PROBABILITY
+        supporter, held = position[finding.supporter], position[finding.held]
+        before = float(raised[supporter, held])
+        if before < TIP_SUPPORT_PROBABILITY:
+            raised[supporter, held] = TIP_SUPPORT_PROBABILITY
             said.append(
-                f"{finding.describe()}: P({finding.supporter} supports {finding.leaning}) raised from "
-                f"{before:.2f} to {LEAN_SUPPORT_PROBABILITY:.2f}"
+                f"{finding.describe()}: P({finding.supporter} supports {finding.held}) raised from "
+                f"{before:.2f} to {TIP_SUPPORT_PROBABILITY:.2f}"
             )
     return raised, said
