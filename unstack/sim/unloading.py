@@ -505,6 +505,13 @@ def rebuilt_removals(
     Returns
     -------
     dict of str to UnloadStep
+
+    Examples
+    --------
+    >>> from unstack.scene import load_scene
+    >>> outcomes = rebuilt_removals(load_scene("examples/pile5.scene.json"), ["b04"])
+    >>> "b14" in outcomes["b04"].moved   # b14 rests on b04
+    True
     """
     from unstack.sim.world import PhysicsWorld
 
