@@ -20,7 +20,7 @@ pytestmark = pytest.mark.slow  # physics runs of every decision maker
 @pytest.fixture(scope="module")
 def result(small_dataset: Path) -> dict[str, object]:
     model = load_model(default_model_path())
-    return container_experiment(small_dataset, model, piles=1, max_picks=1, samples=64, seed=2)
+    return container_experiment(small_dataset, model, piles=1, max_picks=1, samples=64, seed=2, makers=CONTAINER_MAKERS)
 
 
 def test_every_maker_picks_from_the_same_pile_up_to_the_pick_limit(result: dict[str, object]) -> None:
@@ -112,3 +112,10 @@ def test_containers_run_on_a_dask_cluster_with_the_same_results(small_dataset: P
 def test_an_unreachable_scheduler_is_one_line(small_dataset: Path, tmp_path: Path) -> None:
     result = unstack("experiment", "container", str(small_dataset), "--out", str(tmp_path), "--scheduler", "nonsense")
     assert result.returncode == 2 and result.stderr.count("\n") == 1 and "tcp://HOST:PORT" in result.stderr
+
+
+def test_the_oracles_run_only_when_named() -> None:
+    from unstack.experiments.container import DEFAULT_CONTAINER_MAKERS, ORACLE_MAKERS
+
+    assert set(ORACLE_MAKERS) <= set(CONTAINER_MAKERS) and not set(ORACLE_MAKERS) & set(DEFAULT_CONTAINER_MAKERS)
+    assert set(DEFAULT_CONTAINER_MAKERS) | set(ORACLE_MAKERS) == set(CONTAINER_MAKERS)

@@ -13,7 +13,7 @@ from unstack.cli.learning import FEATURES_HELP, ISETS_FROM_HELP
 from unstack.cli.main import MODEL_HELP, STATICS_HELP, finite_seconds
 from unstack.cli.progress import progress_bar
 from unstack.errors import UnstackError
-from unstack.experiments.container import CONTAINER_MAKERS, CONTAINER_SAMPLES
+from unstack.experiments.container import CONTAINER_SAMPLES, DEFAULT_CONTAINER_MAKERS, ORACLE_MAKERS
 from unstack.experiments.unloading import UNLOAD_SAMPLES
 from unstack.learning.choices import LEARNERS, SPLITS
 from unstack.learning.features import FEATURE_SETS
@@ -381,8 +381,9 @@ def unload(
 @click.option("--out", required=True, type=click.Path(), help="Folder for container.json.")
 @click.option("--model", "model_path", default=None, help=MODEL_HELP)
 @click.option("--piles", type=click.IntRange(min=1), default=2, show_default=True, help="Piles (the first N).")
-@click.option("--makers", default=",".join(CONTAINER_MAKERS), show_default=True,
-              help="Comma-separated decision makers.")  # fmt: skip
+@click.option("--makers", default=",".join(DEFAULT_CONTAINER_MAKERS), show_default=True,
+              help=f"Comma-separated decision makers; the oracles {', '.join(ORACLE_MAKERS)} (they read every box "
+              "of the pile, for diagnosis) run only when named.")  # fmt: skip
 @click.option("--detector-noise", type=click.FloatRange(0.0, 0.1), default=0.0, show_default=True,
               help="Position error of the box detector (m); yaw errors follow.")  # fmt: skip
 @click.option("--detector-misses", type=click.FloatRange(0.0, 0.9), default=0.0, show_default=True,

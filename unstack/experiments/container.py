@@ -84,13 +84,25 @@ import numpy as np
 from unstack.experiments.dispatch import run_unordered
 from unstack.scene import Scene
 
-__all__ = ["CONTAINER_MAKERS", "CONTAINER_SAMPLES", "container_experiment", "container_policies"]
+__all__ = [
+    "CONTAINER_MAKERS",
+    "CONTAINER_SAMPLES",
+    "DEFAULT_CONTAINER_MAKERS",
+    "ORACLE_MAKERS",
+    "container_experiment",
+    "container_policies",
+]
 
 CONTAINER_MAKERS = (
     "unstack", "min_cost", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random", "lookahead",
     "moves", "moves_veto", "belief", "belief_veto", "rebuilt",
     "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen",
 )  # fmt: skip
+#: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
+#: run only when named.
+ORACLE_MAKERS = ("rebuilt", "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen")
+#: The makers run when none are named.
+DEFAULT_CONTAINER_MAKERS = tuple(maker for maker in CONTAINER_MAKERS if maker not in ORACLE_MAKERS)
 #: Makers whose policy is told what every candidate's removal does in the engine (the true pile).
 PROBING_MAKERS = ("lookahead",)
 #: Recorded sweeps per sampled group in each decision: 512 when a sweep re-inserted every box,
@@ -302,7 +314,7 @@ def container_experiment(
     model: Any,
     *,
     piles: int = 2,
-    makers: Sequence[str] = CONTAINER_MAKERS,
+    makers: Sequence[str] = DEFAULT_CONTAINER_MAKERS,
     detector_noise: float = 0.0,
     detector_misses: float = 0.0,
     reach: str = "door",
