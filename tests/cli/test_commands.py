@@ -197,6 +197,7 @@ def test_plan_with_sampling(twelve_boxes: Path) -> None:
     ("option", "message"),
     [
         (["--samples", "0"], "--samples"),
+        (["--samples", "1000000000"], "samples must be at most 100,000,000"),
         (["--time-limit", "0"], "--time-limit"),
         (["--time-limit", "nan"], "--time-limit"),
         (["--time-limit", "inf"], "--time-limit"),

@@ -10,7 +10,7 @@ from rich.console import Console
 from rich.table import Table
 
 from unstack.cli.learning import FEATURES_HELP, ISETS_FROM_HELP
-from unstack.cli.main import MODEL_HELP, STATICS_HELP, finite_seconds
+from unstack.cli.main import MODEL_HELP, SECONDS, STATICS_HELP
 from unstack.cli.progress import progress_bar
 from unstack.errors import UnstackError
 from unstack.experiments.container import CONTAINER_SAMPLES, DEFAULT_CONTAINER_MAKERS, ORACLE_MAKERS
@@ -292,7 +292,7 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
 @click.option("--configs", type=click.IntRange(min=1), default=4, show_default=True, help="Piles (the first N).")
 @click.option("--samples", type=click.IntRange(min=1), default=UNLOAD_SAMPLES, show_default=True,
               help="Recorded sweeps per sampled group in each decision (reproducible with the seed).")  # fmt: skip
-@click.option("--time-limit", type=float, default=None, callback=finite_seconds,
+@click.option("--time-limit", type=SECONDS, default=None,
               help="Seconds per decision instead of --samples (not reproducible).")  # fmt: skip
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of the sampler and the random order.")  # fmt: skip

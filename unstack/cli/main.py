@@ -13,7 +13,6 @@ from __future__ import annotations
 import contextlib
 import importlib
 import json
-import math
 import os
 import sys
 import time
@@ -22,6 +21,7 @@ from typing import Any
 
 import click
 
+from unstack.cli.options import Checked
 from unstack.cli.text import printable
 from unstack.errors import UnstackError
 from unstack.reasoner.costs import PAYOFF_COSTS
@@ -121,16 +121,35 @@ def _load_input(path: str, model: str | None, statics: bool = True) -> Any:
     return loaded
 
 
-def finite_seconds(_ctx: click.Context, _param: click.Parameter, value: float | None) -> float | None:
-    if value is not None and not (math.isfinite(value) and value > 0):
-        raise click.BadParameter(f"expected a positive, finite number of seconds, got {value}")
-    return value
+def _seconds(value: Any) -> float:
+    from unstack.reasoner.arguments import check_budget
+
+    return check_budget(value, "time_limit")
 
 
-def finite_margin(_ctx: click.Context, _param: click.Parameter, value: float | None) -> float | None:
-    if value is not None and not (math.isfinite(value) and value >= 0):
-        raise click.BadParameter(f"expected a finite number >= 0 of expected boxes moved, got {value}")
-    return value
+def _margin(value: Any) -> float:
+    from unstack.reasoner.arguments import check_margin
+
+    return check_margin(value, "near_tie_margin")
+
+
+def _samples(value: Any) -> int:
+    from unstack.reasoner.arguments import check_samples
+
+    return check_samples(value)
+
+
+def _seed(value: Any) -> int | None:
+    from unstack.reasoner.arguments import check_seed
+
+    return check_seed(value)
+
+
+#: Option types checked by the library's own argument checks (:mod:`unstack.cli.options`).
+SECONDS = Checked(float, _seconds)
+MARGIN = Checked(float, _margin)
+SAMPLES = Checked(int, _samples)
+SEED = Checked(int, _seed)
 
 
 def load_model_option(model: str | None) -> tuple[Any, str]:
@@ -166,25 +185,23 @@ def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
         ),
         click.option(
             "--samples",
-            type=click.IntRange(min=1),
+            type=SAMPLES,
             default=None,
             help="Recorded sweeps per sampled group (default 4096, 2048 for 64+ boxes; reproducible with --seed).",
         ),
         click.option(
             "--time-limit",
-            type=float,
+            type=SECONDS,
             default=None,
-            callback=finite_seconds,
             help="Seconds for the whole decision instead of a number of sweeps (not reproducible; under 10 "
             "also samples groups of 8).",
         ),
-        click.option("--seed", type=click.IntRange(min=0), default=None, help="Seed of the sampler."),
+        click.option("--seed", type=SEED, default=None, help="Seed of the sampler."),
         click.option(
             "--near-ties",
             "near_tie_margin",
-            type=float,
+            type=MARGIN,
             default=None,
-            callback=finite_margin,
             help="Expected costs within this many boxes of the lowest are tied and the box resting highest is taken; "
             "on one layer the lowest cost (default 0.05 for a scene or supports with heights; 0: Eq. 13's minimum).",
         ),

@@ -1,0 +1,61 @@
+"""Click parameter types whose constraints are the library's own argument checks.
+
+A command-line option and the library argument it feeds are checked by one function
+(:mod:`unstack.reasoner.arguments`): the bounds are declared once, and an option that the
+library would refuse is refused by click with the library's words, before any work.
+
+Examples
+--------
+>>> import click
+>>> from unstack.reasoner.arguments import check_samples
+>>> samples = Checked(int, check_samples)
+>>> samples.convert("64", None, None)
+64
+>>> try:
+...     samples.convert("0", None, None)
+... except click.BadParameter as error:
+...     print(error.message)
+samples must be at least 1, got 0
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+import click
+
+from unstack.errors import InvalidArgument
+
+__all__ = ["Checked"]
+
+
+if TYPE_CHECKING:
+    _ParamType = click.ParamType[Any]  # generic in the click that type-checks us
+else:
+    _ParamType = click.ParamType  # not subscriptable before click 8.2
+
+
+class Checked(_ParamType):
+    """An option of type ``kind`` (int or float) that must pass ``check(value)``.
+
+    Parameters
+    ----------
+    kind : type
+        ``int`` or ``float``: what the text is read as.
+    check : callable
+        The library's check: returns the canonical value or raises
+        :class:`~unstack.errors.InvalidArgument`.
+    """
+
+    def __init__(self, kind: type, check: Callable[[Any], Any]) -> None:
+        self.kind = kind
+        self.check = check
+        self.name = "integer" if kind is int else "number"
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        read = (click.INT if self.kind is int else click.FLOAT).convert(value, param, ctx)
+        try:
+            return self.check(read)
+        except InvalidArgument as error:
+            self.fail(str(error), param, ctx)
