@@ -9,7 +9,8 @@ Every ``import`` counts, at module level or inside a function (imports under
   detector model) above it;
 - ``reasoner``, ``learning``, ``sim`` and ``pictures`` above that, none importing another;
 - the recipe scene -> probabilities (``pipeline``) above those;
-- the public API (``unstack``, ``api``, ``describe``, ``moves``, ``validation``, ``warmup``) above that;
+- the public API (``unstack``, ``api``, ``describe``, ``moves``, ``picture_inputs``, ``validation``,
+  ``warmup``) above that;
 - ``experiments`` above the API; ``cli`` on top.
 """
 
@@ -24,7 +25,15 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "unstack"
 MIDDLE = ("reasoner", "learning", "sim", "pictures")
-API = {"unstack", "unstack.api", "unstack.describe", "unstack.moves", "unstack.validation", "unstack.warmup"}
+API = {
+    "unstack",
+    "unstack.api",
+    "unstack.describe",
+    "unstack.moves",
+    "unstack.picture_inputs",
+    "unstack.validation",
+    "unstack.warmup",
+}
 
 
 @dataclass(frozen=True)

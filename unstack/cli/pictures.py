@@ -1,7 +1,7 @@
 """``unstack render`` and ``unstack view``: pictures of a decision, drawn by :mod:`unstack.pictures`.
 
-The commands decide (through :mod:`unstack.api`) or read a stored decision, and hand the
-numbers to the pictures as :class:`~unstack.pictures.values.DecisionValues`.
+The commands read the files and hand them to :mod:`unstack.picture_inputs` (the decision's
+numbers, stored or made now, and the sensor's camera) and to :mod:`unstack.pictures`.
 """
 
 from __future__ import annotations
@@ -13,50 +13,12 @@ import click
 
 from unstack.cli.main import MODEL_HELP, _warn
 from unstack.errors import UnstackError
+from unstack.picture_inputs import decision_values, scene_camera
 from unstack.pictures.render import COLOURINGS
 
 __all__ = ["render", "view"]
 
 DECISION_HELP = "A stored unstack.decision/1 file to show instead of deciding (its boxes must be in the scene)."
-
-
-def _values(loaded: Any, decision_file: str | None, with_plan: bool, model: str | None, seed: int | None) -> Any:
-    """The decision to show: read from ``decision_file``, or decided (and planned) now."""
-    import unstack
-    from unstack.pictures.values import DecisionValues, read_decision_values
-
-    if decision_file is not None:
-        if with_plan:
-            raise UnstackError("--plan decides the unloading order itself; it does not combine with --decision")
-        values = read_decision_values(decision_file)
-        values.check_boxes(loaded.box_ids if isinstance(loaded, unstack.Scene) else loaded.objects, loaded.source)
-        return values
-    if with_plan:
-        result = unstack.plan(loaded, model=model, seed=seed)
-        return DecisionValues.from_decision(result.steps[0].decision, order=result.order, source=loaded.source)
-    return DecisionValues.from_decision(unstack.decide(loaded, model=model, seed=seed), source=loaded.source)
-
-
-def _camera(scene: Any) -> Any:
-    """The sensor that scanned a simulated scene, as a :class:`~unstack.pictures.camera.Camera`."""
-    from unstack.pictures.camera import Camera
-
-    settings = scene.metadata.get("settings")
-    if not isinstance(settings, dict):
-        return Camera()
-    from unstack.sim.settings import SimulationSettings
-
-    try:
-        sensor = SimulationSettings.from_dict(settings).sensor
-    except (KeyError, TypeError, ValueError, UnstackError):
-        return Camera()
-    return Camera(
-        position=(float(sensor.position[0]), float(sensor.position[1]), float(sensor.position[2])),
-        target=(float(sensor.target[0]), float(sensor.target[1]), float(sensor.target[2])),
-        vertical_fov_deg=sensor.vertical_fov_deg,
-        width=sensor.width,
-        height=sensor.height,
-    )
 
 
 def _load(file: str) -> tuple[Any, Path]:
@@ -129,7 +91,7 @@ def render(
     if isinstance(loaded, unstack.Supports):
         if colour in ("truth", "none"):
             raise UnstackError(f"{file}: a supports file has no ground truth or geometry; it is coloured by cost")
-        values = _values(loaded, decision_file, with_plan, model, seed)
+        values = decision_values(loaded, decision_file, with_plan=with_plan, model=model, seed=seed)
         from unstack.pictures.graph import render_support_graph
 
         render_support_graph(values, output, threshold=threshold, title=title, dpi=dpi)
@@ -138,7 +100,9 @@ def render(
     scene = loaded
     colour = colour or "cost"  # a scene always has detected boxes to decide on
     needs_decision = colour == "cost" or arrows or with_plan or decision_file is not None
-    values = _values(scene, decision_file, with_plan, model, seed) if needs_decision else None
+    values = (
+        decision_values(scene, decision_file, with_plan=with_plan, model=model, seed=seed) if needs_decision else None
+    )
     from unstack.pictures.render import render_scene
 
     render_scene(
@@ -146,7 +110,7 @@ def render(
         output,
         values=values,
         colour=colour,
-        camera=_camera(scene),
+        camera=scene_camera(scene),
         point_labels=point_box_labels(scene, base_dir),
         threshold=threshold,
         arrows=arrows,
@@ -189,7 +153,7 @@ def view(
     loaded, _ = _load(file)
     if isinstance(loaded, unstack.Supports):
         raise UnstackError(f"{file}: a supports file has no geometry to show in 3D; unstack render draws its graph")
-    values = _values(loaded, decision_file, with_plan, model, seed)
+    values = decision_values(loaded, decision_file, with_plan=with_plan, model=model, seed=seed)
     from unstack.pictures.view import write_view
 
     size = write_view(loaded, output, values=values, max_points=max_points, seed=seed, title=title or Path(file).name)
