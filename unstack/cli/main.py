@@ -11,6 +11,7 @@ file loads neither scikit-learn, numba for small groups, networkx nor rich's tab
 from __future__ import annotations
 
 import contextlib
+import functools
 import importlib
 import json
 import os
@@ -24,6 +25,7 @@ import click
 from unstack.cli.options import Checked
 from unstack.cli.text import printable
 from unstack.errors import UnstackError
+from unstack.reasoner.arguments import check_budget, check_margin, check_samples, check_seed
 from unstack.reasoner.costs import PAYOFF_COSTS
 
 __all__ = ["cli", "main"]
@@ -121,35 +123,11 @@ def _load_input(path: str, model: str | None, statics: bool = True) -> Any:
     return loaded
 
 
-def _seconds(value: Any) -> float:
-    from unstack.reasoner.arguments import check_budget
-
-    return check_budget(value, "time_limit")
-
-
-def _margin(value: Any) -> float:
-    from unstack.reasoner.arguments import check_margin
-
-    return check_margin(value, "near_tie_margin")
-
-
-def _samples(value: Any) -> int:
-    from unstack.reasoner.arguments import check_samples
-
-    return check_samples(value)
-
-
-def _seed(value: Any) -> int | None:
-    from unstack.reasoner.arguments import check_seed
-
-    return check_seed(value)
-
-
 #: Option types checked by the library's own argument checks (:mod:`unstack.cli.options`).
-SECONDS = Checked(float, _seconds)
-MARGIN = Checked(float, _margin)
-SAMPLES = Checked(int, _samples)
-SEED = Checked(int, _seed)
+SECONDS = Checked(float, functools.partial(check_budget, name="time_limit"))
+MARGIN = Checked(float, functools.partial(check_margin, name="near_tie_margin"))
+SAMPLES = Checked(int, check_samples)
+SEED = Checked(int, check_seed)
 
 
 def load_model_option(model: str | None) -> tuple[Any, str]:

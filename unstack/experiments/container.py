@@ -171,17 +171,24 @@ def container_policies(
     def random(scene: Scene) -> str:
         return str(rng.choice(sorted(scene.detected)))
 
-    def lookahead(scene: Scene, outcomes: dict[str, Any]) -> str:
+    def fewest(scene: Scene, expected: dict[str, float]) -> str:
+        """The candidate expected to move the fewest boxes, ties to the box resting highest."""
         from unstack.geometry import bounding_boxes
 
         resting = {box_id: float(bounding_boxes([scene.box(box_id)])[0, 2]) for box_id in scene.detected}
-        return min(scene.detected, key=lambda box_id: (outcomes[box_id].boxes_moved, -resting[box_id], box_id))
+        return min(scene.detected, key=lambda box_id: (expected[box_id], -resting[box_id], box_id))
 
-    def rebuilding(true_masses: bool) -> Callable[[Scene], str]:
+    def lookahead(scene: Scene, outcomes: dict[str, Any]) -> str:
+        return fewest(scene, {box_id: outcomes[box_id].boxes_moved for box_id in scene.detected})
+
+    def rebuilding(own_masses: bool) -> Callable[[Scene], str]:
         def policy(scene: Scene) -> str:
+            from unstack.sim.settings import SimulationSettings
             from unstack.sim.unloading import rebuilt_removals
 
-            return lookahead(scene, rebuilt_removals(scene, true_masses=true_masses))
+            typical = float(np.mean(SimulationSettings.from_dict(scene.metadata["settings"]).pile.mass_range))
+            masses = None if own_masses else {box.id: typical for box in scene.boxes}
+            return lookahead(scene, rebuilt_removals(scene, masses=masses))
 
         return policy
 
@@ -194,8 +201,7 @@ def container_policies(
         return lookahead(scene, rebuilt_removals(scene, fixed=hidden))
 
     def rebuilt_draws(scene: Scene) -> str:
-        from unstack.geometry import bounding_boxes
-        from unstack.sim.belief import BELIEF_WORLDS, choose_by_expected_moves
+        from unstack.sim.belief import BELIEF_WORLDS
         from unstack.sim.settings import SimulationSettings
         from unstack.sim.unloading import rebuilt_removals
 
@@ -206,20 +212,16 @@ def container_policies(
             masses = {box.id: float(draws.uniform(low, high)) for box in scene.boxes}
             for box_id, outcome in rebuilt_removals(scene, masses=masses).items():
                 moved[box_id] += outcome.boxes_moved / BELIEF_WORLDS
-        resting = {box_id: float(bounding_boxes([scene.box(box_id)])[0, 2]) for box_id in scene.detected}
-        return choose_by_expected_moves(moved, resting, "fewest")
+        return fewest(scene, moved)
 
     def belief_seen(scene: Scene) -> str:
         import dataclasses
 
-        from unstack.geometry import bounding_boxes
-        from unstack.sim.belief import belief_removals, choose_by_expected_moves, seen_boxes
+        from unstack.sim.belief import belief_removals, seen_boxes
 
         seen = sorted(set(seen_boxes(scene)) | set(scene.detected), key=scene.box_ids.index)
         outcomes = belief_removals(dataclasses.replace(scene, detected=tuple(seen)), scene.detected, seed=seed)
-        resting = {box_id: float(bounding_boxes([scene.box(box_id)])[0, 2]) for box_id in scene.detected}
-        expected = {box_id: outcome.expected_moved for box_id, outcome in outcomes.items()}
-        return choose_by_expected_moves(expected, resting, "fewest")
+        return fewest(scene, {box_id: outcome.expected_moved for box_id, outcome in outcomes.items()})
 
     loaded: list[Any] = []
 

@@ -473,7 +473,6 @@ def rebuilt_removals(
     scene: Scene,
     candidates: Sequence[str] | None = None,
     *,
-    true_masses: bool = True,
     masses: dict[str, float] | None = None,
     fixed: Sequence[str] = (),
 ) -> dict[str, UnloadStep]:
@@ -494,11 +493,9 @@ def rebuilt_removals(
         and simulation settings in its metadata.
     candidates : sequence of str, optional
         Boxes to try (default: the scene's detected boxes).
-    true_masses : bool
-        Each box with its own mass; False: every box of the settings' mean mass (what a
-        robot that sees every pose but weighs nothing would build).
     masses : dict of str to float, optional
-        The mass of each box (kg), instead of either (a draw of what the robot does not know).
+        The mass of each box (kg) instead of its own (the settings' mean mass for every box,
+        or a draw: what a robot that sees every pose but weighs nothing would build).
     fixed : sequence of str
         Boxes put in as static bodies: the space they fill is known, what they would do is not.
 
@@ -523,10 +520,8 @@ def rebuilt_removals(
     with PhysicsWorld(settings, door=False) as world:
         typical = float(np.mean(settings.pile.mass_range))
         for box in scene.boxes:
-            mass = box.mass if box.mass is not None and true_masses else typical
-            mass = mass if masses is None else masses[box.id]
-            mass = 0.0 if box.id in fixed else mass
-            world.add_box(box.size, box.position, box.orientation_xyzw, mass=mass)
+            mass = (box.mass if box.mass is not None else typical) if masses is None else masses[box.id]
+            world.add_box(box.size, box.position, box.orientation_xyzw, mass=0.0 if box.id in fixed else mass)
         world.step(RESETTLE_SECONDS)
         return probe_removals(scene, world, scene.box_ids, tried)
 
