@@ -129,14 +129,14 @@ def test_experiment_commands(small_dataset: Path, tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("arguments", "message"),
     [
-        (["table1", "--out", "{tmp}", "--max-n", "12"], "--max-n must be between 3 and 8, got 12"),
+        (["table1", "--out", "{tmp}", "--max-n", "12"], "Invalid value for '--max-n': max_n must be at most 8, got 12"),
         (["decisions", "examples", "--out", "{tmp}"], "examples: expected a data set folder with config-NNNN.json"),
         (
             ["decisions", "examples", "--out", "{tmp}", "--r", "1"],
-            "Invalid value for '--r': 1 is not in the range x>=2",
+            "Invalid value for '--r': r must be at least 2, got 1",
         ),
         (["unload", "examples", "--out", "{tmp}"], "examples: expected a data set folder with config-NNNN.json"),
-        (["fig5a", "{data}", "--out", "{tmp}", "--full"], "--full is the paper's size: 200 configurations and 10"),
+        (["fig5a", "{data}", "--out", "{tmp}", "--full"], "the paper's size is 200 configurations and 10 folds"),
         (["unload", "{data}", "--out", "{tmp}", "--scheduler", "nowhere"], "expected an address like tcp://HOST:PORT"),
     ],
 )

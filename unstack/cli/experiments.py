@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import json
+import functools
 from pathlib import Path
 
 import click
@@ -10,18 +10,42 @@ from rich.console import Console
 from rich.table import Table
 
 from unstack.cli.learning import FEATURES_HELP, ISETS_FROM_HELP
-from unstack.cli.main import MODEL_HELP, SECONDS, STATICS_HELP
+from unstack.cli.main import MODEL_HELP, SAMPLES, SECONDS, STATICS_HELP
+from unstack.cli.options import Checked, constrained
 from unstack.cli.progress import progress_bar
 from unstack.errors import UnstackError
-from unstack.experiments.container import CONTAINER_SAMPLES, DEFAULT_CONTAINER_MAKERS, ORACLE_MAKERS
-from unstack.experiments.unloading import UNLOAD_SAMPLES
-from unstack.learning.choices import LEARNERS, SPLITS
-from unstack.learning.features import FEATURE_SETS
-from unstack.learning.training_data import ISET_DRAWS
-from unstack.reasoner.costs import COSTS, DEFAULT_COST
-from unstack.sim.unloading import REACH_RULES
+from unstack.experiments.belief_calibration import belief_calibration
+from unstack.experiments.camera_roundtrip import camera_roundtrip
+from unstack.experiments.container import (
+    CONTAINER_SAMPLES,
+    DEFAULT_CONTAINER_MAKERS,
+    ORACLE_MAKERS,
+    container_experiment,
+)
+from unstack.experiments.decisions import evaluate_decisions
+from unstack.experiments.disturbance_training import train_disturbance
+from unstack.experiments.fig5a import fig5a as fig5a_experiment
+from unstack.experiments.outputs import results_folder, save_results
+from unstack.experiments.pick_responses import collect_pick_responses, pick_table
+from unstack.experiments.real7 import real7 as real7_experiment
+from unstack.experiments.table1 import TABLE_SIZE
+from unstack.experiments.unloading import UNLOAD_SAMPLES, unloading_experiment
+from unstack.reasoner.costs import DEFAULT_COST
 
 __all__ = ["experiment"]
+
+
+# The option types of each experiment's arguments: the constraints the library function declares.
+FIG5A = functools.partial(constrained, fig5a_experiment)
+DECISIONS = functools.partial(constrained, evaluate_decisions)
+REAL7 = functools.partial(constrained, real7_experiment)
+UNLOAD = functools.partial(constrained, unloading_experiment)
+CONTAINER = functools.partial(constrained, container_experiment)
+ROUNDTRIP = functools.partial(constrained, camera_roundtrip)
+CALIBRATION = functools.partial(constrained, belief_calibration)
+RESPONSES = functools.partial(constrained, collect_pick_responses)
+PICK_TABLE = functools.partial(constrained, pick_table)
+TRAINING = functools.partial(constrained, train_disturbance)
 
 
 @click.group()
@@ -33,19 +57,6 @@ def experiment() -> None:
     """
 
 
-#: The paper's size of Fig. 5a (§V): 200 simulated configurations (its 493 test ISets for Fig. 4
-#: are :data:`unstack.experiments.decisions.PAPER_TEST_ISETS`).
-PAPER_CONFIGURATIONS = 200
-
-
-def _out(out: str) -> Path:
-    folder = Path(out)
-    if folder.exists() and not folder.is_dir():
-        raise UnstackError(f"{out}: expected a folder for the results, got a file")
-    folder.mkdir(parents=True, exist_ok=True)
-    return folder
-
-
 def _paired(difference: dict[str, float | None] | None) -> str:
     """``+0.16 ± 0.08``: a paired difference and its standard error (blank for unstack itself)."""
     if difference is None:
@@ -54,15 +65,15 @@ def _paired(difference: dict[str, float | None] | None) -> str:
     return f"{difference['mean']:+.2f}" + ("" if error is None else f" ± {error:.2f}")
 
 
-def _write_json(path: Path, data: object) -> None:
-    from unstack.atomic import atomic_write_text
-
-    atomic_write_text(path, json.dumps(data, indent=2) + "\n")
+def _results_in(paths: list[Path]) -> str:
+    """``results in a.json and a.png``."""
+    return "results in " + " and ".join(str(path) for path in paths)
 
 
 @experiment.command()
 @click.option("--out", required=True, type=click.Path(), help="Folder for table1.json.")
-@click.option("--max-n", type=int, default=6, show_default=True, help="Largest n (7 takes seconds, 8 minutes).")
+@click.option("--max-n", type=Checked(int, functools.partial(TABLE_SIZE.check, name="max_n")), default=6,
+              show_default=True, help="Largest n (7 takes seconds, 8 minutes).")  # fmt: skip
 @click.option("--full", is_flag=True, help="The paper's size: n = 3..7 (overrides --max-n).")
 def table1(out: str, max_n: int, full: bool) -> None:
     """Table I: consistent worlds for n = 3..max-n by the exact engine and SAT, against the paper and OEIS."""
@@ -70,11 +81,8 @@ def table1(out: str, max_n: int, full: bool) -> None:
 
     if full:
         max_n = 7
-
-    if not 3 <= max_n <= 8:
-        raise UnstackError(f"--max-n must be between 3 and 8, got {max_n}")
     rows = count(range(3, max_n + 1))
-    _write_json(_out(out) / "table1.json", rows)
+    save_results(results_folder(out), "table1.json", rows)
     table = Table(title="Table I: consistent worlds q' of n boxes")
     for column in ("n", "all worlds q", "exact engine", "SAT listing", "paper", "OEIS A000798"):
         table.add_column(column, justify="right")
@@ -93,20 +101,24 @@ def table1(out: str, max_n: int, full: bool) -> None:
 @experiment.command(short_help="Fig. 5a: the validation confusion matrix of the SVM, beside the paper's.")
 @click.argument("data_dir", type=click.Path(file_okay=False))
 @click.option("--out", required=True, type=click.Path(), help="Folder for fig5a.json.")
-@click.option("--r", "r", type=click.IntRange(min=2), default=5, show_default=True, help="Boxes per ISet.")
-@click.option("--isets", type=int, default=1, show_default=True, help="ISets per configuration.")
-@click.option("--isets-from", "draw", type=click.Choice(list(ISET_DRAWS)), default="random",
+@click.option("--r", "r", type=FIG5A("r"), default=5, show_default=True,
+              help="Boxes per ISet.")  # fmt: skip
+@click.option("--isets", type=FIG5A("isets"), default=1, show_default=True,
+              help="ISets per configuration.")  # fmt: skip
+@click.option("--isets-from", "draw", type=FIG5A("draw"), default="random",
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
-@click.option("--learner", type=click.Choice(list(LEARNERS)), default="svm",
+@click.option("--learner", type=FIG5A("learner"), default="svm",
               show_default=True, help="svm: the paper's RBF SVM with probabilities.")  # fmt: skip
-@click.option("--split-by", type=click.Choice(list(SPLITS)), default="pairs", show_default=True,
+@click.option("--split-by", type=FIG5A("split_by"), default="pairs", show_default=True,
               help="pairs: the paper's split of the relations; configuration: whole piles on one side.")  # fmt: skip
-@click.option("--features", "feature_set", type=click.Choice(list(FEATURE_SETS)), default="paper",
+@click.option("--features", "feature_set", type=FIG5A("feature_set"), default="paper",
               show_default=True, help=FEATURES_HELP)  # fmt: skip
-@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+@click.option("--seed", type=FIG5A("seed"), default=0, show_default=True,
               help="Seed of the ISets, split and folds.")  # fmt: skip
-@click.option("--cv", type=int, default=10, show_default=True, help="Cross-validation folds.")
-@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Parallel processes.")
+@click.option("--cv", type=FIG5A("cv"), default=10, show_default=True,
+              help="Cross-validation folds.")  # fmt: skip
+@click.option("--jobs", type=FIG5A("n_jobs"), default=1, show_default=True,
+              help="Parallel processes.")  # fmt: skip
 @click.option("--full", is_flag=True, help="Insist on the paper's size: at least 200 configurations, 10 folds.")
 def fig5a(
     data_dir: str,
@@ -124,24 +136,16 @@ def fig5a(
 ) -> None:
     """Fig. 5a: the validation confusion matrix of the SVM on a simulated data set, beside the paper's."""
     from unstack.dataset_folders import require_configurations
-    from unstack.experiments.fig5a import fig5a as run
-    from unstack.experiments.fig5a import plot_fig5a
+    from unstack.experiments.fig5a import plot_fig5a, require_paper_size
 
-    if r < 2 or isets < 1 or cv < 2 or jobs < 1:
-        raise UnstackError("expected --r >= 2, --isets >= 1, --cv >= 2 and --jobs >= 1")
-    found = len(require_configurations(data_dir))
-    if full and (found < PAPER_CONFIGURATIONS or cv != 10):
-        raise UnstackError(
-            f"{data_dir}: --full is the paper's size: {PAPER_CONFIGURATIONS} configurations and 10 folds; "
-            f"this data set has {found} and --cv is {cv} (make it with unstack simulate --configs 200)"
-        )
-    result = run(
+    require_configurations(data_dir)
+    if full:
+        require_paper_size(data_dir, cv)
+    result = fig5a_experiment(
         data_dir, r=r, isets=isets, seed=seed, cv=cv, n_jobs=jobs, draw=draw, learner=learner, split_by=split_by,
         feature_set=feature_set,
     )  # fmt: skip
-    folder = _out(out)
-    _write_json(folder / "fig5a.json", result)
-    plot_fig5a(result, folder / "fig5a.png")
+    written = save_results(results_folder(out), "fig5a.json", result, plot_fig5a)
     table = Table(title=f"Fig. 5a: validation relations of {data_dir} ({result['relations']} relations, "
                   f"{result['supp']} SUPP)")  # fmt: skip
     for column in ("", "SUPP right", "not SUPP right"):
@@ -169,18 +173,21 @@ def fig5a(
         f"{100 * result['validation_roc']['not_supp_recall_at_paper_supp_recall']:.1f} %",
     )
     Console().print(table)
-    Console().print(f"results in {folder / 'fig5a.json'} and {folder / 'fig5a.png'}")
+    Console().print(_results_in(written))
 
 
 @experiment.command(short_help="Fig. 4 and beyond: MSE(cost), first pick right, disturbance per decision maker.")
 @click.argument("data_dir", type=click.Path(file_okay=False))
 @click.option("--out", required=True, type=click.Path(), help="Folder for decisions.json and fig4.png.")
 @click.option("--model", "model_path", default=None, help=MODEL_HELP)
-@click.option("--r", "r", type=click.IntRange(min=2), default=5, show_default=True, help="Boxes per ISet.")
-@click.option("--isets", type=int, default=50, show_default=True, help="Test ISets (the paper: 493).")
-@click.option("--isets-from", "draw", type=click.Choice(list(ISET_DRAWS)), default="random",
+@click.option("--r", "r", type=DECISIONS("r"), default=5, show_default=True,
+              help="Boxes per ISet.")  # fmt: skip
+@click.option("--isets", type=DECISIONS("isets"), default=50, show_default=True,
+              help="Test ISets (the paper: 493).")  # fmt: skip
+@click.option("--isets-from", "draw", type=FIG5A("draw"), default="random",
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
-@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Seed of the ISets.")
+@click.option("--seed", type=DECISIONS("seed"), default=0, show_default=True,
+              help="Seed of the ISets.")  # fmt: skip
 @click.option("--full", is_flag=True, help="The paper's size: 493 test ISets (overrides --isets).")
 @click.option("--pair-with", "pair_with", type=click.Path(dir_okay=False), default=None,
               help="decisions.json of an earlier run on the same ISets (another model, say): "
@@ -201,23 +208,15 @@ def decisions(
     """Fig. 4 and beyond: MSE(cost), first pick right and physical disturbance of every decision maker."""
     from unstack.cli.main import load_model_option
     from unstack.dataset_folders import require_configurations
-    from unstack.experiments.decisions import (
-        DECISION_MAKERS,
-        PAPER_TEST_ISETS,
-        evaluate_decisions,
-        paired_between_runs,
-        plot_fig4,
-    )
+    from unstack.experiments.decisions import DECISION_MAKERS, PAPER_TEST_ISETS, paired_between_runs, plot_fig4
     from unstack.jsonio import read_document
 
     if full:
         isets = PAPER_TEST_ISETS
-    if r < 2 or isets < 1:
-        raise UnstackError(f"expected --r >= 2 and --isets >= 1, got {r} and {isets}")
     require_configurations(data_dir)  # before any progress bar or output folder
     earlier = read_document(pair_with).data if pair_with is not None else None
     model, name = load_model_option(model_path)
-    folder = _out(out)
+    folder = results_folder(out)
     with progress_bar("ISets") as report:
         result = evaluate_decisions(
             data_dir, model, r=r, isets=isets, seed=seed, progress=report, draw=draw, statics=statics
@@ -228,8 +227,7 @@ def decisions(
             result["against_earlier_run"] = {"file": str(pair_with), **paired_between_runs(earlier, result)}
         except ValueError as error:
             raise UnstackError(f"{pair_with}: {error}") from None
-    _write_json(folder / "decisions.json", result)
-    plot_fig4(result, folder / "fig4.png")
+    written = save_results(folder, "decisions.json", result, plot_fig4, "fig4.png")
     table = Table(title=f"{result['isets']} test ISets of {r} boxes ({data_dir})")
     columns = ("decision maker", "MSE(cost)", "first pick right", "boxes moved > 2 cm", "moved - unstack's (± s.e.)",
                "displacement (m)")  # fmt: skip
@@ -250,29 +248,26 @@ def decisions(
     if earlier is not None:
         paired = result["against_earlier_run"]
         click.echo(f"unstack's boxes moved, this run minus {pair_with}: {_paired(paired)}")
-    click.echo(f"results in {folder / 'decisions.json'} and {folder / 'fig4.png'}")
+    click.echo(_results_in(written))
 
 
 @experiment.command()
 @click.argument("data_dir", type=click.Path(file_okay=False))
 @click.option("--out", required=True, type=click.Path(), help="Folder for real7.json.")
 @click.option("--model", "model_path", default=None, help="Model trained on piles of the same four sizes.")
-@click.option("--piles", type=int, default=None, help="Use only the first N piles.")
+@click.option("--piles", type=REAL7("piles"), default=None, help="Use only the first N piles.")
 def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) -> None:
     """The paper's real setting in simulation: every ISet of r = 3, 4, 5 of each 7-box pile."""
     from unstack.cli.main import load_model_option
     from unstack.dataset_folders import require_configurations
-    from unstack.experiments.real7 import real7 as run
     from unstack.experiments.real7 import summary_rows
 
-    if piles is not None and piles < 1:
-        raise UnstackError(f"--piles must be at least 1, got {piles}")
     require_configurations(data_dir)
     model, name = load_model_option(model_path)
     with progress_bar("ISets") as report:
-        result = run(data_dir, model, piles=piles, progress=report)
+        result = real7_experiment(data_dir, model, piles=piles, progress=report)
     result["model"] = name
-    _write_json(_out(out) / "real7.json", result)
+    written = save_results(results_folder(out), "real7.json", result)
     table = Table(title=f"first pick right, {result['piles']} simulated 7-box piles ({data_dir})")
     for column in ("r", "ISets", "paper", "unstack", "highest first", "random"):
         table.add_column(column, justify="right")
@@ -283,26 +278,27 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
     click.echo(
         f"worst MSE(cost) over r: unstack {worst['reasoner']:.3f}, random {worst['random']:.3f} (paper 0.5 vs 3.5)"
     )
+    click.echo(_results_in(written))
 
 
 @experiment.command()
 @click.argument("data_dir", type=click.Path(file_okay=False))
 @click.option("--out", required=True, type=click.Path(), help="Folder for unloading.json and unloading.png.")
 @click.option("--model", "model_path", default=None, help=MODEL_HELP)
-@click.option("--configs", type=click.IntRange(min=1), default=4, show_default=True, help="Piles (the first N).")
-@click.option("--samples", type=click.IntRange(min=1), default=UNLOAD_SAMPLES, show_default=True,
+@click.option("--configs", type=UNLOAD("configs"), default=4, show_default=True, help="Piles (the first N).")
+@click.option("--samples", type=SAMPLES, default=UNLOAD_SAMPLES, show_default=True,
               help="Recorded sweeps per sampled group in each decision (reproducible with the seed).")  # fmt: skip
 @click.option("--time-limit", type=SECONDS, default=None,
               help="Seconds per decision instead of --samples (not reproducible).")  # fmt: skip
-@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+@click.option("--seed", type=UNLOAD("seed"), default=0, show_default=True,
               help="Seed of the sampler and the random order.")  # fmt: skip
 @click.option("--full", is_flag=True, help="Every configuration of the data set (overrides --configs).")
-@click.option("--cost", type=click.Choice(list(COSTS)), default=DEFAULT_COST, show_default=True,
+@click.option("--cost", type=UNLOAD("cost"), default=DEFAULT_COST, show_default=True,
               help="Cost of unstack's decisions: load (hidden load counted), count (Eq. 11) or mass.")  # fmt: skip
 @click.option("--closed-loop", is_flag=True,
               help="Also unstack and highest-first sensing the pile again before each pick (3x slower).")  # fmt: skip
 @click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)
-@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Piles run in parallel.")
+@click.option("--jobs", type=UNLOAD("n_jobs"), default=1, show_default=True, help="Piles run in parallel.")
 @click.option("--scheduler", default=None,
               help="Address of a dask.distributed scheduler (tcp://HOST:PORT): piles run on its workers.")  # fmt: skip
 def unload(
@@ -327,7 +323,7 @@ def unload(
     """
     from unstack.cli.main import load_model_option
     from unstack.dataset_folders import require_configurations
-    from unstack.experiments.unloading import plot_unloading, unloading_experiment
+    from unstack.experiments.unloading import plot_unloading
 
     found = len(require_configurations(data_dir))
     if full:
@@ -336,7 +332,7 @@ def unload(
     from unstack.sim.dataset import connect_scheduler
 
     client = connect_scheduler(scheduler) if scheduler else None  # fails in seconds, before any output
-    folder = _out(out)
+    folder = results_folder(out)
     try:
         with progress_bar("piles") as report:
             result = unloading_experiment(
@@ -349,8 +345,7 @@ def unload(
         if client is not None:
             client.close()
     result["model"] = name
-    _write_json(folder / "unloading.json", result)
-    plot_unloading(result, folder / "unloading.png")
+    written = save_results(folder, "unloading.json", result, plot_unloading)
     table = Table(title=f"Unloading every detected box of {result['configs']} piles ({data_dir}) in the simulator")
     for column in (
         "decision maker",
@@ -373,33 +368,33 @@ def unload(
             f"{row['displacement_m_per_pile']:.3f}",
         )
     Console().print(table)
-    click.echo(f"results in {folder / 'unloading.json'} and {folder / 'unloading.png'}")
+    click.echo(_results_in(written))
 
 
 @experiment.command()
 @click.argument("data_dir", type=click.Path(file_okay=False))
 @click.option("--out", required=True, type=click.Path(), help="Folder for container.json.")
 @click.option("--model", "model_path", default=None, help=MODEL_HELP)
-@click.option("--piles", type=click.IntRange(min=1), default=2, show_default=True, help="Piles (the first N).")
+@click.option("--piles", type=CONTAINER("piles"), default=2, show_default=True, help="Piles (the first N).")
 @click.option("--makers", default=",".join(DEFAULT_CONTAINER_MAKERS), show_default=True,
               help=f"Comma-separated decision makers; the oracles {', '.join(ORACLE_MAKERS)} (they read every box "
               "of the pile, for diagnosis) run only when named.")  # fmt: skip
-@click.option("--detector-noise", type=click.FloatRange(0.0, 0.1), default=0.0, show_default=True,
+@click.option("--detector-noise", type=CONTAINER("detector_noise"), default=0.0, show_default=True,
               help="Position error of the box detector (m); yaw errors follow.")  # fmt: skip
-@click.option("--detector-misses", type=click.FloatRange(0.0, 0.9), default=0.0, show_default=True,
+@click.option("--detector-misses", type=CONTAINER("detector_misses"), default=0.0, show_default=True,
               help="Share of the seen boxes the detector misses at each scan.")  # fmt: skip
 @click.option(
     "--reach",
-    type=click.Choice(list(REACH_RULES)),
+    type=CONTAINER("reach"),
     default="door",
     show_default=True,
     help="door: a box whose door-facing side or top is at most half covered; any: every detected box.",
 )
-@click.option("--max-picks", type=click.IntRange(min=1), default=None, help="Stop each pile after this many picks.")
-@click.option("--samples", type=click.IntRange(min=1), default=CONTAINER_SAMPLES, show_default=True,
+@click.option("--max-picks", type=CONTAINER("max_picks"), default=None, help="Stop each pile after this many picks.")
+@click.option("--samples", type=SAMPLES, default=CONTAINER_SAMPLES, show_default=True,
               help="Recorded sweeps per sampled group in each decision.")  # fmt: skip
-@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True)
-@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Piles run in parallel.")
+@click.option("--seed", type=CONTAINER("seed"), default=0, show_default=True)
+@click.option("--jobs", type=CONTAINER("n_jobs"), default=1, show_default=True, help="Piles run in parallel.")
 @click.option("--scheduler", default=None,
               help="Address of a dask.distributed scheduler (tcp://HOST:PORT): piles run on its workers.")  # fmt: skip
 @click.option("--disturbance", "disturbance_path", type=click.Path(dir_okay=False, exists=True), default=None,
@@ -428,7 +423,7 @@ def container(
     """
     from unstack.cli.main import load_model_option
     from unstack.dataset_folders import require_configurations
-    from unstack.experiments.container import container_experiment, container_policies
+    from unstack.experiments.container import container_policies
 
     require_configurations(data_dir)
     chosen = tuple(name.strip() for name in makers.split(",") if name.strip())
@@ -437,7 +432,7 @@ def container(
     from unstack.sim.dataset import connect_scheduler
 
     client = connect_scheduler(scheduler) if scheduler else None  # fails in seconds, before any output
-    folder = _out(out)
+    folder = results_folder(out)
     try:
         with progress_bar("piles") as report:
             result = container_experiment(
@@ -450,7 +445,7 @@ def container(
         if client is not None:
             client.close()
     result["model"] = name
-    _write_json(folder / "container.json", result)
+    written = save_results(folder, "container.json", result)
     table = Table(title=f"Emptying {result['piles']} piles of {data_dir}, detecting again before every pick")
     for column in ("decision maker", "picks", "boxes moved", "minus unstack's", "fallen", "minus unstack's", "calm"):
         table.add_column(column, justify="right")
@@ -467,7 +462,7 @@ def container(
             f"{100 * row['calm_picks_per_pile']:.0f} %",
         )
     Console().print(table)
-    click.echo(f"results in {folder / 'container.json'}")
+    click.echo(_results_in(written))
 
 
 @experiment.command()
@@ -494,7 +489,7 @@ def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int
     from unstack.pipeline import scene_support_probabilities
     from unstack.reasoner.decision import decide
 
-    folder = _out(out)
+    folder = results_folder(out)
     model, name = load_model_option(model_path)
     seed_list = list(range(first_seed, first_seed + seeds))
     with progress_bar("scenes") as report:
@@ -513,7 +508,7 @@ def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int
                 if problems:
                     physics_problems[f"{kind} seed {seed}"] = problems
     rows = summary_rows(results)
-    _write_json(folder / "generalisation.json", {"model": name, "pick": pick, "seeds": seed_list, "summary": rows,
+    save_results(folder, "generalisation.json", {"model": name, "pick": pick, "seeds": seed_list, "summary": rows,
                  "physics": physics_problems if physics else None,
                  "decisions": [result.to_dict() for result in results]})  # fmt: skip
     first = {(r.kind, r.cloud): r for r in results if r.seed == first_seed}
@@ -537,8 +532,8 @@ def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int
 @click.argument("data_dir", type=click.Path(file_okay=False))
 @click.option("--out", required=True, type=click.Path(), help="Folder for camera-roundtrip.json.")
 @click.option("--model", "model_path", default=None, help=MODEL_HELP)
-@click.option("--piles", type=click.IntRange(min=1), default=2, show_default=True, help="Piles (the first N).")
-@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Piles run in parallel.")
+@click.option("--piles", type=ROUNDTRIP("piles"), default=2, show_default=True, help="Piles (the first N).")
+@click.option("--jobs", type=ROUNDTRIP("n_jobs"), default=1, show_default=True, help="Piles run in parallel.")
 def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, piles: int, jobs: int) -> None:
     """Render piles as camera files, build the scenes back (unstack scene's method), compare with the truth.
 
@@ -547,14 +542,13 @@ def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, pi
     """
     from unstack.cli.main import load_model_option
     from unstack.dataset_folders import require_configurations
-    from unstack.experiments.camera_roundtrip import camera_roundtrip
 
     require_configurations(data_dir)
     model, _ = load_model_option(model_path)
-    folder = _out(out)
+    folder = results_folder(out)
     with progress_bar("piles") as report:
         result = camera_roundtrip(data_dir, model, piles=piles, n_jobs=jobs, progress=report)
-    _write_json(folder / "camera-roundtrip.json", result)
+    written = save_results(folder, "camera-roundtrip.json", result)
     summary = result["summary"]
     table = Table(title=f"Camera files to scenes: {summary['boxes']} boxes fitted from {summary['masks']} masks "
                   f"({summary['piles']} piles of {data_dir})")  # fmt: skip
@@ -577,19 +571,19 @@ def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, pi
         f"{100 * summary['top_faces_share']:.0f} %; the same decision as on the true poses in "
         f"{100 * summary['same_decision_share']:.0f} % of piles"
     )
-    click.echo(f"results in {folder / 'camera-roundtrip.json'}")
+    click.echo(_results_in(written))
 
 
 @experiment.command("belief-calibration")
 @click.argument("data_dir", type=click.Path(file_okay=False))
 @click.option("--out", required=True, type=click.Path(), help="Folder for belief-calibration.json.")
-@click.option("--piles", type=click.IntRange(min=1), default=2, show_default=True, help="Piles (the first N).")
-@click.option("--detector-misses", type=click.FloatRange(0.0, 0.9), default=0.0, show_default=True,
+@click.option("--piles", type=CALIBRATION("piles"), default=2, show_default=True, help="Piles (the first N).")
+@click.option("--detector-misses", type=CALIBRATION("detector_misses"), default=0.0, show_default=True,
               help="Share of the seen boxes the detector misses at each scan.")  # fmt: skip
-@click.option("--worlds", type=click.IntRange(min=1), default=None, help="Belief worlds per decision (default 4).")
-@click.option("--max-picks", type=click.IntRange(min=1), default=None, help="Stop each pile after this many picks.")
-@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True)
-@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Piles run in parallel.")
+@click.option("--worlds", type=CALIBRATION("worlds"), default=None, help="Belief worlds per decision (default 4).")
+@click.option("--max-picks", type=CALIBRATION("max_picks"), default=None, help="Stop each pile after this many picks.")
+@click.option("--seed", type=CALIBRATION("seed"), default=0, show_default=True)
+@click.option("--jobs", type=CALIBRATION("n_jobs"), default=1, show_default=True, help="Piles run in parallel.")
 def belief_calibration_command(
     data_dir: str, out: str, piles: int, detector_misses: float, worlds: int | None, max_picks: int | None, seed: int,
     jobs: int,
@@ -601,16 +595,15 @@ def belief_calibration_command(
     correlation, the means per predicted bin, and what each rule's pick would have moved.
     """
     from unstack.dataset_folders import require_configurations
-    from unstack.experiments.belief_calibration import belief_calibration
 
     require_configurations(data_dir)
-    folder = _out(out)
+    folder = results_folder(out)
     with progress_bar("piles") as report:
         result = belief_calibration(
             data_dir, piles=piles, detector_misses=detector_misses, worlds=worlds, max_picks=max_picks, seed=seed,
             n_jobs=jobs, progress=report,
         )  # fmt: skip
-    _write_json(folder / "belief-calibration.json", result)
+    written = save_results(folder, "belief-calibration.json", result)
     table = Table(title=f"Expected against actual boxes moved per candidate ({result['piles']} piles of {data_dir})")
     for column in ("expected", "candidates", "mean expected", "mean actual"):
         table.add_column(column, justify="right")
@@ -627,16 +620,16 @@ def belief_calibration_command(
         f"the belief's fewest {picks['belief']}, height vetoed by the belief {picks['belief_veto']}, "
         f"the look-ahead's {picks['lookahead']}"
     )
-    click.echo(f"results in {folder / 'belief-calibration.json'}")
+    click.echo(_results_in(written))
 
 
 @experiment.command("pick-responses")
 @click.argument("data_dirs", nargs=-1, required=True, type=click.Path(file_okay=False))
 @click.option("--out", required=True, type=click.Path(), help="Folder of the collected states (resumable).")
-@click.option("--piles", type=click.IntRange(min=1), default=None, help="The first N piles of each data set.")
-@click.option("--max-picks", type=click.IntRange(min=1), default=None, help="Stop each pile after this many picks.")
-@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True)
-@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Piles run in parallel.")
+@click.option("--piles", type=RESPONSES("piles"), default=None, help="The first N piles of each data set.")
+@click.option("--max-picks", type=RESPONSES("max_picks"), default=None, help="Stop each pile after this many picks.")
+@click.option("--seed", type=RESPONSES("seed"), default=0, show_default=True)
+@click.option("--jobs", type=RESPONSES("n_jobs"), default=1, show_default=True, help="Piles run in parallel.")
 @click.option("--scheduler", default=None,
               help="Address of a dask.distributed scheduler (tcp://HOST:PORT): piles run on its workers.")  # fmt: skip
 def pick_responses(
@@ -649,7 +642,6 @@ def pick_responses(
     reachable candidates and what each candidate's removal moves (tried in the engine and
     undone). Which candidate is then taken is drawn: the probe's best, the highest, a random one.
     """
-    from unstack.experiments.pick_responses import collect_pick_responses
     from unstack.sim.dataset import connect_scheduler
 
     client = connect_scheduler(scheduler) if scheduler else None
@@ -670,10 +662,11 @@ def pick_responses(
 @click.argument("states", type=click.Path(file_okay=False, exists=True))
 @click.option("--out", required=True, type=click.Path(), help="Folder for disturbance.skops and disturbance.json.")
 @click.option("--model", "model_path", default=None, help=MODEL_HELP)
-@click.option("--folds", type=click.IntRange(min=2), default=5, show_default=True,
+@click.option("--folds", type=TRAINING("folds"), default=5, show_default=True,
               help="Grouped folds (piles held out together) of the held-out figures.")  # fmt: skip
-@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True)
-@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Piles in parallel.")
+@click.option("--seed", type=TRAINING("random_state"), default=0, show_default=True)
+@click.option("--jobs", type=PICK_TABLE("n_jobs"), default=1, show_default=True,
+              help="Piles in parallel.")  # fmt: skip
 def train_disturbance_command(states: str, out: str, model_path: str | None, folds: int, seed: int, jobs: int) -> None:
     """Fit the disturbance model (what a pick moves) on collected states; report it held out.
 
@@ -682,12 +675,10 @@ def train_disturbance_command(states: str, out: str, model_path: str | None, fol
     the held-out picks moved beside highest first, the load cost and the look-ahead.
     """
     from unstack.cli.main import load_model_option
-    from unstack.experiments.disturbance_training import train_disturbance
-    from unstack.experiments.pick_responses import pick_table
     from unstack.learning.disturbance import save_disturbance_model
 
     model, name = load_model_option(model_path)
-    folder = _out(out)
+    folder = results_folder(out)
     with progress_bar("piles") as report:
         records = pick_table(states, model, seed=seed, n_jobs=jobs, progress=report)
     if not records:
@@ -695,7 +686,7 @@ def train_disturbance_command(states: str, out: str, model_path: str | None, fol
     disturbance, result = train_disturbance(records, random_state=seed, folds=folds)
     disturbance.metadata["training"] = {"states": str(states), "support_model": name, "seed": seed}
     save_disturbance_model(disturbance, folder / "disturbance.skops")
-    _write_json(folder / "disturbance.json", result)
+    save_results(folder, "disturbance.json", result)
     table = Table(title=f"Boxes the next pick moved, held out ({result['piles']} piles, {result['records']} views)")
     for column in ("family / view", "states", "highest", "load cost", "moves", "look-ahead"):
         table.add_column(column, justify="right")

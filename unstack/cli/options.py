@@ -1,8 +1,9 @@
 """Click parameter types whose constraints are the library's own argument checks.
 
 A command-line option and the library argument it feeds are checked by one function
-(:mod:`unstack.reasoner.arguments`): the bounds are declared once, and an option that the
-library would refuse is refused by click with the library's words, before any work.
+(:mod:`unstack.reasoner.arguments`, or the constraints a function declares with
+:func:`unstack.parameters.validate_params`): the bounds are declared once, and an option
+that the library would refuse is refused by click with the library's words, before any work.
 
 Examples
 --------
@@ -16,18 +17,28 @@ Examples
 ... except click.BadParameter as error:
 ...     print(error.message)
 samples must be at least 1, got 0
+
+An option typed from a library function's declared constraints:
+
+>>> from unstack.experiments.container import container_experiment
+>>> constrained(container_experiment, "detector_misses").convert("0.5", None, None)
+0.5
+>>> list(constrained(container_experiment, "reach").choices)
+['door', 'any']
 """
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 import click
 
 from unstack.errors import InvalidArgument
+from unstack.parameters import OneOf, constraints_of
 
-__all__ = ["Checked"]
+__all__ = ["Checked", "constrained"]
 
 
 if TYPE_CHECKING:
@@ -59,3 +70,25 @@ class Checked(_ParamType):
             return self.check(read)
         except InvalidArgument as error:
             self.fail(str(error), param, ctx)
+
+
+def constrained(function: Callable[..., Any], parameter: str) -> _ParamType:
+    """The click type of an option feeding ``parameter`` of ``function``: its declared constraint.
+
+    A choice becomes :class:`click.Choice` (the choices show in ``--help``); a range, a
+    :class:`Checked` number running the constraint's check.
+
+    Parameters
+    ----------
+    function : callable
+        A function decorated with :func:`unstack.parameters.validate_params`.
+    parameter : str
+        The name of the argument the option feeds.
+    """
+    constraints = constraints_of(function)
+    if parameter not in constraints:
+        raise TypeError(f"{function.__qualname__} declares no constraint on {parameter!r}")
+    constraint = constraints[parameter]
+    if isinstance(constraint, OneOf):
+        return click.Choice(list(constraint.choices))
+    return Checked(constraint.kind, functools.partial(constraint.check, name=parameter))

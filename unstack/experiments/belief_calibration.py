@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from unstack.experiments.dispatch import run_unordered
+from unstack.parameters import COUNT, MISSED_SHARE, OPTIONAL_COUNT, SEED, validate_params
 from unstack.scene import Scene
 
 __all__ = ["belief_calibration", "pick_summary"]
@@ -74,6 +75,10 @@ def _calibrate_pile(path: Path, number: int, options: dict[str, Any]) -> tuple[i
     return number, {"scene": path.name, "pairs": pairs, "states": states}
 
 
+@validate_params({
+    "piles": COUNT, "detector_misses": MISSED_SHARE, "worlds": OPTIONAL_COUNT, "max_picks": OPTIONAL_COUNT,
+    "seed": SEED, "n_jobs": COUNT,
+})  # fmt: skip
 def belief_calibration(
     data_dir: str | os.PathLike[str],
     *,

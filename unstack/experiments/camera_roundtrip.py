@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from unstack.experiments.dispatch import run_unordered
+from unstack.parameters import COUNT, validate_params
 
 __all__ = ["camera_roundtrip", "yaw_error_deg"]
 
@@ -93,6 +94,7 @@ def _roundtrip_pile(path: Path, number: int, model: Any, samples: int) -> tuple[
                     "masks": len(ids), "choices": choices}  # fmt: skip
 
 
+@validate_params({"piles": COUNT, "samples": COUNT, "n_jobs": COUNT})
 def camera_roundtrip(
     data_dir: str | os.PathLike[str],
     model: Any,

@@ -82,7 +82,9 @@ from typing import Any
 import numpy as np
 
 from unstack.experiments.dispatch import run_unordered
+from unstack.parameters import COUNT, DETECTOR_NOISE, MISSED_SHARE, OPTIONAL_COUNT, SEED, OneOf, validate_params
 from unstack.scene import Scene
+from unstack.sim.unloading import REACH_RULES
 
 __all__ = [
     "CONTAINER_MAKERS",
@@ -311,6 +313,10 @@ def _pile_metrics(run: dict[str, Any]) -> dict[str, float]:
     }
 
 
+@validate_params({
+    "piles": COUNT, "detector_noise": DETECTOR_NOISE, "detector_misses": MISSED_SHARE, "reach": OneOf(REACH_RULES),
+    "max_picks": OPTIONAL_COUNT, "samples": COUNT, "seed": SEED, "n_jobs": COUNT,
+})  # fmt: skip
 def container_experiment(
     data_dir: str | os.PathLike[str],
     model: Any,

@@ -60,6 +60,7 @@ from typing import Any
 
 import numpy as np
 
+from unstack.parameters import COUNT, ISET_SIZE, SEED, validate_params
 from unstack.sim.settings import DISPLACEMENT_THRESHOLD
 
 __all__ = [
@@ -249,6 +250,7 @@ def _binned(isets: list[IsetOutcome], scores: dict[str, dict[str, np.ndarray]]) 
 PAPER_TEST_ISETS = 493
 
 
+@validate_params({"r": ISET_SIZE, "isets": COUNT, "seed": SEED})
 def evaluate_decisions(
     data_dir: str | os.PathLike[str],
     model: Any,

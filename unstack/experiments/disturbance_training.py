@@ -28,6 +28,8 @@ from typing import Any
 
 import numpy as np
 
+from unstack.parameters import FOLDS, SEED, validate_params
+
 __all__ = ["family_of", "pick_scores", "table_arrays", "train_disturbance"]
 
 
@@ -84,6 +86,7 @@ def pick_scores(records: Sequence[dict[str, Any]], predicted: Sequence[np.ndarra
     }
 
 
+@validate_params({"random_state": SEED, "folds": FOLDS})
 def train_disturbance(
     records: Sequence[dict[str, Any]], *, random_state: int = 0, folds: int = 5, **parameters: Any
 ) -> tuple[Any, dict[str, Any]]:

@@ -22,13 +22,24 @@ from typing import Any, cast
 
 import numpy as np
 
+from unstack.learning.choices import LEARNERS, SPLITS
+from unstack.learning.features import FEATURE_SETS
+from unstack.learning.training_data import ISET_DRAWS
+from unstack.parameters import COUNT, FOLDS, ISET_SIZE, SEED, OneOf, validate_params
+
+#: The paper's size of Fig. 5a (§V): 200 simulated configurations (its 493 test ISets for Fig. 4
+#: are :data:`unstack.experiments.decisions.PAPER_TEST_ISETS`).
+PAPER_CONFIGURATIONS = 200
+
 __all__ = [
+    "PAPER_CONFIGURATIONS",
     "PAPER_FIG_5A",
     "balanced_threshold",
     "fig5a",
     "paper_point",
     "plot_fig5a",
     "recall_threshold",
+    "require_paper_size",
     "validation_roc",
 ]
 
@@ -149,6 +160,27 @@ def plot_fig5a(result: dict[str, Any], output: str | os.PathLike[str]) -> None:
     save_figure(figure, output)
 
 
+def require_paper_size(data_dir: str | os.PathLike[str], cv: int) -> None:
+    """Refuse a run that claims the paper's size of Fig. 5a and is smaller.
+
+    The paper trains on :data:`PAPER_CONFIGURATIONS` simulated configurations with 10-fold
+    cross-validation.
+    """
+    from unstack.dataset_folders import require_configurations
+    from unstack.errors import UnstackError
+
+    found = len(require_configurations(data_dir))
+    if found < PAPER_CONFIGURATIONS or cv != 10:
+        raise UnstackError(
+            f"{data_dir}: the paper's size is {PAPER_CONFIGURATIONS} configurations and 10 folds; "
+            f"this data set has {found} and cv is {cv} (make it with unstack simulate --configs 200)"
+        )
+
+
+@validate_params({
+    "r": ISET_SIZE, "isets": COUNT, "seed": SEED, "cv": FOLDS, "n_jobs": COUNT, "draw": OneOf(ISET_DRAWS),
+    "learner": OneOf(LEARNERS), "split_by": OneOf(SPLITS), "feature_set": OneOf(FEATURE_SETS),
+})  # fmt: skip
 def fig5a(
     data_dir: str | os.PathLike[str],
     *,
@@ -172,11 +204,8 @@ def fig5a(
     from unstack.learning.features import FeatureSettings
     from unstack.learning.holdout import evaluate_holdout
     from unstack.learning.metrics import classification_report
-    from unstack.learning.training import SPLITS
     from unstack.learning.training_data import dataset_examples
 
-    if split_by not in SPLITS:
-        raise ValueError(f"unknown split {split_by!r}; expected one of {', '.join(SPLITS)}")
     settings = FeatureSettings(feature_set=feature_set)
     examples = dataset_examples(data_dir, r=r, isets=isets, seed=seed, settings=settings, n_jobs=n_jobs, draw=draw)
     holdout = evaluate_holdout(

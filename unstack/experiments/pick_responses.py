@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from unstack.experiments.dispatch import run_unordered
+from unstack.parameters import COUNT, OPTIONAL_COUNT, SEED, validate_params
 from unstack.scene import Scene
 
 __all__ = [
@@ -143,6 +144,7 @@ def _collect_pile(path: Path, number: int, out: Path, seed: int, max_picks: int 
     return number, summary
 
 
+@validate_params({"piles": OPTIONAL_COUNT, "seed": SEED, "max_picks": OPTIONAL_COUNT, "n_jobs": COUNT})
 def collect_pick_responses(
     data_dirs: list[str | os.PathLike[str]],
     out: str | os.PathLike[str],
@@ -238,6 +240,7 @@ def state_rows(
     }
 
 
+@validate_params({"seed": SEED, "samples": COUNT, "n_jobs": COUNT})
 def pick_table(
     states: str | os.PathLike[str],
     model: Any,

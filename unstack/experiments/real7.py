@@ -20,6 +20,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from unstack.experiments.decisions import DECISION_MAKERS, decision_scores, iset_outcome
+from unstack.parameters import OPTIONAL_COUNT, validate_params
 
 __all__ = ["PAPER_FIRST_PICK_RIGHT", "PAPER_REAL7", "real7", "summary_rows"]
 
@@ -27,6 +28,7 @@ PAPER_FIRST_PICK_RIGHT = {3: 0.905, 4: 0.81, 5: 0.62}
 PAPER_REAL7: dict[str, Any] = {"first_pick_right": PAPER_FIRST_PICK_RIGHT, "worst_mse": {"unstack": 0.5, "random": 3.5}}
 
 
+@validate_params({"piles": OPTIONAL_COUNT})
 def real7(
     data_dir: str | os.PathLike[str],
     model: Any,

@@ -18,9 +18,10 @@ from typing import Any
 
 import numpy as np
 
+from unstack.parameters import Interval
 from unstack.reasoner.consistency import PREORDER_COUNTS
 
-__all__ = ["OEIS_A000798", "PAPER_TABLE_I", "table1"]
+__all__ = ["OEIS_A000798", "PAPER_TABLE_I", "TABLE_SIZE", "table1"]
 
 #: The paper's Table I: consistent worlds q' for n = 3..6.
 PAPER_TABLE_I = {3: 29, 4: 355, 5: 6942, 6: 209527}
@@ -29,12 +30,20 @@ PAPER_TABLE_I = {3: 29, 4: 355, 5: 6942, 6: 209527}
 OEIS_A000798 = dict(enumerate(PREORDER_COUNTS))
 
 
+#: The n a row of Table I may have: 8 boxes take minutes, 9 would take days.
+TABLE_SIZE = Interval(int, 3, 8)
+
+
 def table1(sizes: Sequence[int] = (3, 4, 5, 6, 7), *, sat_max: int = 5) -> list[dict[str, Any]]:
-    """One row per n: all worlds 2^(n(n-1)), consistent worlds by each method, the references."""
+    """One row per n: all worlds 2^(n(n-1)), consistent worlds by each method, the references.
+
+    Every n is checked against :data:`TABLE_SIZE` before any counting.
+    """
     from unstack.reasoner.marginals import exact_marginals
     from unstack.reasoner.worlds import enumerate_worlds
     from unstack.supports import Supports
 
+    sizes = [TABLE_SIZE.check(n, "n") for n in sizes]
     rows = []
     for n in sizes:
         half = np.full((n, n), 0.5)

@@ -43,7 +43,8 @@ from typing import Any
 import numpy as np
 
 from unstack.experiments.dispatch import run_unordered
-from unstack.reasoner.costs import DEFAULT_COST
+from unstack.parameters import COUNT, SEED, OneOf, validate_params
+from unstack.reasoner.costs import COSTS, DEFAULT_COST
 
 __all__ = [
     "CLOSED_LOOP_MAKERS",
@@ -209,6 +210,9 @@ def _run_pile(
     return number, {"scene": path.name, "boxes": len(scene.boxes), "detected": len(scene.detected), "runs": executed}
 
 
+@validate_params({
+    "configs": COUNT, "seed": SEED, "cost": OneOf(COSTS), "n_jobs": COUNT,
+})  # fmt: skip
 def unloading_experiment(
     data_dir: str | os.PathLike[str],
     model: Any,

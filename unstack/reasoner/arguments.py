@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from unstack.errors import InvalidArgument, InvalidFile
+from unstack.parameters import Interval, OneOf
 
 __all__ = [
     "MAX_SAMPLES",
@@ -112,11 +113,8 @@ def check_count(value: Any, name: str, minimum: int = 1) -> int:
     >>> check_count(np.int64(4), "samples")
     4
     """
-    if isinstance(value, bool) or not isinstance(value, int | np.integer):
-        raise InvalidArgument(f"{name} must be an integer, got {value!r}")
-    if value < minimum:
-        raise InvalidArgument(f"{name} must be at least {minimum}, got {value}")
-    return int(value)
+    checked: int = Interval(int, minimum).check(value, name)
+    return checked
 
 
 def check_seed(value: Any) -> int | None:
@@ -140,9 +138,7 @@ def check_choice(value: Any, name: str, choices: tuple[str, ...]) -> str:
     >>> check_choice("exact", "method", ("exact", "sat"))
     'exact'
     """
-    if not isinstance(value, str) or value not in choices:
-        raise InvalidArgument(f"unknown {name} {value!r}; expected one of {', '.join(choices)}")
-    return value
+    return OneOf(choices).check(value, name)
 
 
 def check_matrix(value: Any, name: str = "probabilities") -> np.ndarray:

@@ -1,0 +1,87 @@
+"""Where an experiment's results go: a folder, a JSON document, and its picture.
+
+Every ``unstack experiment`` command writes through here, so that a results folder is
+checked once, every document is written whole or not at all (an interrupted run leaves no
+half-written file), and the command prints where its files are.
+
+Examples
+--------
+>>> import tempfile
+>>> from pathlib import Path
+>>> folder = results_folder(Path(tempfile.mkdtemp()) / "results")
+>>> [path.name for path in save_results(folder, "table1.json", [{"n": 3, "exact": 29}])]
+['table1.json']
+>>> (folder / "table1.json").read_text().splitlines()[:3]
+['[', '  {', '    "n": 3,']
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from unstack.errors import UnstackError
+
+__all__ = ["results_folder", "save_results"]
+
+
+def results_folder(out: str | os.PathLike[str]) -> Path:
+    """The folder ``out``, made if missing; an existing file there is refused.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> afile = Path(tempfile.mkdtemp()) / "afile"
+    >>> _ = afile.write_text("")
+    >>> results_folder(afile)
+    Traceback (most recent call last):
+    ...
+    unstack.errors.UnstackError: ...afile: expected a folder for the results, got a file
+    """
+    folder = Path(out)
+    if folder.exists() and not folder.is_dir():
+        raise UnstackError(f"{out}: expected a folder for the results, got a file")
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder
+
+
+def save_results(
+    folder: Path,
+    name: str,
+    result: Any,
+    plot: Callable[[Any, Path], Any] | None = None,
+    picture: str | None = None,
+) -> list[Path]:
+    """Write ``result`` as the JSON document ``folder/name`` and, given ``plot``, its picture.
+
+    Parameters
+    ----------
+    folder : Path
+        A results folder (:func:`results_folder`).
+    name : str
+        The document's file name (``container.json``).
+    result : JSON-ready value
+    plot : callable, optional
+        ``plot(result, path)`` draws the picture (the experiment module's ``plot_*``).
+    picture : str, optional
+        The picture's file name (default: the document's with ``.png``).
+
+    Returns
+    -------
+    list of Path
+        The files written, the document first.
+    """
+    from unstack.atomic import atomic_write_text
+
+    document = folder / name
+    atomic_write_text(document, json.dumps(result, indent=2) + "\n")
+    written = [document]
+    if plot is not None:
+        path = folder / (picture or Path(name).with_suffix(".png").name)
+        plot(result, path)
+        written.append(path)
+    return written
