@@ -7,12 +7,15 @@ scene, so that a shared, noisy machine slows both alike; they report medians and
 
 from __future__ import annotations
 
+import argparse
+import json
 import statistics
 import time
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any
 
-from unstack.scene import Scene
+from unstack.scene import Scene, load_scene
 
 
 def scenes_with_detected(piles: Sequence[Scene], size: int) -> list[Scene]:
@@ -35,3 +38,42 @@ def median_seconds(scenes: Sequence[Scene], calls: dict[str, Callable[[Scene], A
     medians = {f"{name}_median_s": statistics.median(times) for name, times in seconds.items()}
     first = next(iter(calls))
     return {**medians, "scenes": len(scenes), "calls": len(seconds[first])}
+
+
+def compare_by_size(
+    description: str, calls: dict[str, Callable[[Scene], Any]], *, piles: int, repeat: int
+) -> dict[str, dict[str, float]]:
+    """The speed scripts' whole run: arguments, scenes of each size, alternate timing, report.
+
+    Reads the command line (a data set; ``--piles``, ``--repeat``, ``--sizes``, ``--json``),
+    times ``calls`` alternately on each size's scenes, prints the medians and the ratio of the
+    first call to the second, and writes them to ``--json`` when given.
+    """
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("data", type=Path)
+    parser.add_argument("--piles", type=int, default=piles)
+    parser.add_argument("--repeat", type=int, default=repeat)
+    parser.add_argument("--sizes", default="5,40")
+    parser.add_argument("--json", type=Path, default=None)
+    arguments = parser.parse_args()
+    loaded = [load_scene(path) for path in sorted(arguments.data.glob("config-*.json"))[: arguments.piles]]
+    measured, reference = list(calls)[:2]
+    result: dict[str, dict[str, float]] = {}
+    for size in (int(text) for text in arguments.sizes.split(",")):
+        scenes = scenes_with_detected(loaded, size)
+        if not scenes:
+            print(f"{size} detected boxes: no pile of the data set has that many")
+            continue
+        timed = median_seconds(scenes, calls, arguments.repeat)
+        medians = {name: timed[f"{name}_median_s"] for name in calls}
+        ratio = medians[measured] / medians[reference]
+        result[str(size)] = {**timed, f"ratio_{measured}_to_{reference}": ratio}
+        shown = ", ".join(f"{name} {1000 * seconds:.1f} ms" for name, seconds in medians.items())
+        print(
+            f"{size} detected boxes, {len(scenes)} scenes x {arguments.repeat}: {shown} median "
+            f"({measured} / {reference} {ratio:.2f})"
+        )
+    if arguments.json is not None:
+        arguments.json.parent.mkdir(parents=True, exist_ok=True)
+        arguments.json.write_text(json.dumps(result, indent=2) + "\n")
+    return result

@@ -19,47 +19,16 @@ Usage::
 
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from alternating import median_seconds, scenes_with_detected
+from alternating import compare_by_size
 
 import unstack
-from unstack.scene import load_scene
 from unstack.sim.belief import belief_removals
 
-
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("data", type=Path)
-    parser.add_argument("--piles", type=int, default=3)
-    parser.add_argument("--repeat", type=int, default=2)
-    parser.add_argument("--sizes", default="5,40")
-    parser.add_argument("--json", type=Path, default=None)
-    arguments = parser.parse_args()
-    piles = [load_scene(path) for path in sorted(arguments.data.glob("config-*.json"))[: arguments.piles]]
-    result: dict[str, dict[str, float]] = {}
-    for size in (int(text) for text in arguments.sizes.split(",")):
-        scenes = scenes_with_detected(piles, size)
-        if not scenes:
-            print(f"{size} detected boxes: no pile of the data set has that many")
-            continue
-        calls = {"belief": lambda scene: belief_removals(scene), "load": lambda scene: unstack.decide(scene, seed=0)}
-        timed = median_seconds(scenes, calls, arguments.repeat)
-        medians = {name: timed[f"{name}_median_s"] for name in calls}
-        result[str(size)] = {**timed, "ratio_belief_to_load": medians["belief"] / medians["load"]}
-        print(
-            f"{size} detected boxes, {len(scenes)} scenes x {arguments.repeat}: belief {medians['belief']:.2f} s, "
-            f"load {1000 * medians['load']:.0f} ms median (belief / load {medians['belief'] / medians['load']:.1f})"
-        )
-    if arguments.json is not None:
-        arguments.json.parent.mkdir(parents=True, exist_ok=True)
-        arguments.json.write_text(json.dumps(result, indent=2) + "\n")
-
-
 if __name__ == "__main__":
-    main()
+    calls = {"belief": lambda scene: belief_removals(scene), "load": lambda scene: unstack.decide(scene, seed=0)}
+    compare_by_size(__doc__.splitlines()[0], calls, piles=3, repeat=2)
