@@ -155,9 +155,8 @@ def scene_matrices(dataset: Path) -> dict[str, np.ndarray]:
 
 @contextmanager
 def sampler_options(options: dict[str, bool]) -> Iterator[None]:
-    """Run the decisions inside with these options of the sampler (``insertion_sums``,
-    ``revisits``; ``decide`` does not take them, so the benchmark sets them on the function the
-    decision calls)."""
+    """Run the decisions inside with these options of the sampler (``revisits``; ``decide`` does
+    not take them, so the benchmark sets them on the function the decision calls)."""
     from unstack.reasoner import sampling
 
     plain = sampling._sampled_marginals
@@ -197,7 +196,6 @@ def part_scenes(
                 "samples": int(sum(decision.sampling["samples"])) if decision.sampling else 0,
                 "reference_samples": reference.samples,
                 "reference_max_standard_error": float(truth_errors.max()),
-                "summed_boxes": sum((decision.sampling or {}).get("insertion_sums", [0])),
                 "peak_rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
             }
             rows.append(row)
@@ -210,7 +208,7 @@ def summary(row: dict[str, Any]) -> str:
     if "choice_probability" in row:
         extra = (
             f"  P(min) {row['choice_probability']:.3f}  {row['samples']:,} sweeps"
-            f"  reference s.e. {row['reference_max_standard_error']:.4f}  summed boxes {row['summed_boxes']}"
+            f"  reference s.e. {row['reference_max_standard_error']:.4f}"
         )
     return (
         f"{row['part']:6s} {row['family']:12s} n={row['n']:2d} seed={row['seed']}  "
@@ -256,7 +254,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--parts", default="exact,blocks,scenes")
     parser.add_argument(
         "--compare",
-        choices=("insertion_sums", "revisits"),
+        choices=("revisits",),
         default=None,
         help="in the scenes part, run each seed with this option of the sampler off and on",
     )

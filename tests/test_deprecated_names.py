@@ -41,3 +41,16 @@ def test_a_tip_support_still_answers_to_leaning_with_a_warning() -> None:
     found = TipSupport("lean", "upright", 0.04, True)
     with pytest.warns(DeprecationWarning, match=r"TipSupport\.leaning is renamed TipSupport\.held"):
         assert found.leaning == "lean"
+
+
+def test_insertion_sums_warns_and_changes_no_number() -> None:
+    import numpy as np
+
+    from unstack.reasoner.sampling import sampled_marginals
+
+    probabilities = np.random.default_rng(3).uniform(0.0, 0.4, (12, 12))
+    np.fill_diagonal(probabilities, 0.0)
+    plain = sampled_marginals(probabilities, samples=512, seed=1)
+    with pytest.warns(DeprecationWarning, match="insertion_sums was measured no better .* ignored"):
+        asked = sampled_marginals(probabilities, samples=512, seed=1, insertion_sums=True)
+    assert np.array_equal(asked.marginals, plain.marginals)

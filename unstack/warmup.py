@@ -76,7 +76,6 @@ _COMPILE_SECONDS = {"exact engine": 35.4, "sampler": 37.5, "wide sampler": 53.6,
 _MODULES = {
     "unstack.reasoner._insertion_kernels": "exact engine",
     "unstack.reasoner._sampler_kernels": "sampler",
-    "unstack.reasoner._insertion_sum_kernels": "sampler",
     "unstack.reasoner._wide_kernels": "wide sampler",
     "unstack.learning._dbaf_kernel": "feature kernels",
     "unstack.learning._contact_kernel": "feature kernels",

@@ -31,18 +31,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from unstack.reasoner._insertion_sum_kernels import _lowest, insertion_row
-
 _MULTIPLIER = np.uint64(0x2545F4914F6CDD1D)
 _SHIFT_A = np.uint64(12)
 _SHIFT_B = np.uint64(25)
 _SHIFT_C = np.uint64(27)
 _SHIFT_FLOAT = np.uint64(11)
 _TO_UNIT = 1.0 / 9007199254740992.0  # 2**-53
-#: A summed box's row is recorded every this many sweeps (weighted by it), a divisor of the
-#: anytime loop's rounds: the sums of neighbouring sweeps are alike (autocorrelation time about
-#: 3 sweeps on classifier piles), so a quarter of them keep most of the gain at a quarter of the cost.
-SUM_STRIDE = 4
 _STRIDE = 5  # unstack.reasoner.block_gibbs.BLOCK_STRIDE: bit a * 5 + b of a block's table mask
 
 
@@ -569,16 +563,12 @@ def _add_conditionals(
     predecessors: np.ndarray,
     sums: np.ndarray,
     block_of: np.ndarray,
-    summed_rows: np.ndarray,
 ) -> None:
     """Add ``P(S_ij = 1 | every other relation)`` of the current state to ``sums``: ``p_ij``
     for a free pair, else its current value. Pairs inside a block are skipped (the block
-    update adds their conditional given the relations across), and so are the rows of the
-    boxes whose insertion is summed (``summed_rows``)."""
+    update adds their conditional given the relations across)."""
     n = probabilities.shape[0]
     for i in range(n):
-        if summed_rows[i]:
-            continue
         for j in range(n):
             if i == j or (block_of[i] >= 0 and block_of[i] == block_of[j]):
                 continue
@@ -614,19 +604,12 @@ def _run_chain(
     moves: int,
     cursors: np.ndarray,
     schedule: np.ndarray,
-    summed_boxes: np.ndarray,
-    free_sets: np.ndarray,
-    summed_rows: np.ndarray,
-    workspace: tuple[np.ndarray, ...],
-    sum_stats: np.ndarray,
 ) -> int:
     """Run ``sweeps`` sweeps of one chain; add the estimates when ``record``.
 
     A sweep re-inserts ``moves`` boxes, the next ones of ``schedule`` (each box once, in
     order, unless some are visited more often) in turn from ``cursors[chain]`` (every box
-    when ``moves == n`` and the schedule is every box once). The rows of ``summed_boxes``
-    are recorded every :data:`SUM_STRIDE` sweeps (from the first) by summing their insertion
-    inside ``free_sets`` (:func:`_add_insertion_row`, one workspace per chain)."""
+    when ``moves == n`` and the schedule is every box once)."""
     n = probabilities.shape[0]
     pair_sums = np.zeros(_STRIDE * _STRIDE)
     order = np.empty(n, dtype=np.int64)
@@ -636,7 +619,7 @@ def _run_chain(
     cache_keys = np.zeros((block_sizes.shape[0], 3), dtype=np.int64)
     cache_sums = np.zeros((block_sizes.shape[0], _STRIDE * _STRIDE + 2))
     accepted = 0
-    for sweep in range(sweeps):
+    for _sweep in range(sweeps):
         _flip_pairs(probabilities, successors, predecessors, rng, chain)
         for _ in range(moves):
             x = schedule[cursors[chain]]
@@ -679,49 +662,8 @@ def _run_chain(
                 cache_sums[k],
             )
         if record:
-            _add_conditionals(probabilities, successors, predecessors, sums, block_of, summed_rows)
-            if sweep % SUM_STRIDE == 0:
-                for k in range(summed_boxes.shape[0]):
-                    _add_insertion_row(
-                        summed_boxes[k],
-                        free_sets[k],
-                        probabilities,
-                        successors,
-                        predecessors,
-                        sums,
-                        workspace,
-                        sum_stats,
-                    )
+            _add_conditionals(probabilities, successors, predecessors, sums, block_of)
     return accepted
-
-
-@njit(cache=True, nogil=True)
-def _add_insertion_row(
-    box: int,
-    free: np.int64,
-    probabilities: np.ndarray,
-    successors: np.ndarray,
-    predecessors: np.ndarray,
-    sums: np.ndarray,
-    workspace: tuple[np.ndarray, ...],
-    sum_stats: np.ndarray,
-) -> None:
-    """Add ``box``'s row given its cell (:func:`insertion_row`), or the world's own row when the
-    world's insertion leaves ``free`` or the sum outgrows the workspace, times
-    :data:`SUM_STRIDE` (it is recorded every that many sweeps); count both in ``sum_stats``
-    (``[sums, fallbacks, slots]``)."""
-    masks, factors, table, state, store, row = workspace
-    if insertion_row(box, free, probabilities, successors, predecessors, masks, factors, table, state, store, row):
-        for j in range(probabilities.shape[0]):
-            sums[box, j] += SUM_STRIDE * row[j]
-        sum_stats[0] += 1
-        sum_stats[2] += state[1]
-    else:
-        bits = successors[box] & ~(np.int64(1) << box)
-        while bits:
-            sums[box, _lowest(bits)] += SUM_STRIDE
-            bits &= bits - 1
-        sum_stats[1] += 1
 
 
 @njit(cache=True, nogil=True)
@@ -753,11 +695,6 @@ def run_chains(
     moves: int,
     cursors: np.ndarray,
     schedule: np.ndarray,
-    summed_boxes: np.ndarray,
-    free_sets: np.ndarray,
-    summed_rows: np.ndarray,
-    workspaces: tuple[np.ndarray, ...],
-    sum_stats: np.ndarray,
 ) -> None:
     """Advance chains ``first`` to ``last - 1`` by ``rounds`` times ``sweeps`` sweeps, one chain after
     the other.
@@ -777,11 +714,7 @@ def run_chains(
     ``block_*``: the blocks redrawn exactly after every sweep
     (:class:`~unstack.reasoner.block_gibbs.BlockTables`; no blocks: zero rows);
     a sweep re-inserts ``moves`` boxes, the next ones of ``schedule`` in turn from ``cursors``
-    (``(chains,)`` positions in it, updated);
-    ``summed_boxes``/``free_sets``: the boxes whose rows are recorded by their insertion sum
-    and its free set (``summed_rows``: the same boxes as a boolean per box),
-    ``workspaces``: the arrays of :func:`~unstack.reasoner._insertion_sum_kernels.workspace`
-    plus a row, each with a leading chain axis; ``sum_stats``: ``(chains, 3)`` counts.
+    (``(chains,)`` positions in it, updated).
     """
     for c in range(first, last):
         for r in range(rounds):
@@ -810,16 +743,4 @@ def run_chains(
                 moves,
                 cursors,
                 schedule,
-                summed_boxes,
-                free_sets,
-                summed_rows,
-                (
-                    workspaces[0][c],
-                    workspaces[1][c],
-                    workspaces[2][c],
-                    workspaces[3][c],
-                    workspaces[4][c],
-                    workspaces[5][c],
-                ),
-                sum_stats[c],
             )

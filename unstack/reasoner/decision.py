@@ -434,9 +434,6 @@ def _sampling_summary(results: list[_GroupResult], seed: int | None) -> dict[str
         "acceptance": [round(result.acceptance, 4) for result in sampled],
         "seed": seed,
     }
-    summed = [0 if result.summed_boxes is None else len(result.summed_boxes) for result in sampled]
-    if any(summed):
-        summary["insertion_sums"] = summed  # boxes per group recorded by their insertion sum
     slowest = min(result.acceptance for result in sampled)
     worst_rhat = max(float(np.max(result.convergence_of(np.ones(result.marginals.shape[0])))) for result in sampled)
     summary["rhat_max"] = round(worst_rhat, 4) if np.isfinite(worst_rhat) else None

@@ -113,8 +113,8 @@ MOVES = 8
 RARE_SWEEPS = 30
 #: Sweeps per chain discarded before recording.
 DEFAULT_BURN_IN = 64
-#: The pilot run that chooses the revisit schedule (and the boxes whose insertion is summed)
-#: takes one this-th of the budget; its records are kept unless a box's insertion is summed.
+#: The pilot run that chooses the revisit schedule takes one this-th of the budget; its records
+#: are kept.
 PILOT_SHARE = 8
 #: Sweeps per chain in one round of the anytime loop (one call of the compiled kernel).
 _ROUND_SWEEPS = 16
@@ -187,9 +187,6 @@ class SampledMarginals:
     final_worlds : numpy.ndarray, shape (chains, n) or (chains, n, words), int64, optional
         Last state of every chain (bit masks of the boxes each box supports, in the layout
         of :mod:`unstack.reasoner.world_masks`): a warm start for a related scene.
-    summed_boxes : numpy.ndarray, int64, optional
-        The boxes whose rows were recorded by summing their insertion
-        (:mod:`unstack.reasoner.summed_insertions`).
     schedule : numpy.ndarray, int64, optional
         The order in which the boxes were re-inserted at the end (every box once, unless the
         noisiest were visited more often: :mod:`unstack.reasoner.revisits`).
@@ -208,7 +205,6 @@ class SampledMarginals:
     final_worlds: np.ndarray | None = None
     block_of: np.ndarray | None = None
     link_rates: np.ndarray | None = None
-    summed_boxes: np.ndarray | None = None
     schedule: np.ndarray | None = None
 
     def errors_of(self, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -413,7 +409,6 @@ class _Chains:
         self.moves_done = 0
         self._threads: int | None = None  # threads of the chains, chosen at the first round
         self._pool: ThreadPoolExecutor | None = None
-        self.sum_insertions(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64))
         try:
             if start is None:
                 self.advance(1, scatter=True)
@@ -424,19 +419,6 @@ class _Chains:
         except BaseException:  # an error or Ctrl-C in the burn-in: no threads left behind
             self.close()
             raise
-
-    def sum_insertions(self, boxes: np.ndarray, free_sets: np.ndarray, *, slots: int = 1) -> None:
-        """Record the rows of ``boxes`` by summing their insertion inside ``free_sets`` (bit
-        masks; one-word kernels only; :mod:`unstack.reasoner._insertion_sum_kernels`)."""
-        from unstack.reasoner._insertion_sum_kernels import chain_workspaces
-
-        n = self.probabilities.shape[0]
-        self.summed_boxes = np.asarray(boxes, dtype=np.int64)
-        self.free_sets = np.asarray(free_sets, dtype=np.int64)
-        self.summed_rows = np.zeros(n, dtype=np.bool_)
-        self.summed_rows[self.summed_boxes] = True
-        self.workspaces = chain_workspaces(len(self.rng), n, slots)
-        self.sum_stats = np.zeros((len(self.rng), 3), dtype=np.int64)
 
     def advance(self, sweeps: int, *, record: bool = False, scatter: bool = False, rounds: int = 1) -> None:
         """Run every chain ``rounds`` times ``sweeps`` sweeps; with ``record`` the conditionals of
@@ -449,17 +431,8 @@ class _Chains:
         self.moves_done += len(self.rng) * sweeps * rounds * moves
         blocks = self.blocks
         weights: tuple[np.ndarray, ...] = (blocks.log_weights,)
-        summing: tuple[Any, ...] = (
-            self.schedule,
-            self.summed_boxes,
-            self.free_sets,
-            self.summed_rows,
-            self.workspaces,
-            self.sum_stats,
-        )
         if self.wide:
             weights = (blocks.log_weights, self.linear_weights)
-            summing = (self.schedule,)
         arguments = (
             self.probabilities,
             *self.log_tables,
@@ -484,7 +457,7 @@ class _Chains:
             blocks.block_of,
             moves,
             self.cursors,
-            *summing,
+            self.schedule,
         )
         if self._threads is None:  # the first round: the threads of this run
             self._threads = min(thread_count(), len(self.rng))
@@ -559,10 +532,10 @@ def sampled_marginals(
         they give the same numbers as the default one-word kernels, only more slowly; by
         default they run for groups of 64 boxes and more.
     insertion_sums : bool
-        In groups of 9-63 boxes, record the rows of the noisiest boxes by summing their
-        insertion exactly (:mod:`unstack.reasoner.summed_insertions`; a pilot run of an eighth
-        of the budget, not kept, chooses them). Off by default: on classifier piles it has not
-        yet beaten the pair record in the same time (docs page "Benchmarks").
+        Deprecated and ignored (it warns; it goes with 0.2): recording the noisiest boxes'
+        rows by summing their insertion was measured no better than the pair record in the
+        same time on classifier piles (docs page "Benchmarks", "Tried and measured no
+        better") and is removed.
     revisits : bool
         In groups of more than 8 boxes, re-insert the noisiest boxes more often than the others, by
         the standard errors of a pilot run (the first eighth of the budget, kept;
@@ -578,6 +551,15 @@ def sampled_marginals(
         Not a square probability matrix, or a budget, seed or count out of its domain.
     """
     start = time.perf_counter()  # loading the compiled kernels counts against the time limit
+    if insertion_sums:
+        import warnings
+
+        warnings.warn(
+            "insertion_sums was measured no better than the pair record and is removed; it is ignored "
+            "(and goes with 0.2)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
     p = check_matrix(probabilities)
     _check_sampling(samples, time_limit, seed, chains=chains, burn_in=burn_in, tries=tries)
     return _sampled_marginals(
@@ -591,7 +573,6 @@ def sampled_marginals(
         start=start,
         blocks=blocks,
         wide=wide,
-        insertion_sums=insertion_sums,
         revisits=revisits,
     )
 
@@ -623,7 +604,6 @@ def _sampled_marginals(
     blocks: bool = True,
     warm: np.ndarray | None = None,
     wide: bool | None = None,
-    insertion_sums: bool = False,
     revisits: bool = True,
 ) -> SampledMarginals:
     """:func:`sampled_marginals` on checked arguments; ``warm``: consistent starting worlds,
@@ -637,8 +617,7 @@ def _sampled_marginals(
     with _Chains(
         p, chains=chains, seed=seed, burn_in=burn_in, tries=tries, blocks=blocks, start=warm, wide=wide
     ) as state:
-        insertion_sums = insertion_sums and not state.wide
-        choosing = (insertion_sums or revisits) and n > MOVES  # the pilot: the first part of the run
+        choosing = revisits and n > MOVES  # the pilot: the first part of the run
         pilot_sweeps = None if per_chain is None else max(2 * _ROUND_SWEEPS, per_chain // PILOT_SHARE)
         pilot_deadline = (
             None if deadline is None else time.perf_counter() + (deadline - time.perf_counter()) / PILOT_SHARE
@@ -685,13 +664,8 @@ def _sampled_marginals(
                 choosing = False
                 pilot = (batches[:, :filled] / batch_length).reshape(-1, n, n)  # the complete batch means so far
                 variances = pilot.sum(axis=2).var(axis=0, ddof=1) / len(pilot)  # each box's EC, unit weights
-                if revisits:
-                    state.schedule = schedule(np.sqrt(variances))
-                    state.cursors[:] = 0
-                if insertion_sums and _sum_noisiest_insertions(state, pilot.mean(axis=0), variances):
-                    batches[:] = 0.0  # the pilot's records are not kept: the summed rows start afresh
-                    batch_length, filled, partial, recorded = _ROUND_SWEEPS, 0, 0, 0
-                    continue
+                state.schedule = schedule(np.sqrt(variances))
+                state.cursors[:] = 0
             if per_chain is not None and recorded >= per_chain:
                 break
             if deadline is not None and time.perf_counter() + round_seconds >= deadline and filled >= 2:
@@ -731,48 +705,8 @@ def _sampled_marginals(
             final_worlds=state.successors.copy(),
             block_of=block_of,
             link_rates=link_rates,
-            summed_boxes=state.summed_boxes.copy(),
             schedule=state.schedule.copy(),
         )
-
-
-def _sum_noisiest_insertions(state: _Chains, marginals: np.ndarray, variances: np.ndarray) -> bool:
-    """Choose the boxes whose rows the chains record from now on by summing their insertion
-    (:mod:`unstack.reasoner.summed_insertions`) from a pilot's ``marginals`` and the
-    ``variances`` of its ECs; whether any was chosen."""
-    from unstack.reasoner import summed_insertions
-    from unstack.reasoner._insertion_sum_kernels import insertion_row, workspace
-    from unstack.reasoner._sampler_kernels import SUM_STRIDE
-
-    sum_row: Callable[..., bool] = insertion_row
-    n = state.probabilities.shape[0]
-    chains = len(state.rng)
-    eligible = state.blocks.block_of < 0
-    free = summed_insertions.free_sets(marginals, np.arange(n))
-    costs = np.full(n, np.inf)
-    scratch = workspace(n, summed_insertions.SUM_SLOTS)
-    row = np.zeros(n)
-    for box in np.argsort(-variances)[: 2 * MOVES]:  # the cost of a sum on every chain's world
-        slots = []
-        for chain in range(chains):
-            scratch[3][1] = 0
-            inside = sum_row(
-                int(box),
-                free[box],
-                state.probabilities,
-                state.successors[chain],
-                state.predecessors[chain],
-                *scratch,
-                row,
-            )
-            if inside or scratch[3][1] > 0:  # outgrown sums count at the workspace's size
-                slots.append(scratch[3][1] if inside else summed_insertions.SUM_SLOTS)
-        if slots and np.mean(np.array(slots) >= summed_insertions.SUM_SLOTS) <= 0.25:  # sweeps per recorded sweep
-            costs[box] = float(np.mean(slots)) / (summed_insertions.SLOTS_PER_BOX_SWEEP * n * SUM_STRIDE)
-    boxes = summed_insertions.choose(variances, costs, eligible & np.isfinite(costs))
-    if len(boxes):
-        state.sum_insertions(boxes, free[boxes], slots=summed_insertions.SUM_SLOTS)
-    return len(boxes) > 0
 
 
 def sample_worlds(
