@@ -60,6 +60,12 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
 ``belief_veto``
     the same expected moves, the ``veto`` rule: the box resting highest unless the belief
     expects its removal to move at least :data:`~unstack.sim.belief.BELIEF_VETO` boxes.
+``belief_occlusion``
+    physics on what the robot sees with the unseen space filled: every box the detector
+    reports (:data:`~unstack.sim.unloading.IN_VIEW`, reachable or not) at its pose and of the
+    typical mass, the space the sensor cannot see next to them fixed
+    (``fill="occlusion"`` of :func:`unstack.sim.belief.belief_removals`, one world), every
+    candidate's removal tried; the fewest moved, ties to the box resting highest (slow).
 
 Metrics per pile and per maker: boxes moved more than 2 cm, boxes fallen (dropped more than
 0.2 m or tipped more than 45 degrees), the share of picks that move nothing, and paired
@@ -98,7 +104,7 @@ __all__ = [
 CONTAINER_MAKERS = (
     "unstack", "min_cost", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random", "lookahead",
     "moves", "moves_veto", "belief", "belief_veto", "rebuilt",
-    "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen",
+    "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen", "belief_occlusion",
 )  # fmt: skip
 #: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
 #: run only when named.
@@ -216,6 +222,19 @@ def container_policies(
                 moved[box_id] += outcome.boxes_moved / BELIEF_WORLDS
         return fewest(scene, moved)
 
+    def belief_occlusion(scene: Scene) -> str:
+        import dataclasses
+
+        from unstack.sim.belief import belief_removals
+        from unstack.sim.unloading import IN_VIEW
+
+        in_view = set(scene.metadata.get(IN_VIEW, ())) | set(scene.detected)
+        seen = tuple(box_id for box_id in scene.box_ids if box_id in in_view)
+        outcomes = belief_removals(
+            dataclasses.replace(scene, detected=seen), scene.detected, worlds=1, fill="occlusion"
+        )
+        return fewest(scene, {box_id: outcome.expected_moved for box_id, outcome in outcomes.items()})
+
     def belief_seen(scene: Scene) -> str:
         import dataclasses
 
@@ -272,6 +291,7 @@ def container_policies(
         "rebuilt_draws": rebuilt_draws,
         "rebuilt_hidden_fixed": rebuilt_hidden_fixed,
         "belief_seen": belief_seen,
+        "belief_occlusion": belief_occlusion,
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:

@@ -24,6 +24,12 @@ something unseen and is fixed in place, and a removal that touches it counts it 
 the belief cannot say what it would do, only that it leant on the removed box
 (:data:`HOLD_ROUNDS` rounds of settling and looking).
 
+With ``fill="occlusion"`` the unseen material is instead the space the sensor cannot see
+next to the boxes in the belief (:func:`unstack.understanding.occlusion.occluded_space`: behind
+the visible surface, from the sensor's position), all of it fixed, and nothing is held or
+supported afterwards: boxes deeper in the container and under others are taken to fill the
+space the sensor cannot see into, as a pile packed from the back wall does.
+
 The world settles for :data:`~unstack.sim.unloading.RESETTLE_SECONDS`; then each candidate's
 removal is tried as the look-ahead tries it (the same horizon, thresholds and parking, the
 state restored after each try), counting the detected boxes and the hidden-load bodies that
@@ -56,12 +62,14 @@ from unstack.scene import Box, Scene
 
 __all__ = [
     "CELL",
+    "FILLS",
     "BeliefBlock",
     "BeliefOutcome",
     "belief_blocks",
     "belief_choice",
     "belief_removals",
     "choose_by_expected_moves",
+    "occlusion_blocks",
     "seen_boxes",
     "unseen_supports",
 ]
@@ -80,6 +88,10 @@ CLEARANCE = 0.005
 MIN_POINTS = 3
 #: Rounds of fixing in place the boxes a belief world lets fall (:func:`belief_removals`).
 HOLD_ROUNDS = 3
+#: What the belief puts where the robot sees no box: the cloud's unexplained points as columns
+#: and hidden loads (:func:`belief_blocks`), or all the space the sensor cannot see next to the
+#: boxes it sees (:func:`occlusion_blocks`).
+FILLS = ("cloud", "occlusion")
 #: How :func:`belief_choice` picks: the fewest expected moves, or height vetoed by them.
 BELIEF_RULES = ("fewest", "veto")
 #: The ``veto`` rule passes over the highest box when its removal is expected to move this many.
@@ -227,6 +239,38 @@ def seen_boxes(scene: Scene) -> list[str]:
     ]
 
 
+def occlusion_blocks(scene: Scene, settings: Any = None) -> list[BeliefBlock]:
+    """The space the sensor cannot see next to the scene's detected boxes, as fixed blocks.
+
+    :func:`unstack.understanding.occlusion.occluded_space` from the scene's cloud, its
+    detected boxes, the sensor's position and the container's inside (of ``settings``,
+    default: the scene's own).
+
+    Examples
+    --------
+    >>> from unstack.scene import Box, Scene
+    >>> from unstack.understanding.clouds import surface_cloud
+    >>> front = Box("front", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2])
+    >>> behind = Box("behind", [0.4, 0.4, 0.4], [1.4, 0.0, 0.2])
+    >>> cloud = surface_cloud([front, behind], viewpoint=[-2.8, 0.0, 1.3], seed=0)
+    >>> blocks = occlusion_blocks(Scene([front, behind], cloud, ["front"]))
+    >>> {block.resting_on for block in blocks}, bool(max(block.center[0] for block in blocks) > 1.2)
+    ({None}, True)
+    """
+    from unstack.understanding.occlusion import occluded_space
+
+    simulation = _settings(scene, settings)
+    container = simulation.container
+    interior = [[0.0, -container.width / 2.0, 0.0], [container.depth, container.width / 2.0, container.height]]
+    space = occluded_space(
+        scene.points,
+        [scene.box(box_id) for box_id in scene.detected],
+        viewpoint=simulation.sensor.position,
+        interior=interior,
+    )
+    return [BeliefBlock(size, center, None) for size, center in zip(space.sizes, space.centers, strict=True)]
+
+
 def _settings(scene: Scene, settings: Any) -> Any:
     from unstack.sim.settings import SimulationSettings
 
@@ -342,7 +386,12 @@ def _falling(world: Any, bodies: dict[str, int], truth: Any) -> set[str]:
 
 
 def _try_removals(
-    scene: Scene, blocks: list[BeliefBlock], tried: list[str], simulation: Any, rng: np.random.Generator | None
+    scene: Scene,
+    blocks: list[BeliefBlock],
+    tried: list[str],
+    simulation: Any,
+    rng: np.random.Generator | None,
+    hold_rounds: int = HOLD_ROUNDS,
 ) -> dict[str, tuple[str, ...]]:
     """One belief world: build, support or hold what it cannot hold, try each removal and undo it.
 
@@ -363,7 +412,7 @@ def _try_removals(
     held: set[str] = set()
     supported: set[str] = set()
     all_blocks = list(blocks)
-    for _ in range(HOLD_ROUNDS):  # what falls in the belief stands on, or leans on, something unseen
+    for _ in range(hold_rounds):  # what falls in the belief stands on, or leans on, something unseen
         with PhysicsWorld(simulation, door=False) as world:
             falling = _falling(world, _build(world, scene, all_blocks, masses, held), truth) - held
         falling = {name for name in falling if not name.startswith("load:")}
@@ -410,6 +459,7 @@ def belief_removals(
     worlds: int = BELIEF_WORLDS,
     seed: int = 0,
     settings: Any = None,
+    fill: str = "cloud",
 ) -> dict[str, BeliefOutcome]:
     """What removing each candidate moves in the belief worlds built from ``scene``.
 
@@ -429,6 +479,8 @@ def belief_removals(
     settings : SimulationSettings, optional
         Container, friction, time step, masses and the removal thresholds; default: the
         scene's own (``metadata.settings`` of a simulated scene), else the defaults.
+    fill : {"cloud", "occlusion"}
+        What stands where no detected box is (:data:`FILLS`, the module docstring).
 
     Returns
     -------
@@ -442,10 +494,16 @@ def belief_removals(
         raise UnstackError(f"{scene.source}: candidates {unknown} are not detected boxes of the scene")
     if worlds < 1:
         raise UnstackError(f"worlds must be at least 1, got {worlds}")
+    if fill not in FILLS:
+        raise UnstackError(f"unknown belief fill {fill!r}; expected one of {', '.join(FILLS)}")
     simulation = _settings(scene, settings)
-    blocks = belief_blocks(scene)
+    blocks = belief_blocks(scene) if fill == "cloud" else occlusion_blocks(scene, simulation)
+    hold_rounds = HOLD_ROUNDS if fill == "cloud" else 0
     rng = np.random.default_rng(seed)
-    runs = [_try_removals(scene, blocks, tried, simulation, None if world == 0 else rng) for world in range(worlds)]
+    runs = [
+        _try_removals(scene, blocks, tried, simulation, None if world == 0 else rng, hold_rounds)
+        for world in range(worlds)
+    ]
     return {
         box_id: BeliefOutcome(box_id, runs[0][box_id], float(np.mean([len(run[box_id]) for run in runs])))
         for box_id in tried

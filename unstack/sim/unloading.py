@@ -29,6 +29,7 @@ from unstack.errors import UnstackError
 from unstack.scene import Scene
 
 __all__ = [
+    "IN_VIEW",
     "LOST_BELOW_FLOOR",
     "REACH_RULES",
     "UnloadRun",
@@ -48,6 +49,9 @@ RESETTLE_SECONDS = 0.5
 #: Which detected boxes a gripper can take (:func:`reachable_boxes`): ``door`` -- a box whose
 #: door-facing side or top is at most half covered by another box; ``any`` -- every detected box.
 REACH_RULES = ("door", "any")
+#: Key of the policy's scene metadata listing every box the detector reports at this scan,
+#: reachable or not (the candidates are the reachable ones of these).
+IN_VIEW = "in_view"
 #: Share of a face another box may cover before the face is blocked.
 BLOCKED_SHARE = 0.5
 #: How close (metres) a box must come to a face to cover it.
@@ -273,7 +277,9 @@ def unload_container(
     in front are gone. The detected boxes the gripper can reach (:func:`reachable_boxes`) are
     the candidates; ``policy`` gets a scene whose ``detected`` are those candidates, with the
     poses a detector reports (:func:`unstack.understanding.detector.detector_poses` with ``detector_noise``
-    metres; 0 gives the true poses), and the point cloud of the scan. The run stops when the
+    metres; 0 gives the true poses), the point cloud of the scan, and in its metadata under
+    :data:`IN_VIEW` every box the detector reports (reachable or not, the missed ones left
+    out). The run stops when the
     container is empty, after ``max_picks`` picks, or when no box is both detected and
     reachable (:attr:`UnloadRun.stopped` says which).
 
@@ -329,15 +335,19 @@ def unload_container(
         if not candidates:
             stopped[0] = "nothing detected and reachable"
             return None
+        missed: set[str] = set()
         if detector_misses:
             misses_seed = np.random.SeedSequence(seed, spawn_key=(number, 1))
-            candidates = detector_misses_draw(candidates, detector_misses, misses_seed)
+            kept = detector_misses_draw(candidates, detector_misses, misses_seed)
+            missed, candidates = set(candidates) - set(kept), kept
         reported = (
             detector_poses(true_boxes, detector_noise, np.random.default_rng(step_seed))
             if detector_noise
             else true_boxes
         )
-        current = Scene(reported, scan.points, candidates, metadata=scene.metadata, source=scene.source)
+        in_view = [box_id for box_id in detected if box_id not in missed]  # what the detector reports
+        metadata = {**scene.metadata, IN_VIEW: in_view}
+        current = Scene(reported, scan.points, candidates, metadata=metadata, source=scene.source)
         if probe:
             choice = policy(current, probe_removals(scene, world, in_place, candidates, number))
         else:
