@@ -111,3 +111,37 @@ def test_an_unknown_rule_is_refused(column: list[Box]) -> None:
 )
 def test_the_rules_pick_from_the_expected_moves(expected: dict[str, float], rule: str, choice: str) -> None:
     assert choose_by_expected_moves(expected, {"low": 0.0, "high": 0.3}, rule) == choice
+
+
+@pytest.fixture
+def hidden_step() -> list[Box]:
+    """A tall front box hiding a low box behind it, and a box on the low one showing above."""
+    return [
+        Box("front", [0.4, 0.6, 0.4], [0.6, 0.0, 0.2]),
+        Box("under", [0.4, 0.6, 0.3], [1.0, 0.0, 0.15]),
+        Box("up", [0.4, 0.6, 0.3], [1.0, 0.0, 0.45]),
+    ]
+
+
+def _seen_from_the_door(boxes: list[Box], detected: list[str]) -> Scene:
+    """A dense cloud from the default sensor's position (the belief's occlusion needs it)."""
+    return Scene(boxes, surface_cloud(boxes, viewpoint=[-2.8, 0.0, 1.3], spacing=0.005, seed=0), detected)
+
+
+@pytest.mark.slow  # physics
+def test_with_the_unseen_space_filled_a_box_on_a_hidden_one_stands_and_taking_either_moves_nothing(
+    hidden_step: list[Box],
+) -> None:
+    outcomes = belief_removals(_seen_from_the_door(hidden_step, ["front", "up"]), worlds=1, fill="occlusion")
+    assert outcomes["front"].moved == () and outcomes["up"].moved == ()
+
+
+@pytest.mark.slow  # physics
+def test_with_the_unseen_space_filled_the_seen_box_under_another_still_moves_it(column: list[Box]) -> None:
+    outcomes = belief_removals(_seen_from_the_door(column, [box.id for box in column]), worlds=1, fill="occlusion")
+    assert set(outcomes["bottom"].moved) == {"middle", "top"} and outcomes["top"].moved == ()
+
+
+def test_an_unknown_fill_is_refused(column: list[Box]) -> None:
+    with pytest.raises(UnstackError, match="unknown belief fill 'air'; expected one of cloud, occlusion"):
+        belief_removals(_scene(column, ["bottom"]), fill="air")

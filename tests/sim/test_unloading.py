@@ -10,7 +10,7 @@ import pytest
 from unstack.dataset_folders import list_configurations
 from unstack.errors import UnstackError
 from unstack.scene import Scene, load_scene
-from unstack.sim.unloading import execute_policy, execute_unloading, reachable_boxes, unload_container
+from unstack.sim.unloading import IN_VIEW, execute_policy, execute_unloading, reachable_boxes, unload_container
 
 pytestmark = pytest.mark.slow  # executes unloading orders in the physics engine
 
@@ -165,6 +165,23 @@ def test_detector_noise_moves_the_reported_boxes_reproducibly(pile: Scene) -> No
     unload_container(pile, recording, max_picks=1, seed=4)  # the true poses
     errors = np.linalg.norm(np.array(reported[0]) - np.array(reported[2]), axis=1)
     assert 0 < errors.max() < 0.1
+
+
+def test_the_policy_is_told_every_box_in_view_but_the_missed_ones(pile: Scene) -> None:
+    told: dict[float, tuple[set[str], set[str]]] = {}
+
+    def telling(misses: float):  # type: ignore[no-untyped-def]
+        def policy(current: Scene) -> str:
+            told[misses] = (set(current.metadata[IN_VIEW]), set(current.detected))
+            return highest_first(current)
+
+        return policy
+
+    for misses in (0.0, 0.6):  # the first scan of the same pile, every box reported, then some missed
+        unload_container(pile, telling(misses), detector_misses=misses, max_picks=1, seed=4)
+    (in_view, candidates), (in_view_missing, candidates_missing) = told[0.0], told[0.6]
+    assert candidates <= in_view <= set(pile.box_ids) and candidates_missing < candidates
+    assert in_view_missing == in_view - (candidates - candidates_missing)
 
 
 def test_a_detector_that_misses_boxes_offers_fewer_candidates_reproducibly(pile: Scene) -> None:

@@ -252,7 +252,7 @@ def occlusion_blocks(scene: Scene, settings: Any = None) -> list[BeliefBlock]:
     >>> from unstack.understanding.clouds import surface_cloud
     >>> front = Box("front", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2])
     >>> behind = Box("behind", [0.4, 0.4, 0.4], [1.4, 0.0, 0.2])
-    >>> cloud = surface_cloud([front, behind], viewpoint=[-2.8, 0.0, 1.3], seed=0)
+    >>> cloud = surface_cloud([front, behind], viewpoint=[-2.8, 0.0, 1.3], spacing=0.005, seed=0)
     >>> blocks = occlusion_blocks(Scene([front, behind], cloud, ["front"]))
     >>> {block.resting_on for block in blocks}, bool(max(block.center[0] for block in blocks) > 1.2)
     ({None}, True)

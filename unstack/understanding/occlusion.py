@@ -18,8 +18,9 @@ cloud and the sensor's position alone:
   :data:`CLEARANCE`): blocks of unseen material that touch the given boxes without
   entering them.
 
-A direction in which the cloud has no point says nothing: its cells are not occluded. The
-physics on the belief (:mod:`unstack.sim.belief`) puts these blocks in as fixed bodies.
+The cloud must be as dense as a depth image (a point in every direction bin, as the
+simulator's sensor gives); a direction in which the cloud has no point says nothing, and its
+cells are not occluded. The physics on the belief (:mod:`unstack.sim.belief`) puts these blocks in as fixed bodies.
 
 Examples
 --------
@@ -28,7 +29,7 @@ Examples
 >>> from unstack.understanding.clouds import surface_cloud
 >>> front = Box("front", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2])
 >>> behind = Box("behind", [0.4, 0.4, 0.4], [1.4, 0.0, 0.2])   # hidden by front, seen by nobody
->>> cloud = surface_cloud([front, behind], viewpoint=[-2.0, 0.0, 0.3], seed=0)
+>>> cloud = surface_cloud([front, behind], viewpoint=[-2.0, 0.0, 0.3], spacing=0.005, seed=0)
 >>> blocks = occluded_space(cloud, [front], viewpoint=[-2.0, 0.0, 0.3], interior=[[0, -1, 0], [2, 1, 2]])
 >>> def unseen(point):
 ...     return bool(np.all(np.abs(blocks.centers - point) <= blocks.sizes / 2, axis=1).any())

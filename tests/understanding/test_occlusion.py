@@ -1,0 +1,67 @@
+"""The space the sensor cannot see (unstack.understanding.occlusion)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from unstack.geometry import bounding_boxes
+from unstack.scene import Box
+from unstack.understanding.clouds import surface_cloud
+from unstack.understanding.occlusion import CLEARANCE, OccludedBlocks, occluded_space
+
+VIEWPOINT = [-2.8, 0.0, 1.3]
+INTERIOR = [[0.0, -1.175, 0.0], [2.0, 1.175, 2.39]]
+#: Point spacing of a depth image at the pile's range (about a pixel of the simulated sensor).
+DENSE = 0.005
+
+
+def _unseen(blocks: OccludedBlocks, point: list[float]) -> bool:
+    return bool(np.all(np.abs(blocks.centers - point) <= blocks.sizes / 2, axis=1).any())
+
+
+@pytest.fixture
+def hidden_step() -> list[Box]:
+    """A tall front box hiding a low box behind it, and a box on the low one showing above."""
+    return [
+        Box("front", [0.4, 0.6, 0.4], [0.6, 0.0, 0.2]),
+        Box("under", [0.4, 0.6, 0.3], [1.0, 0.0, 0.15]),
+        Box("up", [0.4, 0.6, 0.3], [1.0, 0.0, 0.45]),
+    ]
+
+
+def test_a_box_hidden_behind_a_seen_one_is_unseen_space_and_seen_space_is_not(hidden_step: list[Box]) -> None:
+    cloud = surface_cloud(hidden_step, viewpoint=VIEWPOINT, spacing=DENSE, seed=0)
+    front, _, up = hidden_step
+    blocks = occluded_space(cloud, [front, up], viewpoint=VIEWPOINT, interior=INTERIOR)
+    assert _unseen(blocks, [1.0, 0.0, 0.15])  # where the hidden box is
+    assert not _unseen(blocks, [0.6, 0.0, 0.2])  # inside a seen box
+    assert not _unseen(blocks, [0.6, 0.0, 0.55])  # open air above the front box, seen through
+    assert not _unseen(blocks, [0.2, 0.0, 0.2])  # in front of the pile
+
+
+def test_no_points_or_no_boxes_give_no_unseen_space(hidden_step: list[Box]) -> None:
+    cloud = surface_cloud(hidden_step, viewpoint=VIEWPOINT, spacing=DENSE, seed=0)
+    assert len(occluded_space(np.zeros((0, 3)), hidden_step, viewpoint=VIEWPOINT, interior=INTERIOR)) == 0
+    assert len(occluded_space(cloud, [], viewpoint=VIEWPOINT, interior=INTERIOR)) == 0
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_blocks_stay_inside_the_container_and_out_of_every_seen_box(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    boxes = []
+    for k, (x, y) in enumerate([(x, y) for x in (0.5, 1.0, 1.5) for y in (-0.6, 0.0, 0.6)]):
+        height = float(rng.uniform(0.2, 0.5))
+        boxes.append(Box(f"b{k}", [0.45, 0.5, height], [x, y, height / 2]))
+        if rng.random() < 0.5:  # a second box on it
+            on = float(rng.uniform(0.2, 0.4))
+            boxes.append(Box(f"b{k}u", [0.45, 0.5, on], [x + rng.uniform(-0.03, 0.03), y, height + on / 2]))
+    cloud = surface_cloud(boxes, viewpoint=VIEWPOINT, spacing=DENSE, seed=seed)
+    seen = [box for box in boxes if rng.random() < 0.6] or boxes[:1]
+    blocks = occluded_space(cloud, seen, viewpoint=VIEWPOINT, interior=INTERIOR)
+    assert len(blocks) > 0
+    low, high = blocks.centers - blocks.sizes / 2, blocks.centers + blocks.sizes / 2
+    assert np.all(low >= np.array(INTERIOR[0]) - 1e-9) and np.all(high <= np.array(INTERIOR[1]) + 1e-9)
+    for bound in bounding_boxes(seen):
+        overlap = np.minimum(high, bound[3:]) - np.maximum(low, bound[:3])
+        assert not np.any(np.all(overlap > CLEARANCE / 2, axis=1))
