@@ -66,6 +66,10 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     typical mass, the space the sensor cannot see next to them fixed
     (``fill="occlusion"`` of :func:`unstack.sim.belief.belief_removals`, one world), every
     candidate's removal tried; the fewest moved, ties to the box resting highest (slow).
+``belief_occlusion_free``
+    the same, among the candidates unstack's default decision believes hold nothing up
+    (expected cost below :data:`~unstack.height_veto.HYBRID_MAX_COST`, as the ``hybrid``);
+    all candidates when none does.
 
 Metrics per pile and per maker: boxes moved more than 2 cm, boxes fallen (dropped more than
 0.2 m or tipped more than 45 degrees), the share of picks that move nothing, and paired
@@ -105,6 +109,7 @@ CONTAINER_MAKERS = (
     "unstack", "min_cost", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random", "lookahead",
     "moves", "moves_veto", "belief", "belief_veto", "rebuilt",
     "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen", "belief_occlusion",
+    "belief_occlusion_free",
 )  # fmt: skip
 #: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
 #: run only when named.
@@ -222,7 +227,7 @@ def container_policies(
                 moved[box_id] += outcome.boxes_moved / BELIEF_WORLDS
         return fewest(scene, moved)
 
-    def belief_occlusion(scene: Scene) -> str:
+    def occlusion_moves(scene: Scene, candidates: Sequence[str]) -> dict[str, float]:
         import dataclasses
 
         from unstack.sim.belief import belief_removals
@@ -230,10 +235,20 @@ def container_policies(
 
         in_view = set(scene.metadata.get(IN_VIEW, ())) | set(scene.detected)
         seen = tuple(box_id for box_id in scene.box_ids if box_id in in_view)
-        outcomes = belief_removals(
-            dataclasses.replace(scene, detected=seen), scene.detected, worlds=1, fill="occlusion"
-        )
-        return fewest(scene, {box_id: outcome.expected_moved for box_id, outcome in outcomes.items()})
+        outcomes = belief_removals(dataclasses.replace(scene, detected=seen), candidates, worlds=1, fill="occlusion")
+        return {box_id: outcome.expected_moved for box_id, outcome in outcomes.items()}
+
+    def belief_occlusion(scene: Scene) -> str:
+        return fewest(scene, occlusion_moves(scene, scene.detected))
+
+    def belief_occlusion_free(scene: Scene) -> str:
+        from unstack.height_veto import HYBRID_MAX_COST
+
+        reasoned = decision(scene, "load")
+        costs = dict(zip(reasoned.objects, (float(cost) for cost in reasoned.expected_costs), strict=True))
+        free = [box_id for box_id in scene.detected if costs[box_id] < HYBRID_MAX_COST] or list(scene.detected)
+        moves = occlusion_moves(scene, free)
+        return fewest(scene, {box_id: moves.get(box_id, np.inf) for box_id in scene.detected})
 
     def belief_seen(scene: Scene) -> str:
         import dataclasses
@@ -292,6 +307,7 @@ def container_policies(
         "rebuilt_hidden_fixed": rebuilt_hidden_fixed,
         "belief_seen": belief_seen,
         "belief_occlusion": belief_occlusion,
+        "belief_occlusion_free": belief_occlusion_free,
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:
