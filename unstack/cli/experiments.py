@@ -583,10 +583,15 @@ def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, pi
 @click.option("--worlds", type=CALIBRATION("worlds"), default=None, help="Belief worlds per decision (default 4).")
 @click.option("--max-picks", type=CALIBRATION("max_picks"), default=None, help="Stop each pile after this many picks.")
 @click.option("--seed", type=CALIBRATION("seed"), default=0, show_default=True)
+@click.option("--fill", type=CALIBRATION("fill"), default="cloud", show_default=True,
+              help="What the belief puts where no box is seen: the cloud's unexplained points, or all the "
+                   "space the sensor cannot see next to the boxes.")  # fmt: skip
+@click.option("--view", type=CALIBRATION("view"), default="candidates", show_default=True,
+              help="Boxes in the belief: the reachable candidates, or every box the detector reports.")  # fmt: skip
 @click.option("--jobs", type=CALIBRATION("n_jobs"), default=1, show_default=True, help="Piles run in parallel.")
 def belief_calibration_command(
     data_dir: str, out: str, piles: int, detector_misses: float, worlds: int | None, max_picks: int | None, seed: int,
-    jobs: int,
+    fill: str, view: str, jobs: int,
 ) -> None:  # fmt: skip
     """What physics on the belief expects each pick to move, against what it moves.
 
@@ -601,7 +606,7 @@ def belief_calibration_command(
     with progress_bar("piles") as report:
         result = belief_calibration(
             data_dir, piles=piles, detector_misses=detector_misses, worlds=worlds, max_picks=max_picks, seed=seed,
-            n_jobs=jobs, progress=report,
+            fill=fill, view=view, n_jobs=jobs, progress=report,
         )  # fmt: skip
     written = save_results(folder, "belief-calibration.json", result)
     table = Table(title=f"Expected against actual boxes moved per candidate ({result['piles']} piles of {data_dir})")

@@ -19,6 +19,7 @@ Examples
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -27,12 +28,15 @@ from typing import Any
 import numpy as np
 
 from unstack.experiments.dispatch import run_unordered
-from unstack.parameters import COUNT, MISSED_SHARE, OPTIONAL_COUNT, SEED, validate_params
+from unstack.parameters import COUNT, MISSED_SHARE, OPTIONAL_COUNT, SEED, OneOf, validate_params
 from unstack.scene import Scene
+from unstack.sim.belief import FILLS
 
 __all__ = ["belief_calibration", "pick_summary"]
 
 RULES = ("highest", "belief", "belief_veto", "lookahead")
+#: The boxes a belief is built from (:func:`belief_calibration`).
+VIEWS = ("candidates", "in_view")
 
 
 def pick_summary(states: Sequence[dict[str, int]]) -> dict[str, int]:
@@ -44,14 +48,20 @@ def _calibrate_pile(path: Path, number: int, options: dict[str, Any]) -> tuple[i
     from unstack.geometry import bounding_boxes
     from unstack.scene import load_scene
     from unstack.sim.belief import belief_removals, choose_by_expected_moves
-    from unstack.sim.unloading import unload_container
+    from unstack.sim.unloading import IN_VIEW, unload_container
 
     scene = load_scene(path)
     pairs: list[tuple[float, int]] = []
     states: list[dict[str, int]] = []
 
     def policy(current: Scene, outcomes: dict[str, Any]) -> str:
-        expected = belief_removals(current, worlds=options["worlds"], seed=options["seed"])
+        believed = current
+        if options["view"] == "in_view":  # every box the detector reports, the candidates tried
+            in_view = set(current.metadata.get(IN_VIEW, ())) | set(current.detected)
+            believed = dataclasses.replace(current, detected=tuple(b for b in current.box_ids if b in in_view))
+        expected = belief_removals(
+            believed, current.detected, worlds=options["worlds"], seed=options["seed"], fill=options["fill"]
+        )
         resting = {box_id: float(bounding_boxes([current.box(box_id)])[0, 2]) for box_id in current.detected}
 
         highest = max(current.detected, key=lambda box_id: (resting[box_id], box_id))
@@ -77,7 +87,7 @@ def _calibrate_pile(path: Path, number: int, options: dict[str, Any]) -> tuple[i
 
 @validate_params({
     "piles": COUNT, "detector_misses": MISSED_SHARE, "worlds": OPTIONAL_COUNT, "max_picks": OPTIONAL_COUNT,
-    "seed": SEED, "n_jobs": COUNT,
+    "seed": SEED, "n_jobs": COUNT, "fill": OneOf(FILLS), "view": OneOf(VIEWS),
 })  # fmt: skip
 def belief_calibration(
     data_dir: str | os.PathLike[str],
@@ -87,6 +97,8 @@ def belief_calibration(
     worlds: int | None = None,
     max_picks: int | None = None,
     seed: int = 0,
+    fill: str = "cloud",
+    view: str = "candidates",
     n_jobs: int = 1,
     client: Any = None,
     progress: Callable[[int, int], None] | None = None,
@@ -105,6 +117,11 @@ def belief_calibration(
     max_picks : int, optional
         Stop each pile after this many picks.
     seed : int
+    fill : {"cloud", "occlusion"}
+        What the belief puts where no box is seen (:data:`~unstack.sim.belief.FILLS`).
+    view : {"candidates", "in_view"}
+        The boxes put in the belief: the reachable candidates, or every box the detector
+        reports (:data:`~unstack.sim.unloading.IN_VIEW`); the candidates are tried either way.
     n_jobs, client
         Piles in parallel processes, or on a dask.distributed cluster.
 
@@ -120,7 +137,7 @@ def belief_calibration(
 
     files = require_configurations(data_dir)[:piles]
     options = {"detector_misses": detector_misses, "worlds": BELIEF_WORLDS if worlds is None else worlds,
-               "max_picks": max_picks, "seed": seed}  # fmt: skip
+               "max_picks": max_picks, "seed": seed, "fill": fill, "view": view}  # fmt: skip
     results: list[dict[str, Any] | None] = [None] * len(files)
     if progress is not None:
         progress(0, len(files))
