@@ -20,6 +20,7 @@ from unstack.experiments.container import (
     CONTAINER_SAMPLES,
     DEFAULT_CONTAINER_MAKERS,
     ORACLE_MAKERS,
+    TRIED_MAKERS,
     container_experiment,
 )
 from unstack.experiments.decisions import evaluate_decisions
@@ -378,7 +379,8 @@ def unload(
 @click.option("--piles", type=CONTAINER("piles"), default=2, show_default=True, help="Piles (the first N).")
 @click.option("--makers", default=",".join(DEFAULT_CONTAINER_MAKERS), show_default=True,
               help=f"Comma-separated decision makers; the oracles {', '.join(ORACLE_MAKERS)} (they read every box "
-              "of the pile, for diagnosis) run only when named.")  # fmt: skip
+              f"of the pile, for diagnosis) and {', '.join(TRIED_MAKERS)} (measured no better than highest first) "
+              "run only when named.")  # fmt: skip
 @click.option("--detector-noise", type=CONTAINER("detector_noise"), default=0.0, show_default=True,
               help="Position error of the box detector (m); yaw errors follow.")  # fmt: skip
 @click.option("--detector-misses", type=CONTAINER("detector_misses"), default=0.0, show_default=True,
