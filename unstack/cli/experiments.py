@@ -330,11 +330,10 @@ def unload(
     if full:
         configs = found
     model, name = load_model_option(model_path)
-    from unstack.sim.dataset import connect_scheduler
+    from unstack.sim.dataset import scheduler_client
 
-    client = connect_scheduler(scheduler) if scheduler else None  # fails in seconds, before any output
-    folder = results_folder(out)
-    try:
+    with scheduler_client(scheduler) as client:  # fails in seconds, before any output
+        folder = results_folder(out)
         with progress_bar("piles") as report:
             result = unloading_experiment(
                 data_dir, model, configs=configs, samples=None if time_limit else samples, time_limit=time_limit,
@@ -342,9 +341,6 @@ def unload(
                 checkpoints=folder / "unloading-piles", closed_loop=closed_loop, cost=cost, statics=statics,
                 n_jobs=jobs, client=client,
             )  # fmt: skip
-    finally:
-        if client is not None:
-            client.close()
     result["model"] = name
     written = save_results(folder, "unloading.json", result, plot_unloading)
     table = Table(title=f"Unloading every detected box of {result['configs']} piles ({data_dir}) in the simulator")
@@ -431,11 +427,10 @@ def container(
     chosen = tuple(name.strip() for name in makers.split(",") if name.strip())
     model, name = load_model_option(model_path)
     container_policies(model, seed=seed, makers=chosen)  # an unknown maker is one line, before any work
-    from unstack.sim.dataset import connect_scheduler
+    from unstack.sim.dataset import scheduler_client
 
-    client = connect_scheduler(scheduler) if scheduler else None  # fails in seconds, before any output
-    folder = results_folder(out)
-    try:
+    with scheduler_client(scheduler) as client:  # fails in seconds, before any output
+        folder = results_folder(out)
         with progress_bar("piles") as report:
             result = container_experiment(
                 data_dir, model, piles=piles, makers=chosen, detector_noise=detector_noise,
@@ -443,9 +438,6 @@ def container(
                 max_picks=max_picks, samples=samples, seed=seed, progress=report,
                 checkpoints=folder / "container-piles", n_jobs=jobs, client=client, disturbance=disturbance_path,
             )  # fmt: skip
-    finally:
-        if client is not None:
-            client.close()
     result["model"] = name
     written = save_results(folder, "container.json", result)
     table = Table(title=f"Emptying {result['piles']} piles of {data_dir}, detecting again before every pick")
@@ -649,18 +641,13 @@ def pick_responses(
     reachable candidates and what each candidate's removal moves (tried in the engine and
     undone). Which candidate is then taken is drawn: the probe's best, the highest, a random one.
     """
-    from unstack.sim.dataset import connect_scheduler
+    from unstack.sim.dataset import scheduler_client
 
-    client = connect_scheduler(scheduler) if scheduler else None
-    try:
-        with progress_bar("piles") as report:
-            summaries = collect_pick_responses(
-                list(data_dirs), out, piles=piles, seed=seed, max_picks=max_picks, n_jobs=jobs, client=client,
-                progress=report,
-            )  # fmt: skip
-    finally:
-        if client is not None:
-            client.close()
+    with scheduler_client(scheduler) as client, progress_bar("piles") as report:
+        summaries = collect_pick_responses(
+            list(data_dirs), out, piles=piles, seed=seed, max_picks=max_picks, n_jobs=jobs, client=client,
+            progress=report,
+        )  # fmt: skip
     states = sum(summary["states"] for summary in summaries)
     click.echo(f"{len(summaries)} piles, {states} states in {out}")
 

@@ -29,6 +29,7 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import re
@@ -52,6 +53,7 @@ __all__ = [
     "DatasetSummary",
     "SchedulerUnavailable",
     "connect_scheduler",
+    "scheduler_client",
     "simulate_dataset",
 ]
 
@@ -194,6 +196,28 @@ def connect_scheduler(scheduler: str) -> Any:
         raise SchedulerUnavailable(
             f"dask scheduler {scheduler} does not answer within {SCHEDULER_TIMEOUT:g} s ({type(error).__name__})"
         ) from error
+
+
+@contextlib.contextmanager
+def scheduler_client(scheduler: str | None) -> Iterator[Any]:
+    """A dask.distributed client for the address ``scheduler`` (None: no client), closed on exit.
+
+    Connects on entry (:func:`connect_scheduler`: a one-line error within
+    :data:`SCHEDULER_TIMEOUT`), so a command that enters it before writing anything fails
+    before any output.
+
+    Examples
+    --------
+    >>> with scheduler_client(None) as client:
+    ...     client is None
+    True
+    """
+    client = connect_scheduler(scheduler) if scheduler else None
+    try:
+        yield client
+    finally:
+        if client is not None:
+            client.close()
 
 
 def _run_dask(
