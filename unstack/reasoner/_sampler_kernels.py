@@ -31,6 +31,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from unstack.reasoner._chain_arrays import BlockArrays, ChainArrays
+
 _MULTIPLIER = np.uint64(0x2545F4914F6CDD1D)
 _SHIFT_A = np.uint64(12)
 _SHIFT_B = np.uint64(25)
@@ -581,43 +583,40 @@ def _add_conditionals(
 @njit(cache=True, nogil=True)
 def _run_chain(
     chain: int,
+    round_: int,
     probabilities: np.ndarray,
     log_present: np.ndarray,
     log_absent: np.ndarray,
-    successors: np.ndarray,
-    predecessors: np.ndarray,
-    rng: np.ndarray,
+    chains: ChainArrays,
+    blocks: BlockArrays,
     sweeps: int,
     tries: int,
     record: bool,
-    sums: np.ndarray,
     scatter: bool,
-    block_members: np.ndarray,
-    block_sizes: np.ndarray,
-    block_counts: np.ndarray,
-    block_masks: np.ndarray,
-    block_log_weights: np.ndarray,
-    block_cumulative: np.ndarray,
-    block_marginals: np.ndarray,
-    block_pairs: np.ndarray,
-    block_of: np.ndarray,
     moves: int,
-    cursors: np.ndarray,
     schedule: np.ndarray,
 ) -> int:
     """Run ``sweeps`` sweeps of one chain; add the estimates when ``record``.
 
     A sweep re-inserts ``moves`` boxes, the next ones of ``schedule`` (each box once, in
     order, unless some are visited more often) in turn from ``cursors[chain]`` (every box
-    when ``moves == n`` and the schedule is every box once)."""
+    when ``moves == n`` and the schedule is every box once). The round's records go to
+    ``chains.sums[chain, round_]``."""
+    successors, predecessors, rng, cursors = (
+        chains.successors[chain],
+        chains.predecessors[chain],
+        chains.rng,
+        chains.cursors,
+    )
+    sums = chains.sums[chain, round_]
     n = probabilities.shape[0]
     pair_sums = np.zeros(_STRIDE * _STRIDE)
     order = np.empty(n, dtype=np.int64)
     candidates_supported = np.empty(tries + 1, dtype=np.int64)
     candidates_supporters = np.empty(tries + 1, dtype=np.int64)
     log_ratios = np.empty(tries + 1)
-    cache_keys = np.zeros((block_sizes.shape[0], 3), dtype=np.int64)
-    cache_sums = np.zeros((block_sizes.shape[0], _STRIDE * _STRIDE + 2))
+    cache_keys = np.zeros((blocks.sizes.shape[0], 3), dtype=np.int64)
+    cache_sums = np.zeros((blocks.sizes.shape[0], _STRIDE * _STRIDE + 2))
     accepted = 0
     for _sweep in range(sweeps):
         _flip_pairs(probabilities, successors, predecessors, rng, chain)
@@ -641,16 +640,16 @@ def _run_chain(
                 scatter,
             ):
                 accepted += 1
-        for k in range(block_sizes.shape[0]):
+        for k in range(blocks.sizes.shape[0]):
             _block_update(
-                block_members[k],
-                block_sizes[k],
-                block_counts[k],
-                block_masks[k],
-                block_log_weights[k],
-                block_cumulative[k],
-                block_marginals[k],
-                block_pairs[k],
+                blocks.members[k],
+                blocks.sizes[k],
+                blocks.counts[k],
+                blocks.masks[k],
+                blocks.log_weights[k],
+                blocks.cumulative[k],
+                blocks.marginals[k],
+                blocks.pairs[k],
                 successors,
                 predecessors,
                 rng,
@@ -662,7 +661,7 @@ def _run_chain(
                 cache_sums[k],
             )
         if record:
-            _add_conditionals(probabilities, successors, predecessors, sums, block_of)
+            _add_conditionals(probabilities, successors, predecessors, sums, blocks.block_of)
     return accepted
 
 
@@ -673,27 +672,14 @@ def run_chains(
     probabilities: np.ndarray,
     log_present: np.ndarray,
     log_absent: np.ndarray,
-    successors: np.ndarray,
-    predecessors: np.ndarray,
-    rng: np.ndarray,
+    chains: ChainArrays,
+    blocks: BlockArrays,
     sweeps: int,
     rounds: int,
     tries: int,
     record: bool,
-    sums: np.ndarray,
-    accepted: np.ndarray,
     scatter: bool,
-    block_members: np.ndarray,
-    block_sizes: np.ndarray,
-    block_counts: np.ndarray,
-    block_masks: np.ndarray,
-    block_log_weights: np.ndarray,
-    block_cumulative: np.ndarray,
-    block_marginals: np.ndarray,
-    block_pairs: np.ndarray,
-    block_of: np.ndarray,
     moves: int,
-    cursors: np.ndarray,
     schedule: np.ndarray,
 ) -> None:
     """Advance chains ``first`` to ``last - 1`` by ``rounds`` times ``sweeps`` sweeps, one chain after
@@ -703,44 +689,18 @@ def run_chains(
     (:mod:`unstack.threads`), not numba's parallel loop, whose OpenMP workers spin while they
     wait (a 31-box plan took 1.4-2.1 s instead of 0.8-0.9 s beside a busy core).
 
-    ``log_present``/``log_absent``: ``log p`` and ``log(1 - p)`` (``-inf`` at 0);
-
-    ``successors``/``predecessors``: ``(chains, n)`` bit masks, updated in place;
-    ``rng``: ``(chains,)`` uint64 states; ``rounds`` rounds of ``sweeps`` sweeps each; ``sums``:
-    ``(chains, rounds, n, n)``, the conditionals of every recorded sweep of round ``r`` are added to
-    ``sums[:, r]``; ``scatter``: take every first proposal (to spread
-    the starting worlds of the chains);
-    ``accepted``: ``(chains,)`` counts of moves that changed the state;
-    ``block_*``: the blocks redrawn exactly after every sweep
-    (:class:`~unstack.reasoner.block_gibbs.BlockTables`; no blocks: zero rows);
-    a sweep re-inserts ``moves`` boxes, the next ones of ``schedule`` in turn from ``cursors``
-    (``(chains,)`` positions in it, updated).
+    ``log_present``/``log_absent``: ``log p`` and ``log(1 - p)`` (``-inf`` at 0); ``chains``:
+    every chain's state (:class:`~unstack.reasoner._chain_arrays.ChainArrays`, ``(chains, n)``
+    bit masks, updated in place; the conditionals of every recorded sweep of round ``r`` are
+    added to ``chains.sums[:, r]``); ``blocks``: the blocks redrawn exactly after every sweep
+    (:class:`~unstack.reasoner._chain_arrays.BlockArrays`; no blocks: zero rows); ``rounds``
+    rounds of ``sweeps`` sweeps each; ``scatter``: take every first proposal (to spread the
+    starting worlds of the chains); a sweep re-inserts ``moves`` boxes, the next ones of
+    ``schedule`` in turn from ``chains.cursors``.
     """
     for c in range(first, last):
         for r in range(rounds):
-            accepted[c] += _run_chain(
-                c,
-                probabilities,
-                log_present,
-                log_absent,
-                successors[c],
-                predecessors[c],
-                rng,
-                sweeps,
-                tries,
-                record,
-                sums[c, r],
-                scatter,
-                block_members,
-                block_sizes,
-                block_counts,
-                block_masks,
-                block_log_weights,
-                block_cumulative,
-                block_marginals,
-                block_pairs,
-                block_of,
-                moves,
-                cursors,
+            chains.accepted[c] += _run_chain(
+                c, r, probabilities, log_present, log_absent, chains, blocks, sweeps, tries, record, scatter, moves,
                 schedule,
-            )
+            )  # fmt: skip

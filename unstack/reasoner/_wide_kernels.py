@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from unstack.reasoner._chain_arrays import BlockArrays, ChainArrays
 from unstack.reasoner._sampler_kernels import _STRIDE, _uniform
 
 #: Below this a linked block's sum of table weights is redone in scaled log space.
@@ -484,36 +485,32 @@ def _add_conditionals(
 @njit(cache=True, nogil=True)
 def _run_chain(
     chain: int,
+    round_: int,
     probabilities: np.ndarray,
     log_present: np.ndarray,
     log_absent: np.ndarray,
-    successors: np.ndarray,
-    predecessors: np.ndarray,
-    rng: np.ndarray,
+    chains: ChainArrays,
+    blocks: BlockArrays,
     sweeps: int,
     tries: int,
     record: bool,
-    sums: np.ndarray,
     scatter: bool,
-    block_members: np.ndarray,
-    block_sizes: np.ndarray,
-    block_counts: np.ndarray,
-    block_masks: np.ndarray,
-    block_log_weights: np.ndarray,
-    block_linear_weights: np.ndarray,
-    block_cumulative: np.ndarray,
-    block_marginals: np.ndarray,
-    block_pairs: np.ndarray,
-    block_of: np.ndarray,
     moves: int,
-    cursors: np.ndarray,
     schedule: np.ndarray,
 ) -> int:
     """Run ``sweeps`` sweeps of one chain; add the estimates when ``record``.
 
     A sweep re-inserts ``moves`` boxes, the next ones of ``schedule`` in turn from
     ``cursors[chain]`` (all boxes, in order, when ``moves == n`` and the schedule is every box
-    once: the sweep of the one-word kernels)."""
+    once: the sweep of the one-word kernels). The round's records go to
+    ``chains.sums[chain, round_]``."""
+    successors, predecessors, rng, cursors = (
+        chains.successors[chain],
+        chains.predecessors[chain],
+        chains.rng,
+        chains.cursors,
+    )
+    sums = chains.sums[chain, round_]
     n = probabilities.shape[0]
     words = successors.shape[1]
     pair_sums = np.zeros(_STRIDE * _STRIDE)
@@ -523,8 +520,8 @@ def _run_chain(
     log_ratios = np.empty(tries + 1)
     scratch = np.zeros((8, words), dtype=np.int64)
     inside = np.zeros(words, dtype=np.int64)
-    cache_keys = np.zeros((block_sizes.shape[0], 3), dtype=np.int64)
-    cache_sums = np.zeros((block_sizes.shape[0], _STRIDE * _STRIDE + 1))
+    cache_keys = np.zeros((blocks.sizes.shape[0], 3), dtype=np.int64)
+    cache_sums = np.zeros((blocks.sizes.shape[0], _STRIDE * _STRIDE + 1))
     accepted = 0
     for _ in range(sweeps):
         _flip_pairs(probabilities, successors, predecessors, rng, chain)
@@ -536,14 +533,14 @@ def _run_chain(
                 candidates_supported, candidates_supporters, log_ratios, scatter, scratch,
             ):  # fmt: skip
                 accepted += 1
-        for k in range(block_sizes.shape[0]):
+        for k in range(blocks.sizes.shape[0]):
             _block_update(
-                block_members[k], block_sizes[k], block_counts[k], block_masks[k], block_log_weights[k],
-                block_linear_weights[k], block_cumulative[k], block_marginals[k], block_pairs[k], successors,
+                blocks.members[k], blocks.sizes[k], blocks.counts[k], blocks.masks[k], blocks.log_weights[k],
+                blocks.linear_weights[k], blocks.cumulative[k], blocks.marginals[k], blocks.pairs[k], successors,
                 predecessors, rng, chain, record, sums, pair_sums, inside, cache_keys[k], cache_sums[k],
             )  # fmt: skip
         if record:
-            _add_conditionals(probabilities, successors, predecessors, sums, block_of)
+            _add_conditionals(probabilities, successors, predecessors, sums, blocks.block_of)
     return accepted
 
 
@@ -554,39 +551,21 @@ def run_chains(
     probabilities: np.ndarray,
     log_present: np.ndarray,
     log_absent: np.ndarray,
-    successors: np.ndarray,
-    predecessors: np.ndarray,
-    rng: np.ndarray,
+    chains: ChainArrays,
+    blocks: BlockArrays,
     sweeps: int,
     rounds: int,
     tries: int,
     record: bool,
-    sums: np.ndarray,
-    accepted: np.ndarray,
     scatter: bool,
-    block_members: np.ndarray,
-    block_sizes: np.ndarray,
-    block_counts: np.ndarray,
-    block_masks: np.ndarray,
-    block_log_weights: np.ndarray,
-    block_linear_weights: np.ndarray,
-    block_cumulative: np.ndarray,
-    block_marginals: np.ndarray,
-    block_pairs: np.ndarray,
-    block_of: np.ndarray,
     moves: int,
-    cursors: np.ndarray,
     schedule: np.ndarray,
 ) -> None:
     """:func:`unstack.reasoner._sampler_kernels.run_chains` (chains ``first`` to ``last - 1``) with
-    ``(chains, n, words)`` states; ``rounds`` and ``sums`` ``(chains, rounds, n, n)`` as there;
-    a sweep re-inserts ``moves`` boxes, the next ones of ``schedule`` in turn from ``cursors``
-    (``(chains,)`` positions in it, updated)."""
+    ``(chains, n, words)`` states in ``chains``; the rest as there."""
     for c in range(first, last):
         for r in range(rounds):
-            accepted[c] += _run_chain(
-                c, probabilities, log_present, log_absent, successors[c], predecessors[c], rng, sweeps, tries,
-                record, sums[c, r], scatter, block_members, block_sizes, block_counts, block_masks,
-                block_log_weights, block_linear_weights, block_cumulative, block_marginals, block_pairs, block_of,
-                moves, cursors, schedule,
+            chains.accepted[c] += _run_chain(
+                c, r, probabilities, log_present, log_absent, chains, blocks, sweeps, tries, record, scatter, moves,
+                schedule,
             )  # fmt: skip

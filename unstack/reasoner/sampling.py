@@ -57,6 +57,7 @@ from typing import Any
 import numpy as np
 
 from unstack.errors import InvalidArgument
+from unstack.reasoner._chain_arrays import BlockArrays, ChainArrays
 from unstack.reasoner.arguments import check_budget, check_count, check_matrix, check_samples, check_seed
 from unstack.reasoner.revisits import schedule
 from unstack.reasoner.world_masks import ONE_WORD_BOXES, mask_words, pack, unpack
@@ -430,35 +431,22 @@ class _Chains:
         moves = self.probabilities.shape[0] if scatter else self.moves
         self.moves_done += len(self.rng) * sweeps * rounds * moves
         blocks = self.blocks
-        weights: tuple[np.ndarray, ...] = (blocks.log_weights,)
-        if self.wide:
-            weights = (blocks.log_weights, self.linear_weights)
         arguments = (
             self.probabilities,
             *self.log_tables,
-            self.successors,
-            self.predecessors,
-            self.rng,
+            ChainArrays(self.successors, self.predecessors, self.rng, self.cursors, self.accepted, self.sums),
+            BlockArrays(
+                blocks.members, blocks.sizes, blocks.counts, blocks.masks, blocks.log_weights, self.linear_weights,
+                blocks.cumulative, blocks.marginals, blocks.pairs, blocks.block_of,
+            ),
             sweeps,
             rounds,
             self.tries,
             record,
-            self.sums,
-            self.accepted,
             scatter,
-            blocks.members,
-            blocks.sizes,
-            blocks.counts,
-            blocks.masks,
-            *weights,
-            blocks.cumulative,
-            blocks.marginals,
-            blocks.pairs,
-            blocks.block_of,
             moves,
-            self.cursors,
             self.schedule,
-        )
+        )  # fmt: skip
         if self._threads is None:  # the first round: the threads of this run
             self._threads = min(thread_count(), len(self.rng))
             if self._threads > 1:  # the calling thread runs the first range itself
