@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from unstack.scene import Box
 from unstack.supports import Supports
 
 REPO = Path(__file__).resolve().parents[1]
@@ -133,3 +134,14 @@ def small_dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
     )
     simulate_dataset(folder, settings, configs=8, seed=5)
     return folder
+
+
+@pytest.fixture
+def hidden_step() -> list[Box]:
+    """A tall front box hiding a low box behind it, and a box on the low one showing above it
+    (seen from the simulator's default sensor position)."""
+    return [
+        Box("front", [0.4, 0.6, 0.4], [0.6, 0.0, 0.2]),
+        Box("under", [0.4, 0.6, 0.3], [1.0, 0.0, 0.15]),
+        Box("up", [0.4, 0.6, 0.3], [1.0, 0.0, 0.45]),
+    ]

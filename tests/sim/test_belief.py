@@ -113,16 +113,6 @@ def test_the_rules_pick_from_the_expected_moves(expected: dict[str, float], rule
     assert choose_by_expected_moves(expected, {"low": 0.0, "high": 0.3}, rule) == choice
 
 
-@pytest.fixture
-def hidden_step() -> list[Box]:
-    """A tall front box hiding a low box behind it, and a box on the low one showing above."""
-    return [
-        Box("front", [0.4, 0.6, 0.4], [0.6, 0.0, 0.2]),
-        Box("under", [0.4, 0.6, 0.3], [1.0, 0.0, 0.15]),
-        Box("up", [0.4, 0.6, 0.3], [1.0, 0.0, 0.45]),
-    ]
-
-
 def _seen_from_the_door(boxes: list[Box], detected: list[str]) -> Scene:
     """A dense cloud from the default sensor's position (the belief's occlusion needs it)."""
     return Scene(boxes, surface_cloud(boxes, viewpoint=[-2.8, 0.0, 1.3], spacing=0.005, seed=0), detected)

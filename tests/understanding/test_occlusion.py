@@ -20,16 +20,6 @@ def _unseen(blocks: OccludedBlocks, point: list[float]) -> bool:
     return bool(np.all(np.abs(blocks.centers - point) <= blocks.sizes / 2, axis=1).any())
 
 
-@pytest.fixture
-def hidden_step() -> list[Box]:
-    """A tall front box hiding a low box behind it, and a box on the low one showing above."""
-    return [
-        Box("front", [0.4, 0.6, 0.4], [0.6, 0.0, 0.2]),
-        Box("under", [0.4, 0.6, 0.3], [1.0, 0.0, 0.15]),
-        Box("up", [0.4, 0.6, 0.3], [1.0, 0.0, 0.45]),
-    ]
-
-
 def test_a_box_hidden_behind_a_seen_one_is_unseen_space_and_seen_space_is_not(hidden_step: list[Box]) -> None:
     cloud = surface_cloud(hidden_step, viewpoint=VIEWPOINT, spacing=DENSE, seed=0)
     front, _, up = hidden_step
