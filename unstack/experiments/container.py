@@ -66,6 +66,10 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     typical mass, the space the sensor cannot see next to them fixed
     (``fill="occlusion"`` of :func:`unstack.sim.belief.belief_removals`, one world), every
     candidate's removal tried; the fewest moved, ties to the box resting highest (slow).
+``belief_bracket``
+    the mean of two beliefs on the boxes in view: the unseen space all solid
+    (``belief_occlusion``) and the cloud's columns with the boxes in view that fall held
+    (``fill="cloud"``); the fewest moved.
 ``belief_occlusion_free``
     the same, among the candidates unstack's default decision believes hold nothing up
     (expected cost below :data:`~unstack.height_veto.HYBRID_MAX_COST`, as the ``hybrid``);
@@ -110,14 +114,14 @@ CONTAINER_MAKERS = (
     "unstack", "min_cost", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random", "lookahead",
     "moves", "moves_veto", "belief", "belief_veto", "rebuilt",
     "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen", "belief_occlusion",
-    "belief_occlusion_free",
+    "belief_occlusion_free", "belief_bracket",
 )  # fmt: skip
 #: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
 #: run only when named.
 ORACLE_MAKERS = ("rebuilt", "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen")
 #: Robot policies measured no better than highest first in the closed loop (results page,
 #: "Filling the space the sensor cannot see"): run only when named.
-TRIED_MAKERS = ("belief_occlusion", "belief_occlusion_free")
+TRIED_MAKERS = ("belief_occlusion", "belief_occlusion_free", "belief_bracket")
 #: The makers run when none are named.
 DEFAULT_CONTAINER_MAKERS = tuple(
     maker for maker in CONTAINER_MAKERS if maker not in ORACLE_MAKERS and maker not in TRIED_MAKERS
@@ -233,7 +237,7 @@ def container_policies(
                 moved[box_id] += outcome.boxes_moved / BELIEF_WORLDS
         return fewest(scene, moved)
 
-    def occlusion_moves(scene: Scene, candidates: Sequence[str]) -> dict[str, float]:
+    def in_view_moves(scene: Scene, candidates: Sequence[str], fill: str = "occlusion") -> dict[str, float]:
         import dataclasses
 
         from unstack.sim.belief import belief_removals
@@ -241,11 +245,15 @@ def container_policies(
 
         in_view = set(scene.metadata.get(IN_VIEW, ())) | set(scene.detected)
         seen = tuple(box_id for box_id in scene.box_ids if box_id in in_view)
-        outcomes = belief_removals(dataclasses.replace(scene, detected=seen), candidates, worlds=1, fill="occlusion")
+        outcomes = belief_removals(dataclasses.replace(scene, detected=seen), candidates, worlds=1, fill=fill)
         return {box_id: outcome.expected_moved for box_id, outcome in outcomes.items()}
 
     def belief_occlusion(scene: Scene) -> str:
-        return fewest(scene, occlusion_moves(scene, scene.detected))
+        return fewest(scene, in_view_moves(scene, scene.detected))
+
+    def belief_bracket(scene: Scene) -> str:
+        solid, columns = (in_view_moves(scene, scene.detected, fill) for fill in ("occlusion", "cloud"))
+        return fewest(scene, {box_id: (solid[box_id] + columns[box_id]) / 2 for box_id in scene.detected})
 
     def belief_occlusion_free(scene: Scene) -> str:
         from unstack.height_veto import HYBRID_MAX_COST
@@ -253,7 +261,7 @@ def container_policies(
         reasoned = decision(scene, "load")
         costs = dict(zip(reasoned.objects, (float(cost) for cost in reasoned.expected_costs), strict=True))
         free = [box_id for box_id in scene.detected if costs[box_id] < HYBRID_MAX_COST] or list(scene.detected)
-        moves = occlusion_moves(scene, free)
+        moves = in_view_moves(scene, free)
         return fewest(scene, {box_id: moves.get(box_id, np.inf) for box_id in scene.detected})
 
     def belief_seen(scene: Scene) -> str:
@@ -314,6 +322,7 @@ def container_policies(
         "belief_seen": belief_seen,
         "belief_occlusion": belief_occlusion,
         "belief_occlusion_free": belief_occlusion_free,
+        "belief_bracket": belief_bracket,
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:
