@@ -70,6 +70,10 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     the mean of two beliefs on the boxes in view: the unseen space all solid
     (``belief_occlusion``) and the cloud's columns with the boxes in view that fall held
     (``fill="cloud"``); the fewest moved.
+``belief_occlusion_veto``
+    height vetoed by the occlusion-filled belief: ``highest``'s pick unless that belief
+    expects its removal to move at least :data:`~unstack.sim.belief.BELIEF_VETO` boxes; then
+    ``belief_occlusion_free``'s pick.
 ``belief_occlusion_free``
     the same, among the candidates unstack's default decision believes hold nothing up
     (expected cost below :data:`~unstack.height_veto.HYBRID_MAX_COST`, as the ``hybrid``);
@@ -114,14 +118,14 @@ CONTAINER_MAKERS = (
     "unstack", "min_cost", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random", "lookahead",
     "moves", "moves_veto", "belief", "belief_veto", "rebuilt",
     "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen", "belief_occlusion",
-    "belief_occlusion_free", "belief_bracket",
+    "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto",
 )  # fmt: skip
 #: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
 #: run only when named.
 ORACLE_MAKERS = ("rebuilt", "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen")
 #: Robot policies measured no better than highest first in the closed loop (results page,
 #: "Filling the space the sensor cannot see"): run only when named.
-TRIED_MAKERS = ("belief_occlusion", "belief_occlusion_free", "belief_bracket")
+TRIED_MAKERS = ("belief_occlusion", "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto")
 #: The makers run when none are named.
 DEFAULT_CONTAINER_MAKERS = tuple(
     maker for maker in CONTAINER_MAKERS if maker not in ORACLE_MAKERS and maker not in TRIED_MAKERS
@@ -255,6 +259,14 @@ def container_policies(
         solid, columns = (in_view_moves(scene, scene.detected, fill) for fill in ("occlusion", "cloud"))
         return fewest(scene, {box_id: (solid[box_id] + columns[box_id]) / 2 for box_id in scene.detected})
 
+    def belief_occlusion_veto(scene: Scene) -> str:
+        from unstack.sim.belief import BELIEF_VETO
+
+        top = highest(scene)
+        if in_view_moves(scene, [top])[top] < BELIEF_VETO:
+            return top
+        return belief_occlusion_free(scene)
+
     def belief_occlusion_free(scene: Scene) -> str:
         from unstack.height_veto import HYBRID_MAX_COST
 
@@ -323,6 +335,7 @@ def container_policies(
         "belief_occlusion": belief_occlusion,
         "belief_occlusion_free": belief_occlusion_free,
         "belief_bracket": belief_bracket,
+        "belief_occlusion_veto": belief_occlusion_veto,
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:
