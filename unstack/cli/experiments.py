@@ -375,7 +375,7 @@ def unload(
 @click.option("--piles", type=CONTAINER("piles"), default=2, show_default=True, help="Piles (the first N).")
 @click.option("--makers", default=",".join(DEFAULT_CONTAINER_MAKERS), show_default=True,
               help=f"Comma-separated decision makers; the oracles {', '.join(ORACLE_MAKERS)} (they read every box "
-              f"of the pile, for diagnosis) and {', '.join(TRIED_MAKERS)} (measured no better than highest first) "
+              f"of the pile, for diagnosis) and {', '.join(TRIED_MAKERS)} (slow; see the results page) "
               "run only when named.")  # fmt: skip
 @click.option("--detector-noise", type=CONTAINER("detector_noise"), default=0.0, show_default=True,
               help="Position error of the box detector (m); yaw errors follow.")  # fmt: skip

@@ -123,8 +123,9 @@ CONTAINER_MAKERS = (
 #: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
 #: run only when named.
 ORACLE_MAKERS = ("rebuilt", "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen")
-#: Robot policies measured no better than highest first in the closed loop (results page,
-#: "Filling the space the sensor cannot see"): run only when named.
+#: Robot policies of physics on the belief with the unseen space filled, slow and measured
+#: no better than highest first in the closed loop on most families (results page, "Filling
+#: the space the sensor cannot see"): run only when named.
 TRIED_MAKERS = ("belief_occlusion", "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto")
 #: The makers run when none are named.
 DEFAULT_CONTAINER_MAKERS = tuple(
