@@ -1,0 +1,36 @@
+"""How long height vetoed by the occlusion-filled belief takes per pick, beside the load cost.
+
+The container maker ``belief_occlusion_veto`` (:mod:`unstack.experiments.container`): the
+highest box unless physics on the belief with the unseen space filled expects its removal to
+move a box, then the belief's fewest among the boxes unstack's reasoner believes free. A
+robot's pick takes about 4-5 s; the decision must take under 1 s median for 40 detected boxes
+and under 50 ms for 5 (issue 34, part 3). The first ``N`` boxes of each simulated pile are
+taken as detected (and as the boxes in view); the maker and ``unstack.decide`` with the load
+cost are timed alternately on the same scenes after one warm-up call each.
+
+Usage::
+
+    python benchmarks/veto_speed.py f30-stacked --piles 6 --repeat 2 --sizes 5,15
+
+``f30-stacked`` is made by::
+
+    unstack simulate --family stacked --configs 30 --seed 9191 --viewpoint-jitter 0.3 --out f30-stacked
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from alternating import compare_by_size
+
+import unstack
+from unstack.api import load_model
+from unstack.experiments.container import container_policies
+
+if __name__ == "__main__":
+    veto = container_policies(load_model(None), seed=0, makers=("belief_occlusion_veto",))["belief_occlusion_veto"]
+    calls = {"veto": veto, "load": lambda scene: unstack.decide(scene, seed=0)}
+    compare_by_size(__doc__.splitlines()[0], calls, piles=6, repeat=2)
