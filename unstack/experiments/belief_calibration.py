@@ -19,7 +19,6 @@ Examples
 
 from __future__ import annotations
 
-import dataclasses
 import os
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -48,17 +47,14 @@ def _calibrate_pile(path: Path, number: int, options: dict[str, Any]) -> tuple[i
     from unstack.geometry import bounding_boxes
     from unstack.scene import load_scene
     from unstack.sim.belief import belief_removals, choose_by_expected_moves
-    from unstack.sim.unloading import IN_VIEW, unload_container
+    from unstack.sim.unloading import in_view_scene, unload_container
 
     scene = load_scene(path)
     pairs: list[tuple[float, int]] = []
     states: list[dict[str, int]] = []
 
     def policy(current: Scene, outcomes: dict[str, Any]) -> str:
-        believed = current
-        if options["view"] == "in_view":  # every box the detector reports, the candidates tried
-            in_view = set(current.metadata.get(IN_VIEW, ())) | set(current.detected)
-            believed = dataclasses.replace(current, detected=tuple(b for b in current.box_ids if b in in_view))
+        believed = in_view_scene(current) if options["view"] == "in_view" else current
         expected = belief_removals(
             believed, current.detected, worlds=options["worlds"], seed=options["seed"], fill=options["fill"]
         )

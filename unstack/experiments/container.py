@@ -243,14 +243,10 @@ def container_policies(
         return fewest(scene, moved)
 
     def in_view_moves(scene: Scene, candidates: Sequence[str], fill: str = "occlusion") -> dict[str, float]:
-        import dataclasses
-
         from unstack.sim.belief import belief_removals
-        from unstack.sim.unloading import IN_VIEW
+        from unstack.sim.unloading import in_view_scene
 
-        in_view = set(scene.metadata.get(IN_VIEW, ())) | set(scene.detected)
-        seen = tuple(box_id for box_id in scene.box_ids if box_id in in_view)
-        outcomes = belief_removals(dataclasses.replace(scene, detected=seen), candidates, worlds=1, fill=fill)
+        outcomes = belief_removals(in_view_scene(scene), candidates, worlds=1, fill=fill)
         return {box_id: outcome.expected_moved for box_id, outcome in outcomes.items()}
 
     def belief_occlusion(scene: Scene) -> str:

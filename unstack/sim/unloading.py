@@ -38,6 +38,7 @@ __all__ = [
     "execute_policy",
     "execute_unloading",
     "fallen_boxes",
+    "in_view_scene",
     "probe_removals",
     "reachable_boxes",
     "rebuilt_removals",
@@ -358,6 +359,27 @@ def unload_container(
 
     run = _execute(scene, sense_and_pick)
     return UnloadRun(run.order, run.steps, run.resettle_drift_m, stopped[0])
+
+
+def in_view_scene(current: Scene) -> Scene:
+    """A policy's scene with every box the detector reports (:data:`IN_VIEW`) as its detected boxes.
+
+    :func:`unload_container` hands its policies the reachable candidates as ``detected`` and
+    lists every reported box under :data:`IN_VIEW`; a belief built from everything in view
+    takes this scene (in the scene's box order) and tries the original candidates.
+
+    Examples
+    --------
+    >>> from unstack.scene import Box
+    >>> boxes = [Box("low", [0.4, 0.4, 0.3], [1.0, 0.0, 0.15]), Box("top", [0.4, 0.4, 0.3], [1.0, 0.0, 0.45])]
+    >>> current = Scene(boxes, np.zeros((0, 3)), ["top"], metadata={IN_VIEW: ["low", "top"]})
+    >>> in_view_scene(current).detected
+    ('low', 'top')
+    """
+    import dataclasses
+
+    in_view = set(current.metadata.get(IN_VIEW, ())) | set(current.detected)
+    return dataclasses.replace(current, detected=tuple(box_id for box_id in current.box_ids if box_id in in_view))
 
 
 def _boxes_in_place(scene: Scene, world: Any, in_place: list[str]) -> list[Any]:
