@@ -55,3 +55,25 @@ def test_blocks_stay_inside_the_container_and_out_of_every_seen_box(seed: int) -
     for bound in bounding_boxes(seen):
         overlap = np.minimum(high, bound[3:]) - np.maximum(low, bound[:3])
         assert not np.any(np.all(overlap > CLEARANCE / 2, axis=1))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_blocks_are_runs_along_the_depth_that_never_overlap_one_another(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    boxes = [
+        Box(f"b{k}", [0.4, 0.45, 0.3], [float(rng.uniform(0.3, 1.7)), float(rng.uniform(-0.9, 0.9)), 0.15])
+        for k in range(6)
+    ]
+    boxes = [
+        box
+        for k, box in enumerate(boxes)
+        if not any(np.all(np.abs(box.position[:2] - other.position[:2]) < [0.4, 0.45]) for other in boxes[:k])
+    ]
+    cloud = surface_cloud(boxes, viewpoint=VIEWPOINT, spacing=DENSE, seed=seed)
+    blocks = occluded_space(cloud, boxes, viewpoint=VIEWPOINT, interior=INTERIOR)
+    low, high = blocks.centers - blocks.sizes / 2, blocks.centers + blocks.sizes / 2
+    overlap = np.minimum(high[:, None], high[None]) - np.maximum(low[:, None], low[None])
+    overlapping = np.all(overlap > 1e-9, axis=2)
+    np.fill_diagonal(overlapping, False)
+    assert len(blocks) > 0 and not overlapping.any()
+    assert np.all(blocks.sizes[:, 1:] <= 0.06 + 1e-9)  # one cell across, any length along the depth

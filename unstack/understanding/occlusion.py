@@ -91,15 +91,16 @@ def _visible_surface(points: np.ndarray, viewpoint: np.ndarray) -> tuple[np.ndar
 
 
 def _clipped(low: np.ndarray, high: np.ndarray, bounds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The block ``[low, high]`` cut back out of every box bound it overlaps."""
+    """The blocks ``[low, high]`` (rows) cut back out of every box bound they overlap, box by box."""
     for bound in bounds:
         overlap = np.minimum(high, bound[3:]) - np.maximum(low, bound[:3])
-        if np.all(overlap > 0):
-            axis = int(np.argmin(overlap))
-            if (low[axis] + high[axis]) / 2 < (bound[axis] + bound[3 + axis]) / 2:
-                high[axis] = bound[axis] - CLEARANCE
-            else:
-                low[axis] = bound[3 + axis] + CLEARANCE
+        hit = np.flatnonzero(np.all(overlap > 0, axis=1))
+        if len(hit) == 0:
+            continue
+        axis = np.argmin(overlap[hit], axis=1)
+        before = (low[hit, axis] + high[hit, axis]) / 2 < (bound[axis] + bound[3 + axis]) / 2
+        high[hit[before], axis[before]] = bound[axis[before]] - CLEARANCE
+        low[hit[~before], axis[~before]] = bound[3 + axis[~before]] + CLEARANCE
     return low, high
 
 
@@ -150,19 +151,21 @@ def occluded_space(
     slot = np.minimum(np.searchsorted(keys, cell_keys), len(keys) - 1)
     behind = (keys[slot] == cell_keys) & (cell_ranges > surface[slot] + 0.75 * cell)
     occluded = (near & ~inside & behind).reshape(tuple(len(axis) for axis in axes))
-    sizes, centers = [], []
-    for j, k in zip(*np.nonzero(occluded.any(axis=0)), strict=True):
-        column = np.r_[False, occluded[:, j, k], False]
-        starts = np.flatnonzero(column[1:] & ~column[:-1])
-        stops = np.flatnonzero(~column[1:] & column[:-1])
-        for start, stop in zip(starts, stops, strict=True):
-            block_low = np.array([axes[0][start] - cell / 2, axes[1][j] - cell / 2, axes[2][k] - cell / 2])
-            block_high = np.array([axes[0][stop - 1] + cell / 2, axes[1][j] + cell / 2, axes[2][k] + cell / 2])
-            block_low, block_high = _clipped(block_low, block_high, bounds)
-            block_low, block_high = _clipped(block_low, block_high, bounds)  # a cut may meet a second box
-            if np.all(block_high - block_low > THINNEST):
-                sizes.append(block_high - block_low)
-                centers.append((block_high + block_low) / 2)
-    if not sizes:
+    grid = np.array([len(axis) for axis in axes])
+    padded = np.zeros((grid[0] + 2, grid[1], grid[2]), dtype=bool)
+    padded[1:-1] = occluded
+    starts = np.argwhere(padded[1:-1] & ~padded[:-2])  # (depth index, j, k) of each run's first cell
+    stops = np.argwhere(~padded[2:] & padded[1:-1])  # ... and of its last; both in (j, k, depth) order below
+    starts = starts[np.lexsort((starts[:, 0], starts[:, 2], starts[:, 1]))]
+    stops = stops[np.lexsort((stops[:, 0], stops[:, 2], stops[:, 1]))]
+    if len(starts) == 0:
         return empty
-    return OccludedBlocks(np.array(sizes), np.array(centers))
+    half = cell / 2
+    block_low = np.column_stack([axes[0][starts[:, 0]], axes[1][starts[:, 1]], axes[2][starts[:, 2]]]) - half
+    block_high = np.column_stack([axes[0][stops[:, 0]], axes[1][stops[:, 1]], axes[2][stops[:, 2]]]) + half
+    block_low, block_high = _clipped(block_low, block_high, bounds)
+    block_low, block_high = _clipped(block_low, block_high, bounds)  # a cut may meet a second box
+    kept = np.all(block_high - block_low > THINNEST, axis=1)
+    if not kept.any():
+        return empty
+    return OccludedBlocks((block_high - block_low)[kept], ((block_high + block_low) / 2)[kept])
