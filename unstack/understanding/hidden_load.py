@@ -157,22 +157,18 @@ def _load_on(column: np.ndarray, top: float, low_y: float, high_y: float, typica
 def _explained(points: np.ndarray, boxes: Sequence[Box], bounds: np.ndarray) -> np.ndarray:
     """Points inside a detected box grown by :data:`EXPLAINED_MARGIN` (boolean mask).
 
-    Each box tests only the points of its bounding slab along x (points sorted once), so a
+    Each box tests only the points over its footprint's bounding rectangle
+    (:class:`~unstack.understanding.cloud_columns.CloudColumns`, the cloud binned once), so a
     cloud of a few hundred thousand points costs one sort, not one pass per box.
     """
-    order = np.argsort(points[:, 0], kind="stable")
-    xs = points[order, 0]
+    from unstack.understanding.cloud_columns import CloudColumns
+
+    columns = CloudColumns(points)
     explained = np.zeros(len(points), dtype=bool)
     for box, bound in zip(boxes, bounds, strict=True):
-        first = np.searchsorted(xs, bound[0] - EXPLAINED_MARGIN, side="left")
-        last = np.searchsorted(xs, bound[3] + EXPLAINED_MARGIN, side="right")
-        near = order[first:last]
-        slab = points[near]
-        near = near[
-            np.all(
-                (slab[:, 1:] >= bound[1:3] - EXPLAINED_MARGIN) & (slab[:, 1:] <= bound[4:6] + EXPLAINED_MARGIN), axis=1
-            )
-        ]
+        near = columns.indices_over(bound[:2] - EXPLAINED_MARGIN, bound[3:5] + EXPLAINED_MARGIN)
+        heights = points[near, 2]
+        near = near[(heights >= bound[2] - EXPLAINED_MARGIN) & (heights <= bound[5] + EXPLAINED_MARGIN)]
         explained[near[points_in_box(points[near], box, margin=EXPLAINED_MARGIN)]] = True
     return explained
 

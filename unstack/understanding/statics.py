@@ -57,6 +57,7 @@ import numpy as np
 
 from unstack.geometry import bounding_boxes, convex_hull_2d, rotation_matrix, tilt_deg
 from unstack.scene import Box, Scene
+from unstack.understanding.cloud_columns import CloudColumns
 
 __all__ = [
     "CONTACT_GAP",
@@ -241,17 +242,14 @@ def _near(bounds: np.ndarray, row: int, margin: float) -> np.ndarray:
     return near
 
 
-def _cloud_under(points: np.ndarray, box: Box, bound: np.ndarray, others: Sequence[Box]) -> np.ndarray:
+def _cloud_under(columns: CloudColumns, box: Box, bound: np.ndarray, others: Sequence[Box]) -> np.ndarray:
     """Points of the cloud just under the box's downward faces, away from its edges (its own
     visible faces, noisy near the edges, are not taken for something under it), and not on
-    a detected box (whose contacts count already). ``points`` are sorted by x."""
+    a detected box (whose contacts count already); in the order of the cloud sorted by x."""
     low, high = bound[:3] - CONTACT_GAP, bound[3:] + CONTACT_GAP
-    slab = points[np.searchsorted(points[:, 0], low[0]) : np.searchsorted(points[:, 0], high[0], side="right")]
-    candidates = slab[np.all((slab >= low) & (slab <= high), axis=1)]
-    for other in others:
-        if len(candidates) == 0:
-            break
-        candidates = candidates[_distances(candidates, other)[0] > CONTACT_BAND]
+    near = columns.indices_over(low[:2], high[:2])
+    near = near[np.all((columns.points[near] >= low) & (columns.points[near] <= high), axis=1)]
+    candidates: np.ndarray = columns.points[near[np.argsort(columns.points[near, 0], kind="stable")]]
     if len(candidates) == 0:
         return candidates[:, :2]
     distance, normals, _, rotation = _distances(candidates, box)
@@ -259,7 +257,12 @@ def _cloud_under(points: np.ndarray, box: Box, bound: np.ndarray, others: Sequen
     excess[np.arange(len(excess)), np.argmax(excess, axis=1)] = -np.inf
     away_from_edges = excess.max(axis=1) <= -0.01
     under = (distance >= 0.002) & (distance <= CONTACT_GAP) & (normals[:, 2] <= -UPWARD) & away_from_edges
-    return candidates[under, :2]
+    candidates = candidates[under]  # each test holds point by point: the cheapest set is checked against the others
+    for other in others:
+        if len(candidates) == 0:
+            break
+        candidates = candidates[_distances(candidates, other)[0] > CONTACT_BAND]
+    return candidates[:, :2]
 
 
 def tip_supports(scene: Scene, objects: Sequence[str] | None = None) -> list[TipSupport]:
@@ -282,7 +285,7 @@ def tip_supports(scene: Scene, objects: Sequence[str] | None = None) -> list[Tip
     index = {box_id: k for k, box_id in enumerate(scene.box_ids)}
     boxes = [scene.boxes[index[name]] for name in names]
     bounds = bounding_boxes(boxes) if boxes else np.zeros((0, 6))
-    cloud = scene.points[np.argsort(scene.points[:, 0], kind="stable")]  # sorted once, sliced per box
+    cloud = CloudColumns(scene.points)  # binned once, looked up per box
     found: list[TipSupport] = []
     for row, box in enumerate(boxes):
         tilted = tilt_deg(box) >= MIN_TILT_DEG
