@@ -132,6 +132,19 @@ def test_with_the_unseen_space_filled_the_seen_box_under_another_still_moves_it(
     assert set(outcomes["bottom"].moved) == {"middle", "top"} and outcomes["top"].moved == ()
 
 
+@pytest.mark.slow  # physics
+def test_with_the_unseen_space_sampled_what_needs_nothing_unseen_moves_in_every_world(column: list[Box]) -> None:
+    outcomes = belief_removals(_seen_from_the_door(column, [box.id for box in column]), worlds=3, fill="sampled")
+    assert outcomes["bottom"].expected_moved == 2.0 and outcomes["top"].expected_moved == 0.0
+
+
+@pytest.mark.slow  # physics
+def test_with_the_unseen_space_sampled_the_same_seed_gives_the_same_outcomes(hidden_step: list[Box]) -> None:
+    scene = _seen_from_the_door(hidden_step, ["front", "up"])
+    first, second = (belief_removals(scene, worlds=2, fill="sampled", seed=3) for _ in range(2))
+    assert first == second
+
+
 def test_an_unknown_fill_is_refused(column: list[Box]) -> None:
-    with pytest.raises(UnstackError, match="unknown belief fill 'air'; expected one of cloud, occlusion"):
+    with pytest.raises(UnstackError, match="unknown belief fill 'air'; expected one of cloud, occlusion, sampled"):
         belief_removals(_scene(column, ["bottom"]), fill="air")

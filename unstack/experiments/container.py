@@ -78,6 +78,21 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     the same, among the candidates unstack's default decision believes hold nothing up
     (expected cost below :data:`~unstack.height_veto.HYBRID_MAX_COST`, as the ``hybrid``);
     all candidates when none does.
+``belief_guard``
+    height guarded by two beliefs: ``highest``'s pick unless the occlusion-filled belief (the
+    unseen space solid: the most support the unseen can give) expects its removal to move at
+    least :data:`~unstack.sim.belief.BELIEF_VETO` boxes; then, among that pick and the
+    candidates unstack's default decision believes hold nothing up, the fewest moved by the
+    worse of the two beliefs (solid, and the cloud's columns: the least support), ties to the
+    box resting highest.
+``belief_sampled``
+    physics on the boxes in view with the space the sensor cannot see sampled
+    (``fill="sampled"`` of :func:`unstack.sim.belief.belief_removals`: each run of it solid
+    with probability :data:`~unstack.sim.belief.OCCUPANCY`, :data:`~unstack.sim.belief.BELIEF_WORLDS`
+    worlds), every candidate tried; the fewest expected moved, ties to the box resting highest.
+``belief_sampled_veto``
+    height vetoed by the same belief: ``highest``'s pick unless its removal is expected to
+    move at least :data:`~unstack.sim.belief.BELIEF_VETO` boxes; then ``belief_sampled``'s pick.
 
 Metrics per pile and per maker: boxes moved more than 2 cm, boxes fallen (dropped more than
 0.2 m or tipped more than 45 degrees), the share of picks that move nothing, and paired
@@ -118,7 +133,8 @@ CONTAINER_MAKERS = (
     "unstack", "min_cost", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random", "lookahead",
     "moves", "moves_veto", "belief", "belief_veto", "rebuilt",
     "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen", "belief_occlusion",
-    "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto",
+    "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
+    "belief_sampled", "belief_sampled_veto",
 )  # fmt: skip
 #: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
 #: run only when named.
@@ -126,7 +142,10 @@ ORACLE_MAKERS = ("rebuilt", "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_
 #: Robot policies of physics on the belief with the unseen space filled, slow and measured
 #: no better than highest first in the closed loop on most families (results page, "Filling
 #: the space the sensor cannot see"): run only when named.
-TRIED_MAKERS = ("belief_occlusion", "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto")
+TRIED_MAKERS = (
+    "belief_occlusion", "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
+    "belief_sampled", "belief_sampled_veto",
+)  # fmt: skip
 #: The makers run when none are named.
 DEFAULT_CONTAINER_MAKERS = tuple(
     maker for maker in CONTAINER_MAKERS if maker not in ORACLE_MAKERS and maker not in TRIED_MAKERS
@@ -242,11 +261,13 @@ def container_policies(
                 moved[box_id] += outcome.boxes_moved / BELIEF_WORLDS
         return fewest(scene, moved)
 
-    def in_view_moves(scene: Scene, candidates: Sequence[str], fill: str = "occlusion") -> dict[str, float]:
+    def in_view_moves(
+        scene: Scene, candidates: Sequence[str], fill: str = "occlusion", worlds: int = 1
+    ) -> dict[str, float]:
         from unstack.sim.belief import belief_removals
         from unstack.sim.unloading import in_view_scene
 
-        outcomes = belief_removals(in_view_scene(scene), candidates, worlds=1, fill=fill)
+        outcomes = belief_removals(in_view_scene(scene), candidates, worlds=worlds, fill=fill, seed=seed)
         return {box_id: outcome.expected_moved for box_id, outcome in outcomes.items()}
 
     def belief_occlusion(scene: Scene) -> str:
@@ -264,14 +285,42 @@ def container_policies(
             return top
         return belief_occlusion_free(scene)
 
-    def belief_occlusion_free(scene: Scene) -> str:
+    def believed_free(scene: Scene) -> list[str]:
         from unstack.height_veto import HYBRID_MAX_COST
 
         reasoned = decision(scene, "load")
         costs = dict(zip(reasoned.objects, (float(cost) for cost in reasoned.expected_costs), strict=True))
-        free = [box_id for box_id in scene.detected if costs[box_id] < HYBRID_MAX_COST] or list(scene.detected)
-        moves = in_view_moves(scene, free)
+        return [box_id for box_id in scene.detected if costs[box_id] < HYBRID_MAX_COST] or list(scene.detected)
+
+    def belief_occlusion_free(scene: Scene) -> str:
+        moves = in_view_moves(scene, believed_free(scene))
         return fewest(scene, {box_id: moves.get(box_id, np.inf) for box_id in scene.detected})
+
+    def belief_guard(scene: Scene) -> str:
+        from unstack.sim.belief import BELIEF_VETO
+
+        top = highest(scene)
+        solid_top = in_view_moves(scene, [top])[top]
+        if solid_top < BELIEF_VETO:
+            return top
+        others = [box_id for box_id in believed_free(scene) if box_id != top]
+        solid = {top: solid_top, **(in_view_moves(scene, others) if others else {})}
+        columns = in_view_moves(scene, [top, *others], "cloud")
+        worse = {box_id: max(solid[box_id], columns[box_id]) for box_id in solid}
+        return fewest(scene, {box_id: worse.get(box_id, np.inf) for box_id in scene.detected})
+
+    def belief_sampled(scene: Scene) -> str:
+        from unstack.sim.belief import BELIEF_WORLDS
+
+        return fewest(scene, in_view_moves(scene, scene.detected, "sampled", BELIEF_WORLDS))
+
+    def belief_sampled_veto(scene: Scene) -> str:
+        from unstack.sim.belief import BELIEF_VETO, BELIEF_WORLDS
+
+        top = highest(scene)
+        if in_view_moves(scene, [top], "sampled", BELIEF_WORLDS)[top] < BELIEF_VETO:
+            return top
+        return belief_sampled(scene)
 
     def belief_seen(scene: Scene) -> str:
         import dataclasses
@@ -333,6 +382,9 @@ def container_policies(
         "belief_occlusion_free": belief_occlusion_free,
         "belief_bracket": belief_bracket,
         "belief_occlusion_veto": belief_occlusion_veto,
+        "belief_guard": belief_guard,
+        "belief_sampled": belief_sampled,
+        "belief_sampled_veto": belief_sampled_veto,
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:
