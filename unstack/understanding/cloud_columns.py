@@ -39,20 +39,22 @@ class CloudColumns:
         self.points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         self.column = float(column)
         if len(self.points) == 0:
-            self._origin = np.zeros(2)
+            self._first = np.zeros(2, dtype=np.int64)
             self._shape = (0, 0)
             self._order = np.zeros(0, dtype=np.int64)
             self._starts = np.zeros(1, dtype=np.int64)
             return
-        self._origin = self.points[:, :2].min(axis=0)
-        cells = self._cells(self.points[:, :2])
-        self._shape = (int(cells[:, 0].max()) + 1, int(cells[:, 1].max()) + 1)
-        keys = cells[:, 0] * self._shape[1] + cells[:, 1]
+        across, along = (np.floor(self.points[:, axis] / self.column).astype(np.int64) for axis in (0, 1))
+        self._first = np.array([across.min(), along.min()])
+        self._shape = (int(across.max() - self._first[0]) + 1, int(along.max() - self._first[1]) + 1)
+        keys = (across - self._first[0]) * self._shape[1] + (along - self._first[1])
+        if self._shape[0] * self._shape[1] <= np.iinfo(np.uint16).max:
+            keys = keys.astype(np.uint16)  # numpy sorts 16-bit keys stably by radix: one pass
         self._order = np.argsort(keys, kind="stable")
         self._starts = np.searchsorted(keys[self._order], np.arange(self._shape[0] * self._shape[1] + 1))
 
     def _cells(self, xy: np.ndarray) -> np.ndarray:
-        cells: np.ndarray = np.floor((xy - self._origin) / self.column).astype(np.int64)
+        cells: np.ndarray = np.floor(xy / self.column).astype(np.int64) - self._first
         return cells
 
     def indices_over(self, low: Any, high: Any) -> np.ndarray:
