@@ -31,8 +31,9 @@ supported afterwards: boxes deeper in the container and under others are taken t
 space the sensor cannot see into, as a pile packed from the back wall does.
 
 With ``fill="sampled"`` that space is mostly air, as it is in the simulated piles (of the
-space the sensor cannot see next to the boxes in view on the first scan, 17 % lies inside a
-hidden box on four-size piles, 9 % on stacked ones): each belief world keeps each run of
+space the sensor cannot see next to the boxes in view on the first scan, 18 % lies inside a
+hidden box on four-size piles, 23 % on dropped ones, 14 % mixed, 11 % walls, 2 % stacked:
+``benchmarks/occlusion_truth.py`` on 8 development piles each): each belief world keeps each run of
 unseen cells (a block of :func:`occlusion_blocks`) with probability :data:`OCCUPANCY`, drawn
 independently, every box of the typical mass; the expected moves are the mean over the
 worlds -- a hidden box holds a visible one up in some worlds and not in others.
@@ -102,7 +103,7 @@ HOLD_ROUNDS = 3
 FILLS = ("cloud", "occlusion", "sampled")
 #: Chance that a run of space the sensor cannot see is kept solid in a world of the
 #: ``sampled`` fill: about the share of that space hidden boxes fill on the first scan of the
-#: simulated piles (17 % on four sizes, 9 % on stacked sections; ``gap`` check in the results).
+#: simulated piles (2-23 % by family; ``benchmarks/occlusion_truth.py``).
 OCCUPANCY = 0.2
 #: How :func:`belief_choice` picks: the fewest expected moves, or height vetoed by them.
 BELIEF_RULES = ("fewest", "veto")

@@ -1,0 +1,82 @@
+"""How much of the space the sensor cannot see is boxes: the occlusion fill against the true pile.
+
+For the first scan of the first ``--piles`` piles of each data set, the space the sensor cannot
+see next to the detected boxes (:func:`unstack.sim.belief.occlusion_blocks`, the blocks the
+``occlusion`` fill makes solid) is sampled on a grid of ``--step`` metres; a sample is
+occupied when it lies inside a box the detector did not report (the simulator knows them, a
+robot does not). Printed per data set: the occupied share of all samples, of the samples under
+a detected box (one stands over them), and of those over the floor only (no detected box
+under them). The ``sampled`` fill keeps each run of that space solid with probability
+:data:`unstack.sim.belief.OCCUPANCY`, chosen from these shares.
+
+Usage::
+
+    python benchmarks/occlusion_truth.py f30-four f30-stacked --piles 8
+"""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from unstack.dataset_folders import require_configurations
+from unstack.geometry import bounding_boxes, points_in_box
+from unstack.scene import load_scene
+from unstack.sim.belief import occlusion_blocks
+
+
+def block_samples(center: np.ndarray, size: np.ndarray, step: float) -> np.ndarray:
+    """Grid points inside an axis-aligned block, ``step`` apart (its centre when it is thinner)."""
+    axes = [
+        np.arange(middle - extent / 2 + step / 2, middle + extent / 2, step) if extent > step else np.array([middle])
+        for middle, extent in zip(center, size, strict=True)
+    ]
+    return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+
+
+def occupancy(data: str, piles: int, step: float) -> dict[str, float]:
+    """Occupied shares of the occluded space on the first scan of each pile."""
+    occupied_parts, under_parts = [], []
+    for path in require_configurations(data)[:piles]:
+        scene = load_scene(path)
+        hidden = [box for box in scene.boxes if box.id not in set(scene.detected)]
+        seen = bounding_boxes([scene.box(box_id) for box_id in scene.detected])
+        blocks = occlusion_blocks(scene)
+        if not blocks:
+            continue
+        samples = np.vstack([block_samples(block.center, block.size, step) for block in blocks])
+        occupied = np.zeros(len(samples), dtype=bool)
+        for box in hidden:
+            occupied |= points_in_box(samples, box)
+        over = np.all((samples[:, None, :2] > seen[None, :, :2]) & (samples[:, None, :2] < seen[None, :, 3:5]), axis=2)
+        under = (over & (seen[None, :, 2] > samples[:, None, 2])).any(axis=1)
+        occupied_parts.append(occupied)
+        under_parts.append(under)
+    occupied, under = np.concatenate(occupied_parts), np.concatenate(under_parts)
+    return {
+        "samples": float(len(occupied)),
+        "occupied": float(occupied.mean()),
+        "under_share": float(under.mean()),
+        "occupied_under": float(occupied[under].mean()) if under.any() else float("nan"),
+        "occupied_elsewhere": float(occupied[~under].mean()) if (~under).any() else float("nan"),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("data", nargs="+", help="simulated data sets (unstack simulate)")
+    parser.add_argument("--piles", type=int, default=8)
+    parser.add_argument("--step", type=float, default=0.03, help="grid step of the samples (m)")
+    arguments = parser.parse_args()
+    print("data set | samples | occupied | share under a detected box | occupied there | occupied elsewhere")
+    for data in arguments.data:
+        shares = occupancy(data, arguments.piles, arguments.step)
+        print(
+            f"{data} | {shares['samples']:.0f} | {shares['occupied']:.3f} | {shares['under_share']:.2f} | "
+            f"{shares['occupied_under']:.3f} | {shares['occupied_elsewhere']:.3f}"
+        )
+
+
+if __name__ == "__main__":
+    main()
