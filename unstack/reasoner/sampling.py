@@ -509,9 +509,9 @@ def sampled_marginals(
         exact conditional marginals (:mod:`unstack.reasoner.block_gibbs`); ``False`` runs
         the single-box moves alone.
     wide : bool, optional
-        Run the word-array kernels (any number of boxes) even for 63 boxes or fewer, where
-        they give the same numbers as the default one-word kernels, only more slowly; by
-        default they run for groups of 64 boxes and more.
+        Run the kernels on word arrays (any number of boxes) even for 63 boxes or fewer,
+        where they give the same numbers as on the default one-word sets, only more slowly;
+        by default word arrays serve groups of 64 boxes and more.
     insertion_sums : bool
         Deprecated and ignored (it warns; it goes with 0.2): recording the noisiest boxes'
         rows by summing their insertion was measured no better than the pair record in the
