@@ -672,15 +672,17 @@ def _reinsert(
         k = (k + step) % n
     walk = order[:m]
     empty = _set(work, 7)
-    candidates_supported[0] = _copied(work, _CANDIDATES, successors, x)
-    candidates_supporters[0] = _copied(work, _CANDIDATES + tries + 1, predecessors, x)
+    old_supported = _copied(work, _CANDIDATES, successors, x)
+    old_supporters = _copied(work, _CANDIDATES + tries + 1, predecessors, x)
     _, _, log_q, log_t = _insertion(
         x, walk, probabilities, log_present, log_absent, successors, predecessors, rng, chain, False,
-        candidates_supported[0], candidates_supporters[0], True, work, 4, 5, 6, empty,
+        old_supported, old_supporters, True, work, 4, 5, 6, empty,
     )  # fmt: skip
+    candidates_supported[0] = old_supported
+    candidates_supporters[0] = old_supporters
     log_ratios[0] = _log_weight(
         x, walk, probabilities, log_present, log_absent, successors, predecessors, rng, chain,
-        candidates_supported[0], candidates_supporters[0], log_q, log_t, False, work,
+        old_supported, old_supporters, log_q, log_t, False, work,
     )  # fmt: skip
     largest = log_ratios[0]
     for t in range(1, tries + 1):
