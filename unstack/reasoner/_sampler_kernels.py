@@ -309,68 +309,65 @@ def _within_row_layout(work: Any, members: Any, relation: Any, k: Any, constrain
     return _within_row_one_word if _one_word(work) else _within_row_words
 
 
-def _row_outside(work: Any, relation: np.ndarray, i: int, members: int) -> bool:
-    """Whether the set of box ``i`` has a box outside ``members``."""
+def _linked(work: Any, successors: np.ndarray, predecessors: np.ndarray, u: int, members: int) -> bool:
+    """Whether box ``u`` has a relation to a box outside ``members``."""
     raise NotImplementedError(_COMPILED_ONLY)
 
 
-def _row_outside_one_word(work: Any, relation: Any, i: Any, members: Any) -> Any:
-    return (relation[i] & ~members) != 0
+def _linked_one_word(work: Any, successors: Any, predecessors: Any, u: Any, members: Any) -> Any:
+    return ((predecessors[u] | successors[u]) & ~members) != 0
 
 
-def _row_outside_words(work: Any, relation: Any, i: Any, members: Any) -> Any:
+def _linked_words(work: Any, successors: Any, predecessors: Any, u: Any, members: Any) -> Any:
     for w in range(work.shape[1]):  # noqa: SIM110 (a plain loop in numba, no generator)
-        if relation[i, w] & ~work[members, w]:
+        if (predecessors[u, w] | successors[u, w]) & ~work[members, w]:
             return True
     return False
 
 
-@overload(_row_outside)
-def _row_outside_layout(work: Any, relation: Any, i: Any, members: Any) -> Any:
-    return _row_outside_one_word if _one_word(work) else _row_outside_words
+@overload(_linked)
+def _linked_layout(work: Any, successors: Any, predecessors: Any, u: Any, members: Any) -> Any:
+    return _linked_one_word if _one_word(work) else _linked_words
 
 
-def _rows_meet_outside(work: Any, first: np.ndarray, i: int, second: np.ndarray, j: int, members: int) -> bool:
-    """Whether the set of ``i`` in ``first`` and that of ``j`` in ``second`` share a box
-    outside ``members``."""
+def _across(work: Any, successors: np.ndarray, predecessors: np.ndarray, u: int, v: int, members: int) -> int:
+    """What the relations of ``u`` and ``v`` to the boxes outside ``members`` make of ``S_uv``:
+    1 forced (``u -> w -> v``), -1 forbidden (a supporter of ``u`` that does not support ``v``,
+    or a box ``v`` supports that ``u`` does not), 0 free."""
     raise NotImplementedError(_COMPILED_ONLY)
 
 
-def _rows_meet_outside_one_word(work: Any, first: Any, i: Any, second: Any, j: Any, members: Any) -> Any:
-    return ((first[i] & ~members) & (second[j] & ~members)) != 0
+def _across_one_word(work: Any, successors: Any, predecessors: Any, u: Any, v: Any, members: Any) -> Any:
+    in_u = predecessors[u] & ~members
+    out_u = successors[u] & ~members
+    in_v = predecessors[v] & ~members
+    out_v = successors[v] & ~members
+    if out_u & in_v:
+        return 1
+    if (in_u & ~in_v) or (out_v & ~out_u):
+        return -1
+    return 0
 
 
-def _rows_meet_outside_words(work: Any, first: Any, i: Any, second: Any, j: Any, members: Any) -> Any:
-    for w in range(work.shape[1]):  # noqa: SIM110 (a plain loop in numba, no generator)
-        if first[i, w] & second[j, w] & ~work[members, w]:
-            return True
-    return False
+def _across_words(work: Any, successors: Any, predecessors: Any, u: Any, v: Any, members: Any) -> Any:
+    through = False  # u -> w -> v for an outside w
+    excluded = False  # In(u) not in In(v), or Out(v) not in Out(u)
+    for w in range(work.shape[1]):
+        outer = ~work[members, w]
+        if successors[u, w] & predecessors[v, w] & outer:
+            through = True
+        if (predecessors[u, w] & ~predecessors[v, w] & outer) or (successors[v, w] & ~successors[u, w] & outer):
+            excluded = True
+    if through:
+        return 1
+    if excluded:
+        return -1
+    return 0
 
 
-@overload(_rows_meet_outside)
-def _rows_meet_outside_layout(work: Any, first: Any, i: Any, second: Any, j: Any, members: Any) -> Any:
-    return _rows_meet_outside_one_word if _one_word(work) else _rows_meet_outside_words
-
-
-def _row_beyond_outside(work: Any, relation: np.ndarray, i: int, j: int, members: int) -> bool:
-    """Whether the set of ``i`` has a box outside ``members`` that the set of ``j`` lacks."""
-    raise NotImplementedError(_COMPILED_ONLY)
-
-
-def _row_beyond_outside_one_word(work: Any, relation: Any, i: Any, j: Any, members: Any) -> Any:
-    return ((relation[i] & ~members) & ~(relation[j] & ~members)) != 0
-
-
-def _row_beyond_outside_words(work: Any, relation: Any, i: Any, j: Any, members: Any) -> Any:
-    for w in range(work.shape[1]):  # noqa: SIM110 (a plain loop in numba, no generator)
-        if relation[i, w] & ~relation[j, w] & ~work[members, w]:
-            return True
-    return False
-
-
-@overload(_row_beyond_outside)
-def _row_beyond_outside_layout(work: Any, relation: Any, i: Any, j: Any, members: Any) -> Any:
-    return _row_beyond_outside_one_word if _one_word(work) else _row_beyond_outside_words
+@overload(_across)
+def _across_layout(work: Any, successors: Any, predecessors: Any, u: Any, v: Any, members: Any) -> Any:
+    return _across_one_word if _one_word(work) else _across_words
 
 
 def _in_row(relation: np.ndarray, i: int, j: int) -> bool:
@@ -790,7 +787,7 @@ def _block_update(
     linked = False
     for a in range(size):
         u = members[a]
-        if _row_outside(work, predecessors, u, inside) or _row_outside(work, successors, u, inside):
+        if _linked(work, successors, predecessors, u, inside):
             linked = True
     if not linked:
         target = _uniform(rng, chain) * cumulative[count - 1]
@@ -815,11 +812,10 @@ def _block_update(
                     continue
                 v = members[b]
                 bit = np.int64(1) << (a * _STRIDE + b)
-                if _rows_meet_outside(work, successors, u, predecessors, v, inside):  # u -> w -> v, w outside
+                constraint = _across(work, successors, predecessors, u, v, inside)
+                if constraint > 0:
                     forced |= bit
-                elif _row_beyond_outside(work, predecessors, u, v, inside) or _row_beyond_outside(
-                    work, successors, v, u, inside
-                ):
+                elif constraint < 0:
                     forbidden |= bit
         top = 0.0
         scaled = not linear
