@@ -330,44 +330,67 @@ def _linked_layout(work: Any, successors: Any, predecessors: Any, u: Any, member
     return _linked_one_word if _one_word(work) else _linked_words
 
 
-def _across(work: Any, successors: np.ndarray, predecessors: np.ndarray, u: int, v: int, members: int) -> int:
-    """What the relations of ``u`` and ``v`` to the boxes outside ``members`` make of ``S_uv``:
-    1 forced (``u -> w -> v``), -1 forbidden (a supporter of ``u`` that does not support ``v``,
-    or a box ``v`` supports that ``u`` does not), 0 free."""
+def _constraints(
+    work: Any, successors: np.ndarray, predecessors: np.ndarray, members: np.ndarray, size: int, inside: int
+) -> tuple[int, int]:
+    """What the relations across make of the pairs of a block (boxes ``members[:size]``, the set
+    ``inside``): ``(forbidden, forced)`` as table masks (bit ``a * 5 + b`` for the pair ``a, b``).
+
+    ``S_uv`` is forced by ``u -> w -> v`` for an outside ``w``, and forbidden by a supporter
+    of ``u`` that does not support ``v`` or a box ``v`` supports that ``u`` does not.
+    """
     raise NotImplementedError(_COMPILED_ONLY)
 
 
-def _across_one_word(work: Any, successors: Any, predecessors: Any, u: Any, v: Any, members: Any) -> Any:
-    in_u = predecessors[u] & ~members
-    out_u = successors[u] & ~members
-    in_v = predecessors[v] & ~members
-    out_v = successors[v] & ~members
-    if out_u & in_v:
-        return 1
-    if (in_u & ~in_v) or (out_v & ~out_u):
-        return -1
-    return 0
+def _constraints_one_word(work: Any, successors: Any, predecessors: Any, members: Any, size: Any, inside: Any) -> Any:
+    forbidden = np.int64(0)
+    forced = np.int64(0)
+    for a in range(size):
+        u = members[a]
+        in_u = predecessors[u] & ~inside
+        out_u = successors[u] & ~inside
+        for b in range(size):
+            if a == b:
+                continue
+            v = members[b]
+            in_v = predecessors[v] & ~inside
+            out_v = successors[v] & ~inside
+            bit = np.int64(1) << (a * _STRIDE + b)
+            if out_u & in_v:
+                forced |= bit
+            elif (in_u & ~in_v) or (out_v & ~out_u):
+                forbidden |= bit
+    return forbidden, forced
 
 
-def _across_words(work: Any, successors: Any, predecessors: Any, u: Any, v: Any, members: Any) -> Any:
-    through = False  # u -> w -> v for an outside w
-    excluded = False  # In(u) not in In(v), or Out(v) not in Out(u)
-    for w in range(work.shape[1]):
-        outer = ~work[members, w]
-        if successors[u, w] & predecessors[v, w] & outer:
-            through = True
-        if (predecessors[u, w] & ~predecessors[v, w] & outer) or (successors[v, w] & ~successors[u, w] & outer):
-            excluded = True
-    if through:
-        return 1
-    if excluded:
-        return -1
-    return 0
+def _constraints_words(work: Any, successors: Any, predecessors: Any, members: Any, size: Any, inside: Any) -> Any:
+    forbidden = np.int64(0)
+    forced = np.int64(0)
+    for a in range(size):
+        u = members[a]
+        for b in range(size):
+            if a == b:
+                continue
+            v = members[b]
+            bit = np.int64(1) << (a * _STRIDE + b)
+            through = False  # u -> w -> v for an outside w
+            excluded = False  # In(u) not in In(v), or Out(v) not in Out(u)
+            for w in range(work.shape[1]):
+                outer = ~work[inside, w]
+                if successors[u, w] & predecessors[v, w] & outer:
+                    through = True
+                if (predecessors[u, w] & ~predecessors[v, w] & outer) or (successors[v, w] & ~successors[u, w] & outer):
+                    excluded = True
+            if through:
+                forced |= bit
+            elif excluded:
+                forbidden |= bit
+    return forbidden, forced
 
 
-@overload(_across)
-def _across_layout(work: Any, successors: Any, predecessors: Any, u: Any, v: Any, members: Any) -> Any:
-    return _across_one_word if _one_word(work) else _across_words
+@overload(_constraints)
+def _constraints_layout(work: Any, successors: Any, predecessors: Any, members: Any, size: Any, inside: Any) -> Any:
+    return _constraints_one_word if _one_word(work) else _constraints_words
 
 
 def _in_row(relation: np.ndarray, i: int, j: int) -> bool:
@@ -782,8 +805,6 @@ def _block_update(
     inside = _emptied(work, _BLOCK_ROW)
     for a in range(size):
         inside = _with(work, inside, members[a])
-    forbidden = np.int64(0)
-    forced = np.int64(0)
     linked = False
     for a in range(size):
         u = members[a]
@@ -805,18 +826,7 @@ def _block_update(
                     if a != b:
                         sums[members[a], members[b]] += clean_marginals[a * _STRIDE + b]
     else:
-        for a in range(size):
-            u = members[a]
-            for b in range(size):
-                if a == b:
-                    continue
-                v = members[b]
-                bit = np.int64(1) << (a * _STRIDE + b)
-                constraint = _across(work, successors, predecessors, u, v, inside)
-                if constraint > 0:
-                    forced |= bit
-                elif constraint < 0:
-                    forbidden |= bit
+        forbidden, forced = _constraints(work, successors, predecessors, members, size, inside)
         top = 0.0
         scaled = not linear
         known = cache_key[1] == forbidden and cache_key[2] == forced and cache_key[0] >= (2 if record else 1)
