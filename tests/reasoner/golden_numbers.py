@@ -8,8 +8,8 @@ comparison in the test suite, exactly for choices and orders and to 1e-12 for fl
 the SHA-256 of the whole arrays (another CPU may compile the fast-math kernels to other
 instructions). Whole sampled arrays are kept as row and column sums plus that digest.
 
-The inputs cover both sampler kernel families (one 64-bit word for up to 64 boxes, word arrays
-above), the exact engine, a decision and a plan from the shipped examples and a scene decision
+The inputs cover both layouts of the sampler's kernels (one 64-bit word for up to 63 boxes, word
+arrays above), the exact engine, a decision and a plan from the shipped examples and a scene decision
 with the default model.
 """
 

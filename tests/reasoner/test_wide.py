@@ -1,4 +1,4 @@
-"""The word-array sampler kernels (groups of 64 boxes and more) against the one-word ones."""
+"""The sampler kernels' word-array layout (groups of 64 boxes and more) against the one-word one."""
 
 from __future__ import annotations
 
@@ -22,10 +22,10 @@ def weak_groups(rng: np.random.Generator, groups: int, size: int, link: float) -
 
 
 @pytest.mark.parametrize("shape", [(1, 7), (3, 4), (4, 5)])
-def test_both_kernels_give_the_same_numbers(rng: np.random.Generator, shape: tuple[int, int]) -> None:
+def test_both_layouts_give_the_same_numbers(rng: np.random.Generator, shape: tuple[int, int]) -> None:
     """Same seed, same moves, same random numbers: identical estimates and final states
     without blocks; with blocks (linked ones sum precomputed weights in the word-array
-    kernels) the same to rounding."""
+    layout) the same to rounding."""
     p = weak_groups(rng, *shape, 1e-3)
     seed = int(rng.integers(2**31))
     one_word = sampled_marginals(p, samples=64, seed=seed, blocks=False)

@@ -1,10 +1,10 @@
 """The arrays the sampler's kernels take, in two structures instead of twenty arguments.
 
-Both kernel families (:mod:`unstack.reasoner._sampler_kernels` for groups of up to 63 boxes,
-:mod:`unstack.reasoner._wide_kernels` above) take the state of every chain as one
-:class:`ChainArrays` and the blocks redrawn exactly after every sweep as one
-:class:`BlockArrays` (numba passes a named tuple of arrays as one argument and reads its
-fields by name).
+The sampler's kernels (:mod:`unstack.reasoner._sampler_kernels`, one family compiled for both
+layouts of a set: one 64-bit word in groups of up to 63 boxes, an array of words above) take
+the state of every chain as one :class:`ChainArrays` and the blocks redrawn exactly after
+every sweep as one :class:`BlockArrays` (numba passes a named tuple of arrays as one argument
+and reads its fields by name).
 """
 
 from __future__ import annotations

@@ -362,9 +362,9 @@ class _Chains:
     """The state of ``chains`` chains on one probability matrix, started and burnt in.
 
     Each chain starts from the closure of the hard evidence, takes one sweep of every first
-    proposal (scattered starts), then ``burn_in`` ordinary sweeps. Groups of up to 63 boxes
-    run the one-word kernels (:mod:`unstack.reasoner._sampler_kernels`), larger ones the
-    word-array kernels (:mod:`unstack.reasoner._wide_kernels`); ``wide=True`` forces the latter.
+    proposal (scattered starts), then ``burn_in`` ordinary sweeps. The kernels
+    (:mod:`unstack.reasoner._sampler_kernels`) keep a set of boxes as one 64-bit word in groups
+    of up to 63 boxes and as an array of words in larger ones; ``wide=True`` forces the latter.
     """
 
     def __init__(
@@ -379,19 +379,12 @@ class _Chains:
         start: np.ndarray | None = None,
         wide: bool | None = None,
     ) -> None:
+        from unstack.reasoner._sampler_kernels import run_chains
         from unstack.reasoner.block_gibbs import block_tables, strong_blocks
 
         n = probabilities.shape[0]
         self.wide = mask_words(n) > 0 if wide is None else wide
-        self._run: Callable[..., None]
-        if self.wide:
-            from unstack.reasoner._wide_kernels import run_chains as run_wide
-
-            self._run = run_wide
-        else:
-            from unstack.reasoner._sampler_kernels import run_chains
-
-            self._run = run_chains
+        self._run: Callable[..., None] = run_chains
         self.probabilities = probabilities
         self.log_tables = _log_tables(probabilities)
         successors, predecessors = _start_state(probabilities, wide=self.wide)
@@ -516,9 +509,9 @@ def sampled_marginals(
         exact conditional marginals (:mod:`unstack.reasoner.block_gibbs`); ``False`` runs
         the single-box moves alone.
     wide : bool, optional
-        Run the word-array kernels (any number of boxes) even for 63 boxes or fewer, where
-        they give the same numbers as the default one-word kernels, only more slowly; by
-        default they run for groups of 64 boxes and more.
+        Run the kernels on word arrays (any number of boxes) even for 63 boxes or fewer,
+        where they give the same numbers as on the default one-word sets, only more slowly;
+        by default word arrays serve groups of 64 boxes and more.
     insertion_sums : bool
         Deprecated and ignored (it warns; it goes with 0.2): recording the noisiest boxes'
         rows by summing their insertion was measured no better than the pair record in the
