@@ -85,6 +85,7 @@ def test_a_constraint_on_a_parameter_the_function_lacks_is_a_programming_error()
         (container_experiment, {"piles": 0}, "piles must be at least 1, got 0"),
         (container_experiment, {"detector_misses": 1.0}, "detector_misses must be at most 0.9, got 1"),
         (container_experiment, {"reach": "window"}, "unknown reach 'window'; expected one of door, any"),
+        (container_experiment, {"occupancy": 1.5}, "occupancy must be at most 1, got 1.5"),
         (belief_calibration, {"worlds": 0}, "worlds must be at least 1, got 0"),
         (evaluate_decisions, {"r": 1}, "r must be at least 2, got 1"),
         (fig5a, {"cv": 1}, "cv must be at least 2, got 1"),

@@ -197,3 +197,5 @@ FOLDS = Interval(int, 2)
 MISSED_SHARE = Interval(float, 0.0, 0.9)
 #: Position error of a simulated box detector (metres).
 DETECTOR_NOISE = Interval(float, 0.0, 0.1)
+#: A share between none and all (a probability), or None for a default.
+OPTIONAL_SHARE = Interval(float, 0.0, 1.0, optional=True)

@@ -145,6 +145,11 @@ def test_with_the_unseen_space_sampled_the_same_seed_gives_the_same_outcomes(hid
     assert first == second
 
 
+def test_an_occupancy_outside_zero_to_one_is_refused(column: list[Box]) -> None:
+    with pytest.raises(UnstackError, match="occupancy must lie between 0 and 1, got 1.5"):
+        belief_removals(_scene(column, ["bottom"]), fill="sampled", occupancy=1.5)
+
+
 def test_an_unknown_fill_is_refused(column: list[Box]) -> None:
     with pytest.raises(UnstackError, match="unknown belief fill 'air'; expected one of cloud, occlusion, sampled"):
         belief_removals(_scene(column, ["bottom"]), fill="air")

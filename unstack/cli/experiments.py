@@ -397,6 +397,9 @@ def unload(
               help="Address of a dask.distributed scheduler (tcp://HOST:PORT): piles run on its workers.")  # fmt: skip
 @click.option("--disturbance", "disturbance_path", type=click.Path(dir_okay=False, exists=True), default=None,
               help="Disturbance model file of the moves maker (default: the shipped one).")  # fmt: skip
+@click.option("--occupancy", type=CONTAINER("occupancy"), default=None,
+              help="Share of the unseen space the sampled belief keeps solid (default: "
+              "unstack.sim.belief.OCCUPANCY).")  # fmt: skip
 def container(
     data_dir: str,
     out: str,
@@ -412,6 +415,7 @@ def container(
     jobs: int,
     scheduler: str | None,
     disturbance_path: str | None,
+    occupancy: float | None,
 ) -> None:
     """Empty whole containers as a robot does: scan and detect again before every pick.
 
@@ -437,6 +441,7 @@ def container(
                 detector_misses=detector_misses, reach=reach,
                 max_picks=max_picks, samples=samples, seed=seed, progress=report,
                 checkpoints=folder / "container-piles", n_jobs=jobs, client=client, disturbance=disturbance_path,
+                occupancy=occupancy,
             )  # fmt: skip
     result["model"] = name
     written = save_results(folder, "container.json", result)

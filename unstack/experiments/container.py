@@ -115,7 +115,16 @@ from typing import Any
 import numpy as np
 
 from unstack.experiments.dispatch import run_unordered
-from unstack.parameters import COUNT, DETECTOR_NOISE, MISSED_SHARE, OPTIONAL_COUNT, SEED, OneOf, validate_params
+from unstack.parameters import (
+    COUNT,
+    DETECTOR_NOISE,
+    MISSED_SHARE,
+    OPTIONAL_COUNT,
+    OPTIONAL_SHARE,
+    SEED,
+    OneOf,
+    validate_params,
+)
 from unstack.scene import Scene
 from unstack.sim.unloading import REACH_RULES
 
@@ -152,6 +161,7 @@ DEFAULT_CONTAINER_MAKERS = tuple(
 )
 #: Makers whose policy is told what every candidate's removal does in the engine (the true pile).
 PROBING_MAKERS = ("lookahead",)
+
 #: Recorded sweeps per sampled group in each decision: 512 when a sweep re-inserted every box,
 #: 3 times that since it re-inserts :data:`~unstack.reasoner.sampling.MOVES` (as the default
 #: budget, :func:`~unstack.reasoner.sampling.default_samples`). On the first 10 wall piles with
@@ -176,10 +186,15 @@ def container_policies(
     samples: int = CONTAINER_SAMPLES,
     makers: Sequence[str] = CONTAINER_MAKERS,
     disturbance: Any = None,
+    occupancy: float | None = None,
 ) -> dict[str, Callable[..., str]]:
     """The decision makers: each maps the freshly sensed scene to one of its ``detected`` boxes
-    (those of :data:`PROBING_MAKERS` take the probe's outcomes as well)."""
+    (those of :data:`PROBING_MAKERS` take the probe's outcomes as well); ``occupancy``: the
+    ``sampled`` fill's (default :data:`~unstack.sim.belief.OCCUPANCY`)."""
     from unstack.experiments.decisions import free_pick
+    from unstack.sim.belief import OCCUPANCY
+
+    kept_share = OCCUPANCY if occupancy is None else occupancy
 
     rng = np.random.default_rng(seed)
 
@@ -267,7 +282,9 @@ def container_policies(
         from unstack.sim.belief import belief_removals
         from unstack.sim.unloading import in_view_scene
 
-        outcomes = belief_removals(in_view_scene(scene), candidates, worlds=worlds, fill=fill, seed=seed)
+        outcomes = belief_removals(
+            in_view_scene(scene), candidates, worlds=worlds, fill=fill, seed=seed, occupancy=kept_share
+        )
         return {box_id: outcome.expected_moved for box_id, outcome in outcomes.items()}
 
     def belief_occlusion(scene: Scene) -> str:
@@ -404,8 +421,9 @@ def _run_pile(
     scene = load_scene(path)
     runs = {}
     policies = container_policies(
-        model, seed=options["seed"], samples=options["samples"], makers=makers, disturbance=options["disturbance"]
-    )
+        model, seed=options["seed"], samples=options["samples"], makers=makers, disturbance=options["disturbance"],
+        occupancy=options["occupancy"],
+    )  # fmt: skip
     for maker, policy in policies.items():
         run = unload_container(
             scene, policy, detector_noise=options["detector_noise"], detector_misses=options["detector_misses"],
@@ -428,7 +446,7 @@ def _pile_metrics(run: dict[str, Any]) -> dict[str, float]:
 
 @validate_params({
     "piles": COUNT, "detector_noise": DETECTOR_NOISE, "detector_misses": MISSED_SHARE, "reach": OneOf(REACH_RULES),
-    "max_picks": OPTIONAL_COUNT, "samples": COUNT, "seed": SEED, "n_jobs": COUNT,
+    "max_picks": OPTIONAL_COUNT, "samples": COUNT, "seed": SEED, "n_jobs": COUNT, "occupancy": OPTIONAL_SHARE,
 })  # fmt: skip
 def container_experiment(
     data_dir: str | os.PathLike[str],
@@ -447,6 +465,7 @@ def container_experiment(
     n_jobs: int = 1,
     client: Any = None,
     disturbance: Any = None,
+    occupancy: float | None = None,
 ) -> dict[str, Any]:
     """Empty the first ``piles`` piles of a data set with every decision maker; compare them.
 
@@ -457,6 +476,8 @@ def container_experiment(
     settings reuses them. ``n_jobs``: piles run in parallel processes; ``client``: on the
     workers of a ``distributed.Client`` instead (the results depend on neither).
     ``disturbance``: the disturbance model of the ``moves`` maker (default: the shipped one).
+    ``occupancy``: the ``sampled`` fill's share of unseen space kept solid (default
+    :data:`~unstack.sim.belief.OCCUPANCY`).
     """
     import hashlib
     import json
@@ -479,12 +500,13 @@ def container_experiment(
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
     settings = {"detector_noise": detector_noise, "detector_misses": detector_misses, "reach": reach,
-                "max_picks": max_picks, "samples": samples}  # fmt: skip
+                "max_picks": max_picks, "samples": samples, "occupancy": occupancy}  # fmt: skip
 
     def key(number: int, path: Path) -> dict[str, Any]:
         digest = hashlib.sha256(path.read_bytes()).hexdigest()
-        # detector_misses joins the key only when set: runs made before it keep their checkpoints
-        kept = {name: value for name, value in settings.items() if name != "detector_misses" or value}
+        # detector_misses and occupancy join the key only when set: earlier runs keep their checkpoints
+        unset = {"detector_misses": 0.0, "occupancy": None}
+        kept = {name: value for name, value in settings.items() if name not in unset or value != unset[name]}
         if {"moves", "moves_veto"} & set(makers):  # the disturbance model joins the key only where it is used
             kept["disturbance_sha256"] = disturbance_digest
         return {"scene_sha256": digest, "model_sha256": model_digest, "makers": list(makers),

@@ -473,6 +473,7 @@ def belief_removals(
     seed: int = 0,
     settings: Any = None,
     fill: str = "cloud",
+    occupancy: float = OCCUPANCY,
 ) -> dict[str, BeliefOutcome]:
     """What removing each candidate moves in the belief worlds built from ``scene``.
 
@@ -495,6 +496,9 @@ def belief_removals(
     fill : {"cloud", "occlusion", "sampled"}
         What stands where no detected box is (:data:`FILLS`, the module docstring); with
         ``"sampled"`` the worlds differ in the unseen space kept, not in masses or poses.
+    occupancy : float
+        With ``fill="sampled"``: the chance that a run of unseen space is kept solid
+        (:data:`OCCUPANCY`).
 
     Returns
     -------
@@ -510,12 +514,14 @@ def belief_removals(
         raise UnstackError(f"worlds must be at least 1, got {worlds}")
     if fill not in FILLS:
         raise UnstackError(f"unknown belief fill {fill!r}; expected one of {', '.join(FILLS)}")
+    if not 0.0 <= occupancy <= 1.0:
+        raise UnstackError(f"occupancy must lie between 0 and 1, got {occupancy}")
     simulation = _settings(scene, settings)
     rng = np.random.default_rng(seed)
     if fill == "sampled":
         space = occlusion_blocks(scene, simulation)
         runs = [
-            _try_removals(scene, [block for block in space if rng.random() < OCCUPANCY], tried, simulation, None, 0)
+            _try_removals(scene, [block for block in space if rng.random() < occupancy], tried, simulation, None, 0)
             for _ in range(worlds)
         ]
     else:
