@@ -146,7 +146,7 @@ def test_with_the_unseen_space_sampled_the_same_seed_gives_the_same_outcomes(hid
 
 
 def test_an_occupancy_outside_zero_to_one_is_refused(column: list[Box]) -> None:
-    with pytest.raises(UnstackError, match="occupancy must lie between 0 and 1, got 1.5"):
+    with pytest.raises(UnstackError, match=r"occupancy must lie between 0 and 1, got 1\.5"):
         belief_removals(_scene(column, ["bottom"]), fill="sampled", occupancy=1.5)
 
 
