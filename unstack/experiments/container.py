@@ -161,7 +161,6 @@ DEFAULT_CONTAINER_MAKERS = tuple(
 )
 #: Makers whose policy is told what every candidate's removal does in the engine (the true pile).
 PROBING_MAKERS = ("lookahead",)
-
 #: Recorded sweeps per sampled group in each decision: 512 when a sweep re-inserted every box,
 #: 3 times that since it re-inserts :data:`~unstack.reasoner.sampling.MOVES` (as the default
 #: budget, :func:`~unstack.reasoner.sampling.default_samples`). On the first 10 wall piles with
@@ -335,9 +334,13 @@ def container_policies(
         from unstack.sim.belief import BELIEF_VETO, BELIEF_WORLDS
 
         top = highest(scene)
-        if in_view_moves(scene, [top], "sampled", BELIEF_WORLDS)[top] < BELIEF_VETO:
+        top_moves = in_view_moves(scene, [top], "sampled", BELIEF_WORLDS)
+        if top_moves[top] < BELIEF_VETO:
             return top
-        return belief_sampled(scene)
+        others = [box_id for box_id in scene.detected if box_id != top]  # each candidate's worlds are its own
+        return fewest(
+            scene, {**top_moves, **(in_view_moves(scene, others, "sampled", BELIEF_WORLDS) if others else {})}
+        )
 
     def belief_seen(scene: Scene) -> str:
         import dataclasses
