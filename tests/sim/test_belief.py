@@ -7,7 +7,17 @@ import pytest
 
 from unstack.errors import UnstackError
 from unstack.scene import Box, Scene
-from unstack.sim.belief import BeliefBlock, belief_blocks, belief_choice, belief_removals, choose_by_expected_moves
+from unstack.sim.belief import (
+    OCCUPANCY_CAP,
+    OCCUPANCY_PER_CUBIC_METRE,
+    BeliefBlock,
+    belief_blocks,
+    belief_choice,
+    belief_removals,
+    choose_by_expected_moves,
+    occlusion_blocks,
+    scaled_occupancy,
+)
 from unstack.understanding.clouds import surface_cloud
 
 VIEWPOINT = [-2.0, 0.0, 1.5]
@@ -145,11 +155,29 @@ def test_with_the_unseen_space_sampled_the_same_seed_gives_the_same_outcomes(hid
     assert first == second
 
 
+@pytest.mark.parametrize("cubic_metres", [0.0, 0.05, 0.4, 1.0, 2.0, 5.0])
+def test_the_scaled_occupancy_grows_with_the_unseen_volume_up_to_its_cap(cubic_metres: float) -> None:
+    blocks = [BeliefBlock(np.array([0.5, 0.5, cubic_metres / 0.25]), np.zeros(3), None)] if cubic_metres else []
+    expected = min(OCCUPANCY_CAP, OCCUPANCY_PER_CUBIC_METRE * cubic_metres)
+    assert scaled_occupancy(blocks) == pytest.approx(expected)
+
+
+@pytest.mark.slow  # physics
+def test_the_scaled_fill_is_the_sampled_fill_at_the_chance_the_unseen_volume_gives(hidden_step: list[Box]) -> None:
+    scene = _seen_from_the_door(hidden_step, ["front", "up"])
+    chance = scaled_occupancy(occlusion_blocks(scene))
+    assert 0.0 < chance < OCCUPANCY_CAP
+    scaled = belief_removals(scene, worlds=3, fill="scaled", seed=5)
+    assert scaled == belief_removals(scene, worlds=3, fill="sampled", occupancy=chance, seed=5)
+
+
 def test_an_occupancy_outside_zero_to_one_is_refused(column: list[Box]) -> None:
     with pytest.raises(UnstackError, match=r"occupancy must lie between 0 and 1, got 1\.5"):
         belief_removals(_scene(column, ["bottom"]), fill="sampled", occupancy=1.5)
 
 
 def test_an_unknown_fill_is_refused(column: list[Box]) -> None:
-    with pytest.raises(UnstackError, match="unknown belief fill 'air'; expected one of cloud, occlusion, sampled"):
+    with pytest.raises(
+        UnstackError, match="unknown belief fill 'air'; expected one of cloud, occlusion, sampled, scaled"
+    ):
         belief_removals(_scene(column, ["bottom"]), fill="air")

@@ -93,6 +93,10 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
 ``belief_sampled_veto``
     height vetoed by the same belief: ``highest``'s pick unless its removal is expected to
     move at least :data:`~unstack.sim.belief.BELIEF_VETO` boxes; then ``belief_sampled``'s pick.
+``belief_scaled_veto``
+    the same with the chance of each run of unseen space scaled by that space's volume in the
+    scene (``fill="scaled"``, :func:`unstack.sim.belief.scaled_occupancy`): a deep pile hides
+    boxes, a sliver behind a stack is air.
 
 Metrics per pile and per maker: boxes moved more than 2 cm, boxes fallen (dropped more than
 0.2 m or tipped more than 45 degrees), the share of picks that move nothing, and paired
@@ -143,7 +147,7 @@ CONTAINER_MAKERS = (
     "moves", "moves_veto", "belief", "belief_veto", "rebuilt",
     "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen", "belief_occlusion",
     "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
-    "belief_sampled", "belief_sampled_veto",
+    "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
 )  # fmt: skip
 #: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
 #: run only when named.
@@ -153,7 +157,7 @@ ORACLE_MAKERS = ("rebuilt", "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_
 #: the space the sensor cannot see"): run only when named.
 TRIED_MAKERS = (
     "belief_occlusion", "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
-    "belief_sampled", "belief_sampled_veto",
+    "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
 )  # fmt: skip
 #: The makers run when none are named.
 DEFAULT_CONTAINER_MAKERS = tuple(
@@ -330,17 +334,18 @@ def container_policies(
 
         return fewest(scene, in_view_moves(scene, scene.detected, "sampled", BELIEF_WORLDS))
 
-    def belief_sampled_veto(scene: Scene) -> str:
-        from unstack.sim.belief import BELIEF_VETO, BELIEF_WORLDS
+    def sampled_veto(fill: str) -> Callable[[Scene], str]:
+        def policy(scene: Scene) -> str:
+            from unstack.sim.belief import BELIEF_VETO, BELIEF_WORLDS
 
-        top = highest(scene)
-        top_moves = in_view_moves(scene, [top], "sampled", BELIEF_WORLDS)
-        if top_moves[top] < BELIEF_VETO:
-            return top
-        others = [box_id for box_id in scene.detected if box_id != top]  # each candidate's worlds are its own
-        return fewest(
-            scene, {**top_moves, **(in_view_moves(scene, others, "sampled", BELIEF_WORLDS) if others else {})}
-        )
+            top = highest(scene)
+            top_moves = in_view_moves(scene, [top], fill, BELIEF_WORLDS)
+            if top_moves[top] < BELIEF_VETO:
+                return top
+            others = [box_id for box_id in scene.detected if box_id != top]  # each candidate's worlds are its own
+            return fewest(scene, {**top_moves, **(in_view_moves(scene, others, fill, BELIEF_WORLDS) if others else {})})
+
+        return policy
 
     def belief_seen(scene: Scene) -> str:
         import dataclasses
@@ -404,7 +409,8 @@ def container_policies(
         "belief_occlusion_veto": belief_occlusion_veto,
         "belief_guard": belief_guard,
         "belief_sampled": belief_sampled,
-        "belief_sampled_veto": belief_sampled_veto,
+        "belief_sampled_veto": sampled_veto("sampled"),
+        "belief_scaled_veto": sampled_veto("scaled"),
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:
