@@ -93,6 +93,7 @@ HERE = Path(__file__).resolve().parent
 if str(HERE) not in sys.path:
     sys.path.insert(0, str(HERE))
 
+from bench_table import seconds_text  # noqa: E402
 from instances import ALL_FAMILIES, box_ids, instance  # noqa: E402
 
 from unstack.atomic import atomic_write_text  # noqa: E402
@@ -530,16 +531,6 @@ def compare(outcomes: list[Outcome]) -> None:
             outcome.ratio = outcome.seconds / exact.seconds
         if outcome.end_to_end_seconds and exact.end_to_end_seconds:
             outcome.wall_ratio = outcome.end_to_end_seconds / exact.end_to_end_seconds
-
-
-def seconds_text(value: float | None) -> str:
-    if value is None:
-        return ""
-    if value < 0.01:
-        return f"{value * 1000:.2f} ms"
-    if value < 1:
-        return f"{value * 1000:.0f} ms"
-    return f"{value:.2f} s"
 
 
 def ratio_text(value: float | None) -> str:

@@ -62,6 +62,19 @@ def random_probabilities(n: int, rng: np.random.Generator, *, hard: float = 0.0)
     return probabilities
 
 
+def weak_groups(rng: np.random.Generator, sizes: list[int], link: float) -> np.ndarray:
+    """Dense groups of the given sizes (``U(0.05, 0.95)`` inside), every pair across ``link``."""
+    n = sum(sizes)
+    probabilities = np.full((n, n), link)
+    start = 0
+    for size in sizes:
+        block = slice(start, start + size)
+        probabilities[block, block] = rng.uniform(0.05, 0.95, (size, size))
+        start += size
+    np.fill_diagonal(probabilities, 0.0)
+    return probabilities
+
+
 def supports_of(probabilities: np.ndarray) -> Supports:
     return Supports([f"b{i}" for i in range(len(probabilities))], probabilities)
 

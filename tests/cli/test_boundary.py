@@ -25,6 +25,19 @@ def one_line_error(result: subprocess.CompletedProcess[str], *fragments: str) ->
         assert fragment in result.stderr, result.stderr
 
 
+@pytest.fixture
+def contradiction(tmp_path: Path) -> Path:
+    """A supports file in which a surely supports b and b surely c, but a surely not c: no consistent world."""
+    path = tmp_path / "contradiction.json"
+    cycle = {
+        "format": "unstack.supports/1",
+        "objects": ["a", "b", "c"],
+        "probabilities": [[0, 1, 0], [0, 0, 1], [0, 0, 0]],
+    }
+    path.write_text(json.dumps(cycle))
+    return path
+
+
 def test_closed_standard_input() -> None:
     result = subprocess.run(
         f"{sys.executable} -m unstack decide - <&-", shell=True, capture_output=True, text=True, cwd=REPO, timeout=120
@@ -107,17 +120,7 @@ def test_an_output_in_a_missing_folder_fails_before_any_work(tmp_path: Path) -> 
     assert not target.parent.exists()
 
 
-def test_validate_checks_every_file_and_summarises(tmp_path: Path) -> None:
-    contradiction = tmp_path / "contradiction.json"
-    contradiction.write_text(
-        json.dumps(
-            {
-                "format": "unstack.supports/1",
-                "objects": ["a", "b", "c"],
-                "probabilities": [[0, 1, 0], [0, 0, 1], [0, 0, 0]],
-            }
-        )
-    )
+def test_validate_checks_every_file_and_summarises(tmp_path: Path, contradiction: Path) -> None:
     missing = tmp_path / "missing.json"
     result = unstack("validate", str(missing), PILE5, str(contradiction), "examples/scene3.json")
     assert result.returncode == 2
@@ -131,17 +134,7 @@ def test_validate_checks_every_file_and_summarises(tmp_path: Path) -> None:
     assert good.returncode == 0 and good.stdout.splitlines()[-1] == "1 file: 1 valid, 0 invalid"
 
 
-def test_a_contradiction_in_decide_names_the_file(tmp_path: Path) -> None:
-    contradiction = tmp_path / "contradiction.json"
-    contradiction.write_text(
-        json.dumps(
-            {
-                "format": "unstack.supports/1",
-                "objects": ["a", "b", "c"],
-                "probabilities": [[0, 1, 0], [0, 0, 1], [0, 0, 0]],
-            }
-        )
-    )
+def test_a_contradiction_in_decide_names_the_file(contradiction: Path) -> None:
     one_line_error(unstack("decide", str(contradiction)), f"{contradiction}: no consistent world")
 
 

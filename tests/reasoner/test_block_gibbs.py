@@ -9,24 +9,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
+from tests.conftest import weak_groups
 from unstack.reasoner.block_gibbs import BLOCK_STRIDE, block_tables, strong_blocks
 from unstack.reasoner.consistency import PREORDER_COUNTS
 from unstack.reasoner.marginals import exact_marginals
 from unstack.reasoner.sampling import sampled_marginals
 from unstack.reasoner.small import small_marginals
-
-
-def weak_groups(rng: np.random.Generator, sizes: list[int], link: float) -> np.ndarray:
-    """Dense groups (``U(0.05, 0.95)`` inside), every pair across ``link``."""
-    n = sum(sizes)
-    p = np.full((n, n), link)
-    start = 0
-    for size in sizes:
-        block = slice(start, start + size)
-        p[block, block] = rng.uniform(0.05, 0.95, (size, size))
-        start += size
-    np.fill_diagonal(p, 0.0)
-    return p
 
 
 @settings(max_examples=40, deadline=None)

@@ -5,20 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tests.conftest import weak_groups
 from unstack.reasoner.consistency import is_transitive
 from unstack.reasoner.sampling import restrict_worlds, sample_worlds, sampled_marginals
 from unstack.reasoner.world_masks import pack, unpack
-
-
-def weak_groups(rng: np.random.Generator, groups: int, size: int, link: float) -> np.ndarray:
-    """Dense groups of ``size`` boxes, every pair across ``link``."""
-    n = groups * size
-    p = np.full((n, n), link)
-    for g in range(groups):
-        block = slice(g * size, (g + 1) * size)
-        p[block, block] = rng.uniform(0.05, 0.95, (size, size))
-    np.fill_diagonal(p, 0.0)
-    return p
 
 
 @pytest.mark.parametrize("shape", [(1, 7), (3, 4), (4, 5)])
@@ -26,7 +16,7 @@ def test_both_layouts_give_the_same_numbers(rng: np.random.Generator, shape: tup
     """Same seed, same moves, same random numbers: identical estimates and final states
     without blocks; with blocks (linked ones sum precomputed weights in the word-array
     layout) the same to rounding."""
-    p = weak_groups(rng, *shape, 1e-3)
+    p = weak_groups(rng, [shape[1]] * shape[0], 1e-3)
     seed = int(rng.integers(2**31))
     one_word = sampled_marginals(p, samples=64, seed=seed, blocks=False)
     words = sampled_marginals(p, samples=64, seed=seed, blocks=False, wide=True)
@@ -62,7 +52,7 @@ def test_more_than_63_boxes_agree_with_the_groups_alone(rng: np.random.Generator
     exact ones to within the links' effect, and every relation across stays near 1e-6."""
     from unstack.reasoner.marginals import exact_marginals
 
-    p = weak_groups(rng, 14, 5, 1e-6)
+    p = weak_groups(rng, [5] * 14, 1e-6)
     result = sampled_marginals(p, samples=64, seed=int(rng.integers(2**31)))
     for g in range(14):
         block = slice(5 * g, 5 * g + 5)
@@ -79,7 +69,7 @@ def test_rare_sweeps_across_weak_links_widen_the_errors(rng: np.random.Generator
     standard errors."""
     from unstack.reasoner.marginals import exact_marginals
 
-    p = weak_groups(rng, 2, 3, 1e-4)
+    p = weak_groups(rng, [3] * 2, 1e-4)
     result = sampled_marginals(p, samples=4096, seed=int(rng.integers(2**31)))
     costs, covariance = result.errors_of(np.ones(6))
     errors = np.sqrt(np.diag(covariance))
