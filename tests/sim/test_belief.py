@@ -11,6 +11,7 @@ from unstack.sim.belief import (
     OCCUPANCY_CAP,
     OCCUPANCY_PER_CUBIC_METRE,
     BeliefBlock,
+    behind_seen_faces,
     belief_blocks,
     belief_choice,
     belief_removals,
@@ -171,6 +172,27 @@ def test_the_scaled_fill_is_the_sampled_fill_at_the_chance_the_unseen_volume_giv
     assert scaled == belief_removals(scene, worlds=3, fill="sampled", occupancy=chance, seed=5)
 
 
+def test_no_unseen_space_lies_behind_a_seen_face_when_every_box_is_detected(column: list[Box]) -> None:
+    scene = _seen_from_the_door(column, [box.id for box in column])
+    blocks = occlusion_blocks(scene)
+    assert len(blocks) > 0 and not behind_seen_faces(scene, blocks).any()
+
+
+def test_the_space_behind_a_missed_box_face_is_behind_a_seen_face(column: list[Box]) -> None:
+    scene = _seen_from_the_door(column, ["middle", "top", "beside"])
+    blocks = occlusion_blocks(scene)
+    behind = behind_seen_faces(scene, blocks)
+    inside_bottom = [bool(np.all(np.abs(block.center - [1.0, -0.3, 0.15]) < [0.2, 0.2, 0.15])) for block in blocks]
+    assert any(inside_bottom) and all(behind[k] for k, inside in enumerate(inside_bottom) if inside)
+
+
+@pytest.mark.slow  # physics
+def test_with_every_box_detected_the_faces_fill_is_the_scaled_fill(column: list[Box]) -> None:
+    scene = _seen_from_the_door(column, [box.id for box in column])
+    faces, scaled = (belief_removals(scene, worlds=2, fill=fill, seed=4) for fill in ("faces", "scaled"))
+    assert faces == scaled
+
+
 def test_an_occupancy_outside_zero_to_one_is_refused(column: list[Box]) -> None:
     with pytest.raises(UnstackError, match=r"occupancy must lie between 0 and 1, got 1\.5"):
         belief_removals(_scene(column, ["bottom"]), fill="sampled", occupancy=1.5)
@@ -178,6 +200,6 @@ def test_an_occupancy_outside_zero_to_one_is_refused(column: list[Box]) -> None:
 
 def test_an_unknown_fill_is_refused(column: list[Box]) -> None:
     with pytest.raises(
-        UnstackError, match="unknown belief fill 'air'; expected one of cloud, occlusion, sampled, scaled"
+        UnstackError, match="unknown belief fill 'air'; expected one of cloud, occlusion, sampled, scaled, faces"
     ):
         belief_removals(_scene(column, ["bottom"]), fill="air")

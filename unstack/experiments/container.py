@@ -97,6 +97,10 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     the same with the chance of each run of unseen space scaled by that space's volume in the
     scene (``fill="scaled"``, :func:`unstack.sim.belief.scaled_occupancy`): a deep pile hides
     boxes, a sliver behind a stack is air.
+``belief_faces_veto``
+    the same, and behind every surface the cloud shows that no detected box explains (a box
+    nobody detected) a carton's depth of the unseen space solid in every world
+    (``fill="faces"``, :func:`unstack.sim.belief.behind_seen_faces`).
 
 Metrics per pile and per maker: boxes moved more than 2 cm, boxes fallen (dropped more than
 0.2 m or tipped more than 45 degrees), the share of picks that move nothing, and paired
@@ -148,6 +152,7 @@ CONTAINER_MAKERS = (
     "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen", "belief_occlusion",
     "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
+    "belief_faces_veto",
 )  # fmt: skip
 #: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
 #: run only when named.
@@ -158,6 +163,7 @@ ORACLE_MAKERS = ("rebuilt", "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_
 TRIED_MAKERS = (
     "belief_occlusion", "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
+    "belief_faces_veto",
 )  # fmt: skip
 #: The makers run when none are named.
 DEFAULT_CONTAINER_MAKERS = tuple(
@@ -411,6 +417,7 @@ def container_policies(
         "belief_sampled": belief_sampled,
         "belief_sampled_veto": sampled_veto("sampled"),
         "belief_scaled_veto": sampled_veto("scaled"),
+        "belief_faces_veto": sampled_veto("faces"),
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:
