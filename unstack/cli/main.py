@@ -100,13 +100,23 @@ def _write_output(path: str | None, document: dict[str, Any]) -> None:
     atomic_write_text(path, json.dumps(document, indent=2) + "\n")
 
 
-def _emit(as_json: bool, document: dict[str, Any], render: Callable[[], Any]) -> None:
+def _deliver(
+    document: dict[str, Any], output: str | None, as_json: bool, view: str, *shown: Any, warnings: tuple[str, ...] = ()
+) -> None:
+    """Write ``--output``, print the warnings, then the JSON or the view of :mod:`unstack.cli.render` named ``view``.
+
+    The view's module (rich tables) is imported only when the view is printed.
+    """
+    _write_output(output, document)
+    _print_warnings(warnings)
     if as_json:
         click.echo(json.dumps(document, indent=2))
-    else:
-        from rich.console import Console
+        return
+    from rich.console import Console
 
-        Console(highlight=False).print(render())
+    from unstack.cli import render as views
+
+    Console(highlight=False).print(getattr(views, view)(*shown))
 
 
 def _load_input(path: str, model: str | None, statics: bool = True) -> Any:
@@ -249,16 +259,7 @@ def decide(file: str, as_json: bool, output: str | None, timing: bool, model: st
     loaded = _load_input(file, model, reasoning["statics"])
     with _first_call(loaded):
         decision = unstack.decide(loaded, model=model, **reasoning)
-    document = decision.to_dict(timing=timing)
-    _write_output(output, document)
-    _print_warnings(decision.warnings)
-
-    def view() -> Any:
-        from unstack.cli.render import decision_view
-
-        return decision_view(decision)
-
-    _emit(as_json, document, view)
+    _deliver(decision.to_dict(timing=timing), output, as_json, "decision_view", decision, warnings=decision.warnings)
 
 
 @cli.command()
@@ -277,15 +278,7 @@ def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str, 
 
     _check_output(output)
     table = payoff(_load_input(file, model), model, cost=cost)
-    document = table.to_dict()
-    _write_output(output, document)
-
-    def view() -> Any:
-        from unstack.cli.render import payoff_view
-
-        return payoff_view(table, limit)
-
-    _emit(as_json, document, view)
+    _deliver(table.to_dict(), output, as_json, "payoff_view", table, limit)
 
 
 @cli.command()
@@ -309,16 +302,7 @@ def plan(file: str, as_json: bool, output: str | None, model: str | None, **reas
     supports = _load_input(file, model, reasoning["statics"])
     with _first_call(supports), progress_bar("planning: steps") as report:
         result = unstack.plan(supports, model=model, progress=report, **reasoning)
-    document = result.to_dict()
-    _write_output(output, document)
-    _print_warnings(result.warnings)
-
-    def view() -> Any:
-        from unstack.cli.render import plan_view
-
-        return plan_view(result)
-
-    _emit(as_json, document, view)
+    _deliver(result.to_dict(), output, as_json, "plan_view", result, warnings=result.warnings)
 
 
 @cli.command()
