@@ -50,8 +50,8 @@ With ``fill="faces"`` the space is sampled as ``scaled`` does, and a surface the
 no detected box explains is taken for a box nobody detected: of each run of unseen space within
 :data:`FACE_REACH` of such a surface (above the floor), the first :data:`FACE_DEPTH` from the
 sensor's side is solid in every world (:func:`behind_seen_faces`). With a detector that misses
-half the boxes, 60-69 % of that space lies inside a hidden box on the development piles (four,
-stacked, mixed), against 10-24 % of the rest.
+half the boxes, 58-76 % of that space lies inside a hidden box on 8 development piles of each
+family, against 16-35 % of the rest (``benchmarks/occlusion_truth.py --misses 0.5``).
 
 The world settles for :data:`~unstack.sim.unloading.RESETTLE_SECONDS`; then each candidate's
 removal is tried as the look-ahead tries it (the same horizon, thresholds and parking, the
