@@ -110,10 +110,13 @@ def scene_support_probabilities(
             scene.source, model, features, [(objects[i], objects[j]) for i, j in zip(rows, columns, strict=True)]
         )
     held_up: list[dict[str, object]] = []
+    from unstack.understanding.cloud_columns import CloudColumns
+
+    binned = CloudColumns(scene.points)  # binned once for the statics and the hidden load
     if statics and n > 1:
         from unstack.understanding.statics import raise_tip_supports, tip_supports
 
-        found = tip_supports(scene, objects)
+        found = tip_supports(scene, objects, columns=binned)
         probabilities, raised = raise_tip_supports(probabilities, objects, found)
         doubts += [f"{scene.source}: {sentence}" for sentence in raised]
         held_up = [
@@ -139,6 +142,6 @@ def scene_support_probabilities(
         masses=masses if all(mass is not None for mass in masses) else None,
         metadata=metadata,
         source=scene.source,
-        hidden_load=hidden_load(scene, objects),
+        hidden_load=hidden_load(scene, objects, columns=binned),
         heights=bounding_boxes([scene.boxes[k] for k in detected])[:, 2],  # the heights the boxes rest at
     )

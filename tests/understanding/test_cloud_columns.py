@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from unstack.understanding.cloud_columns import CloudColumns
+from unstack.understanding.cloud_columns import CloudColumns, columns_of
 
 
 def _brute_force(points: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
@@ -48,3 +48,22 @@ def test_an_empty_cloud_or_an_inverted_rectangle_has_no_points() -> None:
     columns = CloudColumns(np.array([[0.5, 0.5, 0.0]]))
     assert len(columns.indices_over([1, 1], [0, 0])) == 0
     assert columns.indices_over([0.5, 0.5], [0.5, 0.5]).tolist() == [0]
+
+
+def test_shared_columns_of_the_same_cloud_are_reused_and_of_another_refused() -> None:
+    rng = np.random.default_rng(3)
+    points = rng.uniform(0.0, 2.0, (200, 3))
+    shared = CloudColumns(points)
+    assert columns_of(points, shared) is shared
+    assert columns_of(points.copy(), shared) is shared  # equal values: the same cloud
+    with pytest.raises(ValueError, match="the binned columns are of another point cloud"):
+        columns_of(points[:100], shared)
+
+
+def test_the_hidden_load_is_the_same_with_the_cloud_binned_once_or_twice() -> None:
+    from unstack.scene import load_scene
+    from unstack.understanding.hidden_load import hidden_load
+
+    scene = load_scene("examples/pile5.scene.json")
+    binned = CloudColumns(scene.points)
+    np.testing.assert_array_equal(hidden_load(scene, columns=binned), hidden_load(scene))

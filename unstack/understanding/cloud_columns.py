@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["COLUMN", "CloudColumns"]
+__all__ = ["COLUMN", "CloudColumns", "columns_of"]
 
 #: Edge of the square columns (metres): about a quarter of a carton's side.
 COLUMN = 0.1
@@ -82,3 +82,29 @@ class CloudColumns:
         xy = self.points[near, :2]
         inside = np.all((xy >= low_xy) & (xy <= high_xy), axis=1)
         return np.sort(near[inside])
+
+
+def columns_of(points: Any, columns: CloudColumns | None = None) -> CloudColumns:
+    """``columns`` when it bins ``points`` (the same array), else ``points`` binned now.
+
+    Lets the steps of one scene's pipeline share one binning of its cloud.
+
+    Raises
+    ------
+    ValueError
+        ``columns`` bins another cloud.
+
+    Examples
+    --------
+    >>> points = np.zeros((4, 3))
+    >>> shared = CloudColumns(points)
+    >>> columns_of(points, shared) is shared, columns_of(points) is shared
+    (True, False)
+    """
+    if columns is None:
+        return CloudColumns(points)
+    given = np.asarray(points)
+    same = columns.points is given or (columns.points.shape == given.shape and np.array_equal(columns.points, given))
+    if not same:
+        raise ValueError("the binned columns are of another point cloud")
+    return columns

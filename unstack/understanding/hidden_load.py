@@ -45,6 +45,7 @@ import numpy as np
 
 from unstack.geometry import bounding_boxes, box_corners, convex_hull_2d, footprint, points_in_box
 from unstack.scene import Box, Scene
+from unstack.understanding.cloud_columns import CloudColumns, columns_of
 
 __all__ = ["EXPLAINED_MARGIN", "SIDE_REACH", "STACK_GAP", "container_planes", "hidden_load", "unexplained_points"]
 
@@ -154,16 +155,13 @@ def _load_on(column: np.ndarray, top: float, low_y: float, high_y: float, typica
     return len(occupied) / bins * max(1.0, rise / typical_height)
 
 
-def _explained(points: np.ndarray, boxes: Sequence[Box], bounds: np.ndarray) -> np.ndarray:
+def _explained(points: np.ndarray, boxes: Sequence[Box], bounds: np.ndarray, columns: CloudColumns) -> np.ndarray:
     """Points inside a detected box grown by :data:`EXPLAINED_MARGIN` (boolean mask).
 
-    Each box tests only the points over its footprint's bounding rectangle
-    (:class:`~unstack.understanding.cloud_columns.CloudColumns`, the cloud binned once), so a
-    cloud of a few hundred thousand points costs one sort, not one pass per box.
+    Each box tests only the points over its footprint's bounding rectangle (``columns``, the
+    cloud binned once), so a cloud of a few hundred thousand points costs one sort, not one
+    pass per box.
     """
-    from unstack.understanding.cloud_columns import CloudColumns
-
-    columns = CloudColumns(points)
     explained = np.zeros(len(points), dtype=bool)
     for box, bound in zip(boxes, bounds, strict=True):
         near = columns.indices_over(bound[:2] - EXPLAINED_MARGIN, bound[3:5] + EXPLAINED_MARGIN)
@@ -173,11 +171,12 @@ def _explained(points: np.ndarray, boxes: Sequence[Box], bounds: np.ndarray) -> 
     return explained
 
 
-def unexplained_points(points: np.ndarray, boxes: Sequence[Box]) -> np.ndarray:
+def unexplained_points(points: np.ndarray, boxes: Sequence[Box], *, columns: CloudColumns | None = None) -> np.ndarray:
     """Which points no box of ``boxes`` explains and no container plane holds (boolean mask).
 
     A point is explained when it lies inside one of the boxes grown by
     :data:`EXPLAINED_MARGIN`; the container's walls and ceiling are :func:`container_planes`.
+    ``columns``: the same points binned already (:func:`~unstack.understanding.cloud_columns.columns_of`).
 
     Examples
     --------
@@ -190,11 +189,13 @@ def unexplained_points(points: np.ndarray, boxes: Sequence[Box]) -> np.ndarray:
         return np.zeros(0, dtype=bool)
     free = ~container_planes(points)
     if boxes:
-        free &= ~_explained(points, boxes, bounding_boxes(list(boxes)))
+        free &= ~_explained(points, boxes, bounding_boxes(list(boxes)), columns_of(points, columns))
     return free
 
 
-def hidden_load(scene: Scene, detected: Sequence[str] | None = None) -> np.ndarray:
+def hidden_load(
+    scene: Scene, detected: Sequence[str] | None = None, *, columns: CloudColumns | None = None
+) -> np.ndarray:
     """Expected number of undetected boxes resting on each detected box, in ``scene.detected`` order.
 
     Parameters
@@ -204,6 +205,8 @@ def hidden_load(scene: Scene, detected: Sequence[str] | None = None) -> np.ndarr
         are not (a robot does not know them).
     detected : sequence of str, optional
         Box ids to treat as the detected ones instead of ``scene.detected`` (an ISet).
+    columns : CloudColumns, optional
+        The scene's points binned already (one binning serves the whole pipeline).
 
     Returns
     -------
@@ -216,7 +219,7 @@ def hidden_load(scene: Scene, detected: Sequence[str] | None = None) -> np.ndarr
     if len(points) == 0 or not boxes:
         return result
     bounds = bounding_boxes(boxes)
-    free = unexplained_points(points, boxes)
+    free = unexplained_points(points, boxes, columns=columns)
     free &= points[:, 2] > bounds[:, 5].min() + FACE_TOLERANCE  # nothing lower lies on any box
     free_points = points[free]
     typical_height = float(np.median([np.ptp(box_corners(box)[:, 2]) for box in boxes]))

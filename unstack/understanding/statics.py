@@ -57,7 +57,7 @@ import numpy as np
 
 from unstack.geometry import bounding_boxes, convex_hull_2d, rotation_matrix, tilt_deg
 from unstack.scene import Box, Scene
-from unstack.understanding.cloud_columns import CloudColumns
+from unstack.understanding.cloud_columns import CloudColumns, columns_of
 
 __all__ = [
     "CONTACT_GAP",
@@ -265,7 +265,9 @@ def _cloud_under(columns: CloudColumns, box: Box, bound: np.ndarray, others: Seq
     return candidates[:, :2]
 
 
-def tip_supports(scene: Scene, objects: Sequence[str] | None = None) -> list[TipSupport]:
+def tip_supports(
+    scene: Scene, objects: Sequence[str] | None = None, *, columns: CloudColumns | None = None
+) -> list[TipSupport]:
     """The detected boxes that cannot stand without another detected box, and those boxes.
 
     Parameters
@@ -275,6 +277,8 @@ def tip_supports(scene: Scene, objects: Sequence[str] | None = None) -> list[Tip
     objects : sequence of str, optional
         The boxes to consider detected (default: the scene's ``detected``); other boxes are
         not used -- a robot would not know them.
+    columns : CloudColumns, optional
+        The scene's points binned already (one binning serves the whole pipeline).
 
     Returns
     -------
@@ -285,7 +289,7 @@ def tip_supports(scene: Scene, objects: Sequence[str] | None = None) -> list[Tip
     index = {box_id: k for k, box_id in enumerate(scene.box_ids)}
     boxes = [scene.boxes[index[name]] for name in names]
     bounds = bounding_boxes(boxes) if boxes else np.zeros((0, 6))
-    cloud = CloudColumns(scene.points)  # binned once, looked up per box
+    cloud = columns_of(scene.points, columns)  # binned once, looked up per box
     found: list[TipSupport] = []
     for row, box in enumerate(boxes):
         tilted = tilt_deg(box) >= MIN_TILT_DEG
