@@ -73,13 +73,40 @@ _COMPILE_SECONDS = {"exact engine": 35.4, "sampler": 37.5, "wide sampler": 53.6,
 
 
 #: The module each kernel group's compiled functions live in (the sampler's module compiles both
-#: its layouts: "sampler" and "wide sampler" warm up one each).
+#: its layouts: "sampler" and "wide sampler" warm up one each; :func:`_compiled_group` tells them
+#: apart by the chains' arrays).
 _MODULES = {
     "unstack.reasoner._insertion_kernels": "exact engine",
     "unstack.reasoner._sampler_kernels": "sampler",
     "unstack.learning._dbaf_kernel": "feature kernels",
     "unstack.learning._contact_kernel": "feature kernels",
 }
+
+
+def _compiled_group(function: Any, args: Any) -> str:
+    """The kernel group a compilation belongs to: by the compiled function's module, and for the
+    sampler by its chains' layout (successors of three dimensions: word-array sets, the wide sampler).
+
+    Examples
+    --------
+    >>> import numba
+    >>> from unstack.reasoner._chain_arrays import ChainArrays
+    >>> from unstack.reasoner._sampler_kernels import run_chains
+    >>> def chains(ndim):
+    ...     sets = np.zeros((2,) * ndim, dtype=np.int64)
+    ...     return numba.typeof(ChainArrays(sets, sets, *(np.zeros(2, dtype=np.int64),) * 3, np.zeros((2, 2, 2, 2))))
+    >>> _compiled_group(run_chains.py_func, [chains(2)]), _compiled_group(run_chains.py_func, [chains(3)])
+    ('sampler', 'wide sampler')
+    """
+    from unstack.reasoner._chain_arrays import ChainArrays
+
+    group = _MODULES.get(getattr(function, "__module__", ""), "kernels")
+    if group != "sampler":
+        return group
+    for argument in args or ():
+        if getattr(argument, "instance_class", None) is ChainArrays and argument.types[0].ndim == 3:
+            return "wide sampler"
+    return group
 
 
 def might_compile(boxes: int) -> bool:
@@ -122,7 +149,7 @@ def announcing_compilation(announce: Callable[[str], None]) -> Iterator[None]:
     class Listener(event.Listener):
         def on_start(self, started: Any) -> None:
             function = getattr(started.data.get("dispatcher"), "py_func", None)
-            group = _MODULES.get(getattr(function, "__module__", ""), "kernels")
+            group = _compiled_group(function, started.data.get("args"))
             with lock:
                 if told:
                     return
