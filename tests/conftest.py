@@ -62,14 +62,27 @@ def random_probabilities(n: int, rng: np.random.Generator, *, hard: float = 0.0)
     return probabilities
 
 
-def weak_groups(rng: np.random.Generator, sizes: list[int], link: float) -> np.ndarray:
-    """Dense groups of the given sizes (``U(0.05, 0.95)`` inside), every pair across ``link``."""
+def weak_groups(
+    rng: np.random.Generator,
+    sizes: list[int],
+    link: float,
+    *,
+    inside: tuple[float, float] = (0.05, 0.95),
+    strong: float = 0.0,
+) -> np.ndarray:
+    """Dense groups of the given sizes (``U(*inside)`` inside), every pair across ``link``.
+
+    With ``strong`` > 0, that share of the pairs inside a group (drawn) is ``U(0.5, 0.95)`` instead.
+    """
     n = sum(sizes)
     probabilities = np.full((n, n), link)
     start = 0
     for size in sizes:
         block = slice(start, start + size)
-        probabilities[block, block] = rng.uniform(0.05, 0.95, (size, size))
+        probabilities[block, block] = rng.uniform(*inside, (size, size))
+        if strong:
+            chosen = rng.random((size, size)) < strong
+            probabilities[block, block][chosen] = rng.uniform(0.5, 0.95, int(chosen.sum()))
         start += size
     np.fill_diagonal(probabilities, 0.0)
     return probabilities

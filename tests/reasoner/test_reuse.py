@@ -6,6 +6,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.conftest import weak_groups
 from unstack.reasoner.consistency import is_transitive
 from unstack.reasoner.decision import decide
 from unstack.reasoner.plan import unloading_plan
@@ -15,17 +16,9 @@ from unstack.supports import Supports
 
 
 def weak_pile(rng: np.random.Generator, sizes: list[int], link: float) -> Supports:
-    n = sum(sizes)
-    p = np.full((n, n), link)
-    start = 0
-    for size in sizes:
-        block = slice(start, start + size)
-        p[block, block] = rng.uniform(0.01, 0.08, (size, size))
-        strong = rng.random((size, size)) < 0.4
-        p[block, block][strong] = rng.uniform(0.5, 0.95, int(strong.sum()))
-        start += size
-    np.fill_diagonal(p, 0.0)
-    return Supports([f"b{i:02d}" for i in range(n)], p)
+    """Groups of mostly weak pairs (``U(0.01, 0.08)``), 40 % of them strong, linked by ``link``."""
+    probabilities = weak_groups(rng, sizes, link, inside=(0.01, 0.08), strong=0.4)
+    return Supports([f"b{i:02d}" for i in range(sum(sizes))], probabilities)
 
 
 @settings(max_examples=8, deadline=None)
