@@ -398,8 +398,9 @@ def unload(
 @click.option("--disturbance", "disturbance_path", type=click.Path(dir_okay=False, exists=True), default=None,
               help="Disturbance model file of the moves maker (default: the shipped one).")  # fmt: skip
 @click.option("--occupancy", type=CONTAINER("occupancy"), default=None,
-              help="Share of the unseen space the sampled belief keeps solid (default: "
-              "unstack.sim.belief.OCCUPANCY).")  # fmt: skip
+              help="Share of the unseen space the sampled belief of belief_sampled and belief_sampled_veto keeps "
+              "solid (default: unstack.sim.belief.OCCUPANCY; belief_scaled_veto and belief_faces_veto take it from "
+              "the scene).")  # fmt: skip
 def container(
     data_dir: str,
     out: str,

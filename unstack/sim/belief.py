@@ -116,8 +116,6 @@ REST_TOLERANCE = 0.08
 CLEARANCE = 0.005
 #: Fewer unexplained points than this in a column are noise.
 MIN_POINTS = 3
-#: Blocks thinner than this along the depth are left out (metres).
-THINNEST = 0.005
 #: Rounds of fixing in place the boxes a belief world lets fall (:func:`belief_removals`).
 HOLD_ROUNDS = 3
 #: What the belief puts where the robot sees no box: the cloud's unexplained points as columns
@@ -629,6 +627,8 @@ def belief_removals(
     simulation = _settings(scene, settings)
     rng = np.random.default_rng(seed)
     if fill in ("sampled", "scaled", "faces"):
+        from unstack.understanding.occlusion import THINNEST  # the rest of a block split at a face may be thinner
+
         space = occlusion_blocks(scene, simulation)
         kept_share = occupancy if fill == "sampled" else scaled_occupancy(space)
         solid, drawn = _faced(space, behind_seen_faces(scene, space)) if fill == "faces" else ([], space)
