@@ -78,6 +78,11 @@ def test_the_hybrid_takes_the_highest_box_the_model_does_not_believe_loaded() ->
     assert policies["hybrid"](scene) == "free"
 
 
+def test_the_hybrid_faces_veto_starts_from_the_hybrids_pick_not_the_highest_box() -> None:
+    policies = container_policies(load_model(default_model_path()), seed=0, makers=("hybrid_faces_veto",))
+    assert policies["hybrid_faces_veto"](_tall_loaded_and_short_free()) == "free"  # its removal moves nothing
+
+
 def test_unstack_gives_near_ties_to_the_box_resting_highest_and_min_cost_keeps_eq13() -> None:
     boxes = [
         Box("a_low", [0.4, 0.4, 0.3], [1.2, -0.35, 0.151]),

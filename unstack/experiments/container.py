@@ -152,7 +152,7 @@ CONTAINER_MAKERS = (
     "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen", "belief_occlusion",
     "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
-    "belief_faces_veto",
+    "belief_faces_veto", "hybrid_faces_veto",
 )  # fmt: skip
 #: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
 #: run only when named.
@@ -163,7 +163,7 @@ ORACLE_MAKERS = ("rebuilt", "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_
 TRIED_MAKERS = (
     "belief_occlusion", "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
-    "belief_faces_veto",
+    "belief_faces_veto", "hybrid_faces_veto",
 )  # fmt: skip
 #: The makers run when none are named.
 DEFAULT_CONTAINER_MAKERS = tuple(
@@ -340,11 +340,14 @@ def container_policies(
 
         return fewest(scene, in_view_moves(scene, scene.detected, "sampled", BELIEF_WORLDS))
 
-    def sampled_veto(fill: str) -> Callable[[Scene], str]:
+    def sampled_veto(fill: str, base: Callable[[Scene], str] = highest) -> Callable[[Scene], str]:
+        """``base``'s pick unless the ``fill`` belief expects its removal to move a box, then that
+        belief's fewest among every detected box."""
+
         def policy(scene: Scene) -> str:
             from unstack.sim.belief import BELIEF_VETO, BELIEF_WORLDS
 
-            top = highest(scene)
+            top = base(scene)
             top_moves = in_view_moves(scene, [top], fill, BELIEF_WORLDS)
             if top_moves[top] < BELIEF_VETO:
                 return top
@@ -418,6 +421,7 @@ def container_policies(
         "belief_sampled_veto": sampled_veto("sampled"),
         "belief_scaled_veto": sampled_veto("scaled"),
         "belief_faces_veto": sampled_veto("faces"),
+        "hybrid_faces_veto": sampled_veto("faces", hybrid),
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:
