@@ -152,7 +152,7 @@ CONTAINER_MAKERS = (
     "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen", "belief_occlusion",
     "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
-    "belief_faces_veto", "hybrid_faces_veto",
+    "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free",
 )  # fmt: skip
 #: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
 #: run only when named.
@@ -163,7 +163,7 @@ ORACLE_MAKERS = ("rebuilt", "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_
 TRIED_MAKERS = (
     "belief_occlusion", "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
-    "belief_faces_veto", "hybrid_faces_veto",
+    "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free",
 )  # fmt: skip
 #: The makers run when none are named.
 DEFAULT_CONTAINER_MAKERS = tuple(
@@ -356,6 +356,22 @@ def container_policies(
 
         return policy
 
+    def hybrid_faces_free(scene: Scene) -> str:
+        """The hybrid's pick unless the faces belief expects its removal to move a box, then that
+        belief's fewest among the boxes the reasoner believes hold nothing up."""
+        from unstack.height_veto import HYBRID_MAX_COST, hybrid_choice
+        from unstack.sim.belief import BELIEF_VETO, BELIEF_WORLDS
+
+        reasoned = decision(scene, "load")
+        top = hybrid_choice(scene, reasoned)
+        top_moves = in_view_moves(scene, [top], "faces", BELIEF_WORLDS)
+        if top_moves[top] < BELIEF_VETO:
+            return top
+        costs = dict(zip(reasoned.objects, (float(cost) for cost in reasoned.expected_costs), strict=True))
+        others = [box_id for box_id in scene.detected if box_id != top and costs[box_id] < HYBRID_MAX_COST]
+        moves = {**top_moves, **(in_view_moves(scene, others, "faces", BELIEF_WORLDS) if others else {})}
+        return fewest(scene, {box_id: moves.get(box_id, np.inf) for box_id in scene.detected})
+
     def belief_seen(scene: Scene) -> str:
         import dataclasses
 
@@ -422,6 +438,7 @@ def container_policies(
         "belief_scaled_veto": sampled_veto("scaled"),
         "belief_faces_veto": sampled_veto("faces"),
         "hybrid_faces_veto": sampled_veto("faces", hybrid),
+        "hybrid_faces_free": hybrid_faces_free,
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:
