@@ -78,9 +78,10 @@ def test_the_hybrid_takes_the_highest_box_the_model_does_not_believe_loaded() ->
     assert policies["hybrid"](scene) == "free"
 
 
-def test_the_hybrid_faces_veto_starts_from_the_hybrids_pick_not_the_highest_box() -> None:
-    policies = container_policies(load_model(default_model_path()), seed=0, makers=("hybrid_faces_veto",))
-    assert policies["hybrid_faces_veto"](_tall_loaded_and_short_free()) == "free"  # its removal moves nothing
+@pytest.mark.parametrize("maker", ["hybrid_faces_veto", "hybrid_faces_free"])
+def test_the_hybrid_vetoes_start_from_the_hybrids_pick_not_the_highest_box(maker: str) -> None:
+    policies = container_policies(load_model(default_model_path()), seed=0, makers=(maker,))
+    assert policies[maker](_tall_loaded_and_short_free()) == "free"  # its removal moves nothing
 
 
 def test_unstack_gives_near_ties_to_the_box_resting_highest_and_min_cost_keeps_eq13() -> None:
