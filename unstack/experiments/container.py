@@ -101,6 +101,13 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     the same, and behind every surface the cloud shows that no detected box explains (a box
     nobody detected) a carton's depth of the unseen space solid in every world
     (``fill="faces"``, :func:`unstack.sim.belief.behind_seen_faces`).
+``hybrid_faces_veto``
+    ``belief_faces_veto`` starting from the ``hybrid``'s pick instead of the highest box: the
+    reasoner's hidden load first, then physics on the belief.
+``hybrid_faces_free``
+    the same, the alternatives to a vetoed pick only the boxes the reasoner believes hold
+    nothing up (expected cost below :data:`~unstack.height_veto.HYBRID_MAX_COST`); the faces
+    belief's fewest among them.
 
 Metrics per pile and per maker: boxes moved more than 2 cm, boxes fallen (dropped more than
 0.2 m or tipped more than 45 degrees), the share of picks that move nothing, and paired
@@ -157,9 +164,9 @@ CONTAINER_MAKERS = (
 #: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
 #: run only when named.
 ORACLE_MAKERS = ("rebuilt", "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen")
-#: Robot policies of physics on the belief with the unseen space filled, slow and measured
-#: no better than highest first in the closed loop on most families (results page, "Filling
-#: the space the sensor cannot see"): run only when named.
+#: Robot policies of physics on the belief with the unseen space filled, slow (0.25-4 s a pick,
+#: benchmarks page) and needing the physics engine (results page, "Filling the space the sensor
+#: cannot see" and after): run only when named.
 TRIED_MAKERS = (
     "belief_occlusion", "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
