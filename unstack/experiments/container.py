@@ -318,11 +318,13 @@ def container_policies(
             return top
         return belief_occlusion_free(scene)
 
+    def expected_costs(reasoned: Any) -> dict[str, float]:
+        return dict(zip(reasoned.objects, (float(cost) for cost in reasoned.expected_costs), strict=True))
+
     def believed_free(scene: Scene) -> list[str]:
         from unstack.height_veto import HYBRID_MAX_COST
 
-        reasoned = decision(scene, "load")
-        costs = dict(zip(reasoned.objects, (float(cost) for cost in reasoned.expected_costs), strict=True))
+        costs = expected_costs(decision(scene, "load"))
         return [box_id for box_id in scene.detected if costs[box_id] < HYBRID_MAX_COST] or list(scene.detected)
 
     def belief_occlusion_free(scene: Scene) -> str:
@@ -374,7 +376,7 @@ def container_policies(
         top_moves = in_view_moves(scene, [top], "faces", BELIEF_WORLDS)
         if top_moves[top] < BELIEF_VETO:
             return top
-        costs = dict(zip(reasoned.objects, (float(cost) for cost in reasoned.expected_costs), strict=True))
+        costs = expected_costs(reasoned)
         others = [box_id for box_id in scene.detected if box_id != top and costs[box_id] < HYBRID_MAX_COST]
         moves = {**top_moves, **(in_view_moves(scene, others, "faces", BELIEF_WORLDS) if others else {})}
         return fewest(scene, {box_id: moves.get(box_id, np.inf) for box_id in scene.detected})
