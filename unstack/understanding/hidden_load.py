@@ -131,9 +131,12 @@ def container_planes(points: np.ndarray) -> np.ndarray:
         coordinate = direction * points[candidates, axis]
         others = [other for other in range(3) if other != axis]
         extreme = coordinate.max()
-        for inside in np.arange(0.0, PLANE_SEARCH_DEPTH, PLANE_THICKNESS):
-            slab = (coordinate > extreme - inside - PLANE_THICKNESS) & (coordinate <= extreme - inside)
-            if slab.any() and np.all(np.ptp(points[candidates[slab]][:, others], axis=0) > PLANE_SPREAD):
+        depths = np.arange(0.0, PLANE_SEARCH_DEPTH, PLANE_THICKNESS)
+        searched = np.flatnonzero(coordinate > extreme - depths[-1] - PLANE_THICKNESS)  # every slab's points
+        near = coordinate[searched]
+        for inside in depths:
+            slab = searched[(near > extreme - inside - PLANE_THICKNESS) & (near <= extreme - inside)]
+            if len(slab) and np.all(np.ptp(points[candidates[slab]][:, others], axis=0) > PLANE_SPREAD):
                 wall = float(np.median(coordinate[slab]))  # a noisy wall straddles two slabs
                 planes[candidates[coordinate > wall - PLANE_THICKNESS / 2]] = True  # the wall and beyond
                 break
@@ -219,13 +222,14 @@ def hidden_load(
     if len(points) == 0 or not boxes:
         return result
     bounds = bounding_boxes(boxes)
-    free = unexplained_points(points, boxes, columns=columns)
+    binned = columns_of(points, columns)
+    free = unexplained_points(points, boxes, columns=binned)
     free &= points[:, 2] > bounds[:, 5].min() + FACE_TOLERANCE  # nothing lower lies on any box
-    free_points = points[free]
     typical_height = float(np.median([np.ptp(box_corners(box)[:, 2]) for box in boxes]))
     for k, box in enumerate(boxes):
         low, high = bounds[k, :2] - [FRONT_REACH + SIDE_REACH, SIDE_REACH], bounds[k, 3:5] + SIDE_REACH
-        column = free_points[np.all((free_points[:, :2] >= low) & (free_points[:, :2] <= high), axis=1)]
+        over = binned.indices_over(low, high)  # ascending: the cloud's order
+        column = points[over[free[over]]]
         if len(column) == 0:
             continue
         polygon = np.vstack([footprint(box) + offset for offset in _SIDE_OFFSETS])
