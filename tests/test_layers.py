@@ -9,7 +9,7 @@ Every ``import`` counts, at module level or inside a function (imports under
   detector model) above it;
 - ``reasoner``, ``learning``, ``sim`` and ``pictures`` above that, none importing another;
 - the recipe scene -> probabilities (``pipeline``) above those;
-- the public API (``unstack``, ``api``, ``describe``, ``moves``, ``picture_inputs``, ``validation``,
+- the public API (``unstack``, ``api``, ``describe``, ``height_veto``, ``moves``, ``picture_inputs``, ``validation``,
   ``warmup``) above that;
 - ``experiments`` above the API; ``cli`` on top.
 """
@@ -29,6 +29,7 @@ API = {
     "unstack",
     "unstack.api",
     "unstack.describe",
+    "unstack.height_veto",
     "unstack.moves",
     "unstack.picture_inputs",
     "unstack.validation",

@@ -283,6 +283,7 @@ def decide(
     samples: int | None = None,
     time_limit: float | None = None,
     near_tie_margin: float | None = None,
+    free_cost: float | None = None,
     statics: bool = True,
     disturbance: Any = None,
 ) -> Decision:
@@ -315,6 +316,12 @@ def decide(
         (:data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`) for a scene (and for supports
         that carry heights), Eq. 13's minimum for supports without heights; 0 keeps Eq. 13
         exactly.
+    free_cost : float, optional
+        For a scene: the highest detected box (its centre) whose expected cost is below this
+        is taken -- it holds nothing up (:func:`unstack.height_veto.free_highest`); when none
+        is, the reasoner's choice. Default: 0.5 (:data:`~unstack.height_veto.FREE_COST`),
+        0 with ``near_tie_margin=0`` (Eq. 13); 0 leaves the choice to the reasoner. Support
+        probabilities (no box centres) and the ``moves`` cost take none.
     statics : bool
         For a scene: raise the probability that a box holds up another that cannot stand
         without it (:func:`support_probabilities`); ``False`` keeps the model's probabilities.
@@ -343,14 +350,22 @@ def decide(
     >>> decide(unstack.Supports(["a", "b"], [[0, 0.2], [0.7, 0]]), seed=0).choice
     'a'
     """
+    from unstack.reasoner.arguments import check_margin
     from unstack.reasoner.decision import decide as decide_supports
 
+    if free_cost is not None:
+        free_cost = check_margin(free_cost, "free_cost")
     supports = _supports(scene_or_supports, model, statics)
     if cost == "moves":
         if not isinstance(scene_or_supports, Scene):
             raise InvalidArgument(
                 f"{supports.source}: the moves cost reads the scene's poses and cloud; support probabilities "
                 "alone are decided on load, count or mass"
+            )
+        if free_cost:
+            raise InvalidArgument(
+                "free_cost takes the highest box that holds nothing up by its expected load; the moves cost ties by "
+                "near_tie_margin alone"
             )
         from unstack.moves import decide_on_moves
 
@@ -376,7 +391,26 @@ def decide(
             time_limit=time_limit,
             near_tie_margin=near_tie_margin,
         )
+        decision = _free_highest(decision, scene_or_supports, free_cost, near_tie_margin)
     return _described(decision, scene_or_supports, supports)
+
+
+def _free_highest(
+    decision: Decision, given: Scene | Supports, free_cost: float | None, near_tie_margin: float | None
+) -> Decision:
+    """The default pick on a scene: the highest free box (:func:`unstack.height_veto.free_highest`)."""
+    from unstack.height_veto import FREE_COST, free_highest
+
+    if not isinstance(given, Scene):
+        if free_cost:
+            raise InvalidArgument(
+                f"{given.source}: free_cost takes the highest box by its centre, which support probabilities do not "
+                "give; decide on the scene file"
+            )
+        return decision
+    if free_cost is None:
+        free_cost = 0.0 if near_tie_margin == 0 else FREE_COST
+    return free_highest(decision, given, free_cost=free_cost)
 
 
 def _described(decision: Decision, given: Scene | Supports, supports: Supports) -> Decision:

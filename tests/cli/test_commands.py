@@ -207,6 +207,8 @@ def test_plan_with_sampling(twelve_boxes: Path) -> None:
         (["--near-ties", "nan"], "--near-ties"),
         (["--near-ties", "-0.1"], "--near-ties"),
         (["--near-ties", "inf"], "--near-ties"),
+        (["--free-cost", "-0.5"], "--free-cost"),
+        (["--free-cost", "nan"], "--free-cost"),
     ],
 )
 def test_bad_sampling_options_exit_2(option: list[str], message: str) -> None:
@@ -225,7 +227,7 @@ def test_decide_on_a_scene_gives_near_ties_to_the_box_resting_highest(tmp_path: 
     ]
     path = tmp_path / "three.scene.json"
     Scene(boxes, np.zeros((0, 3)), ["low", "base", "high"]).save(path)
-    default = unstack("decide", str(path), "--json")
+    default = unstack("decide", str(path), "--json", "--free-cost", "0")  # the reasoner's own choice
     assert default.returncode == 0, default.stderr
     document = json.loads(default.stdout)
     assert document["choice"] == "high" and document["near_tie_margin"] == 0.05
@@ -234,9 +236,35 @@ def test_decide_on_a_scene_gives_near_ties_to_the_box_resting_highest(tmp_path: 
     assert "near_tie_margin" not in strict and strict["choice"] == min(
         strict["objects"], key=lambda box: (strict["expected_costs"][strict["objects"].index(box)], box)
     )
-    table = unstack("decide", str(path))
+    table = unstack("decide", str(path), "--free-cost", "0")
     words = " ".join(table.stdout.split())  # rich wraps the headline
     assert "Unload first: high (tied with low: EC within 0.05 of the lowest; the box resting highest wins)" in words
+
+
+def test_decide_on_a_scene_takes_the_highest_free_box_unless_free_cost_is_0(tmp_path: Path) -> None:
+    from unstack.scene import Box, Scene
+
+    boxes = [  # 'tall' and 'low' hold nothing up; 'tall' is the higher, 'low' the slightly cheaper
+        Box("tall", [0.4, 0.4, 0.8], [1.2, -0.35, 0.401]),
+        Box("low", [0.4, 0.4, 0.3], [1.2, 0.35, 0.151]),
+    ]
+    path = tmp_path / "two.scene.json"
+    Scene(boxes, np.zeros((0, 3)), ["tall", "low"]).save(path)
+    default = json.loads(unstack("decide", str(path), "--json").stdout)
+    assert (default["choice"], default["free_cost"]) == ("tall", 0.5)
+    assert default["ties"] == ["low", "tall"]
+    strict = json.loads(unstack("decide", str(path), "--json", "--free-cost", "0").stdout)
+    assert "free_cost" not in strict and strict["choice"] == min(
+        strict["objects"], key=lambda box: (strict["expected_costs"][strict["objects"].index(box)], box)
+    )
+    words = " ".join(unstack("decide", str(path)).stdout.split())
+    assert "Unload first: tall (tied with low: EC below 0.5, holding nothing up; the highest wins)" in words
+
+
+def test_a_free_cost_on_support_probabilities_exits_2() -> None:
+    result = unstack("decide", PILE5, "--free-cost", "0.5")
+    assert result.returncode == 2 and result.stderr.count("\n") == 1
+    assert "free_cost takes the highest box by its centre" in result.stderr
 
 
 def test_near_ties_on_supports_without_heights_exit_2() -> None:

@@ -25,10 +25,15 @@ SEEDS = (7, 8)
 @pytest.mark.parametrize("cloud", CLOUDS)
 @pytest.mark.parametrize("kind", list(CANONICAL_KINDS))
 def test_the_default_model_picks_a_box_that_holds_up_nothing(default_model, kind: str, cloud: str) -> None:  # type: ignore[no-untyped-def]
+    from unstack.height_veto import free_highest
+
     for seed in SEEDS:
         case = build_case(kind, seed=seed)
-        decision = decide(scene_support_probabilities(canonical_scene(case, cloud=cloud, seed=seed), default_model))
-        assert decision.choice in case.pickable, (seed, decision.choice, case.pickable)
+        scene = canonical_scene(case, cloud=cloud, seed=seed)
+        decision = decide(scene_support_probabilities(scene, default_model))
+        assert decision.choice in case.pickable, (seed, decision.choice, case.pickable)  # the reasoner's own
+        default = free_highest(decision, scene).choice  # unstack.decide's on a scene
+        assert default in case.pickable, (seed, default, case.pickable)
 
 
 #: TipSupport scenes on which near ties by the box centre's height took the box leant on (the
@@ -44,6 +49,10 @@ def test_a_box_leant_on_is_not_taken_for_being_taller(default_model, seed: int) 
     for statics in (False, True):  # the model alone, and with statics
         decision = decide(scene_support_probabilities(scene, default_model, statics=statics))
         assert decision.choice == "free"  # the taller box leant on is not taken
+    from unstack.height_veto import free_highest
+
+    default = free_highest(decide(scene_support_probabilities(scene, default_model)), scene).choice
+    assert default in case.pickable and default != "upright"  # statics price the box leant on above the free cost
 
 
 @pytest.mark.parametrize("cloud", CLOUDS)
@@ -108,11 +117,15 @@ def test_an_unknown_pick_is_refused() -> None:
 
     case = build_case("plain_stack", seed=0)
     scene = canonical_scene(case, cloud="surface", seed=0)
-    with pytest.raises(UnstackError, match="unknown pick 'tallest'; expected one of default, min-cost, hybrid"):
+    with pytest.raises(
+        UnstackError, match="unknown pick 'tallest'; expected one of default, near-ties, min-cost, hybrid"
+    ):
         picked(None, scene, "tallest")
 
 
-@pytest.mark.parametrize(("pick", "expected"), [("default", "high"), ("min-cost", "low"), ("hybrid", "high")])
+@pytest.mark.parametrize(
+    ("pick", "expected"), [("default", "high"), ("near-ties", "high"), ("min-cost", "low"), ("hybrid", "high")]
+)
 def test_the_suite_can_pick_by_each_rule(pick: str, expected: str) -> None:
     import numpy as np
 

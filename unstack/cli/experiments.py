@@ -26,6 +26,7 @@ from unstack.experiments.container import (
 from unstack.experiments.decisions import evaluate_decisions
 from unstack.experiments.disturbance_training import train_disturbance
 from unstack.experiments.fig5a import fig5a as fig5a_experiment
+from unstack.experiments.generalisation import PICKS
 from unstack.experiments.outputs import results_folder, save_results
 from unstack.experiments.pick_responses import collect_pick_responses, pick_table
 from unstack.experiments.real7 import real7 as real7_experiment
@@ -472,9 +473,10 @@ def container(
 @click.option("--first-seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of the first scene of each kind (later ones follow).")  # fmt: skip
 @click.option("--physics", is_flag=True, help="Also check each scene's labels in the physics engine.")
-@click.option("--pick", type=click.Choice(["default", "min-cost", "hybrid"]), default="default", show_default=True,
-              help="default: the decision's choice (near ties to the box resting highest); min-cost: Eq. 13's minimum; "
-                   "hybrid: the highest box of EC below 0.5.")  # fmt: skip
+@click.option("--pick", type=click.Choice(list(PICKS)), default="default", show_default=True,
+              help="default: the highest box of EC below 0.5, else near ties (unstack decide's pick); near-ties: the "
+                   "reasoner's choice (near ties to the box resting highest); min-cost: Eq. 13's minimum; hybrid: the "
+                   "highest box of EC below 0.5, else the minimum.")  # fmt: skip
 def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int, physics: bool, pick: str) -> None:
     """The generalisation suite: hand-made canonical scenes, two clouds each, the decision checked.
 

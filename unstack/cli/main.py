@@ -136,6 +136,7 @@ def _load_input(path: str, model: str | None, statics: bool = True) -> Any:
 #: Option types checked by the library's own argument checks (:mod:`unstack.cli.options`).
 SECONDS = Checked(float, functools.partial(check_budget, name="time_limit"))
 MARGIN = Checked(float, functools.partial(check_margin, name="near_tie_margin"))
+FREE_COST = Checked(float, functools.partial(check_margin, name="free_cost"))
 SAMPLES = Checked(int, check_samples)
 SEED = Checked(int, check_seed)
 
@@ -243,6 +244,14 @@ def cli() -> None:
 )
 @click.option("--timing", is_flag=True, help="Add wall-clock seconds to the JSON (it is canonical without them).")
 @_reasoning_options
+@click.option(
+    "--free-cost",
+    "free_cost",
+    type=FREE_COST,
+    default=None,
+    help="For a scene: the highest box whose expected cost is below this holds nothing up and is taken "
+    "(default 0.5; 0 with --near-ties 0; 0: the reasoner's choice).",
+)
 @click.option("--model", "model", default=None, help=MODEL_HELP)
 @click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)
 def decide(file: str, as_json: bool, output: str | None, timing: bool, model: str | None, **reasoning: Any) -> None:

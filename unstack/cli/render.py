@@ -67,10 +67,11 @@ def decision_view(decision: Decision) -> Group:
     near = decision.near_tie_margin
     if decision.choice_probability < 1.0 or decision.sampling is not None:
         what = f"within {near:g} of the minimum EC" if near else "the minimum EC"
+        what = f"below {decision.free_cost:g}" if decision.free_cost else what
         headline.append(f"  (P(truly {what}) = {decision.choice_probability:.3f})")
     if len(decision.ties) > 1:
         others = ", ".join(printable(t) for t in decision.ties if t != decision.choice)
-        rule = f"EC within {near:g} of the lowest; the box resting highest wins" if near else "smallest id wins"
+        rule = _tie_rule(near, decision.free_cost)
         headline.append(f"  (tied with {others}: {rule})")
     if decision.pick is not None:
         headline.append(f"\nwhere: {place_in_words(decision.pick)}")
@@ -172,3 +173,12 @@ def plan_view(result: Plan) -> Table:
         errors = (f"{step.expected_cost_error:.4f}", f"{step.decision.choice_probability:.3f}") if sampled else ()
         table.add_row(str(number), _id(step.choice), f"{step.expected_cost:.4f}", *errors, str(len(step.remaining)))
     return table
+
+
+def _tie_rule(margin: float, free_cost: float) -> str:
+    """How the choice was made among the tied boxes, in words."""
+    if free_cost:
+        return f"EC below {free_cost:g}, holding nothing up; the highest wins"
+    if margin:
+        return f"EC within {margin:g} of the lowest; the box resting highest wins"
+    return "smallest id wins"

@@ -5,9 +5,13 @@ pile is scanned and the boxes detected again, only boxes reachable from the door
 candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`):
 
 ``unstack``
-    unstack's default decision: the default model's probabilities, the default cost (hidden
-    load counted) and near ties in expected cost to the box resting highest
+    unstack's default decision on a scene (:func:`unstack.decide`): the default model's
+    probabilities, the default cost (hidden load counted), the highest box whose expected
+    cost is below :data:`~unstack.height_veto.FREE_COST` (:func:`unstack.height_veto.free_highest`);
+    when none is, near ties in expected cost to the box resting highest
     (:data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`).
+``near_ties``
+    the reasoner's own choice: near ties alone (the default before 2026-12-06).
 ``min_cost``
     the same expected costs with Eq. 13's minimum (no near ties; the default before
     2026-12-01).
@@ -117,7 +121,7 @@ not time limits); resumable per pile; piles in parallel processes.
 Examples
 --------
 >>> CONTAINER_MAKERS[:4]
-('unstack', 'min_cost', 'unstack_count', 'hybrid')
+('unstack', 'near_ties', 'min_cost', 'unstack_count')
 """
 
 from __future__ import annotations
@@ -154,8 +158,8 @@ __all__ = [
 ]
 
 CONTAINER_MAKERS = (
-    "unstack", "min_cost", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random", "lookahead",
-    "moves", "moves_veto", "belief", "belief_veto", "rebuilt",
+    "unstack", "near_ties", "min_cost", "unstack_count", "hybrid", "highest", "footprint", "nearest_door", "random",
+    "lookahead", "moves", "moves_veto", "belief", "belief_veto", "rebuilt",
     "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen", "belief_occlusion",
     "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
@@ -229,6 +233,11 @@ def container_policies(
 
     def height(scene: Scene, box_id: str) -> float:
         return float(scene.box(box_id).position[2])
+
+    def default(scene: Scene) -> str:
+        from unstack.height_veto import free_highest
+
+        return str(free_highest(decision(scene, "load"), scene).choice)
 
     def hybrid(scene: Scene) -> str:
         from unstack.height_veto import hybrid_choice
@@ -419,7 +428,8 @@ def container_policies(
         return policy
 
     every: dict[str, Callable[..., str]] = {
-        "unstack": deciding("load"),
+        "unstack": default,
+        "near_ties": deciding("load"),
         "min_cost": deciding("load", 0.0),
         "unstack_count": deciding("count", 0.0),
         "hybrid": hybrid,

@@ -8,8 +8,11 @@ decision maker picks the box to unload first:
     with the default cost (``load``: every box counted with the undetected load the cloud
     shows on it); Eq. 13's minimum, as the paper decides.
 ``near_ties``
-    unstack's default choice: the same expected costs, near ties (within
+    the reasoner's choice: the same expected costs, near ties (within
     :data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`) to the box resting highest.
+``default``
+    unstack's default choice on a scene (:func:`unstack.height_veto.free_highest`): the
+    highest box of the ISet whose expected cost is below 0.5, else ``near_ties``' choice.
 ``count``
     the same with Eq. 11's count exactly (``cost="count"``): the load nobody detected is
     not counted.
@@ -76,7 +79,7 @@ __all__ = [
     "uncovered_boxes",
 ]
 
-DECISION_MAKERS = ("reasoner", "near_ties", "count", "priors", "highest", "free", "hybrid", "random")
+DECISION_MAKERS = ("reasoner", "near_ties", "default", "count", "priors", "highest", "free", "hybrid", "random")
 
 
 def squared_regret(costs: np.ndarray, choice: int) -> float:
@@ -156,7 +159,9 @@ def iset_outcome(scene: Any, ids: list[str], model: Any, *, statics: bool = True
     ``statics``: as in :func:`~unstack.pipeline.scene_support_probabilities` (the
     default pipeline); the scores compare the picks with the simulator's ground truth either way.
     """
-    from unstack.height_veto import hybrid_choice
+    import dataclasses
+
+    from unstack.height_veto import free_highest, hybrid_choice
     from unstack.learning.metrics import classification_report
     from unstack.pipeline import scene_support_probabilities
     from unstack.reasoner.decision import NEAR_TIE_MARGIN, choose, decide
@@ -175,6 +180,7 @@ def iset_outcome(scene: Any, ids: list[str], model: Any, *, statics: bool = True
     picks = {
         "reasoner": ids.index(decision.choice),
         "near_ties": ids.index(near_tie),
+        "default": ids.index(free_highest(dataclasses.replace(decision, choice=near_tie), scene).choice),
         "count": ids.index(decide(supports, cost="count", near_tie_margin=0.0).choice),
         "priors": ids.index(choose(tuple(ids), priors_costs)[0]),
         "highest": int(np.argmax([box.position[2] for box in boxes])),

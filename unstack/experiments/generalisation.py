@@ -45,10 +45,11 @@ __all__ = [
 
 #: The two ways a canonical scene is scanned.
 CLOUDS = ("sensor", "surface")
-#: How the first box is picked from a decision: its own choice (the default: near ties in
-#: expected cost to the box resting highest), Eq. 13's minimum, or the hybrid
+#: How the first box is picked from a decision: the default on a scene (the highest free box,
+#: :func:`unstack.height_veto.free_highest`), the reasoner's own choice (near ties in expected
+#: cost to the box resting highest), Eq. 13's minimum, or the hybrid
 #: (:func:`unstack.height_veto.highest_free_box`).
-PICKS = ("default", "min-cost", "hybrid")
+PICKS = ("default", "near-ties", "min-cost", "hybrid")
 #: A box that carries a load of k boxes must cost at least this share of k.
 HOLD_SHARE = 0.5
 #: A pickable box must cost less than this.
@@ -167,18 +168,20 @@ def picked(decision: Any, scene: Scene, pick: str) -> Any:
     >>> boxes = [Box("tall", [0.4, 0.4, 0.8], [1.0, 0.0, 0.4]), Box("low", [0.4, 0.4, 0.3], [1.0, 0.5, 0.15])]
     >>> scene = Scene(boxes, np.zeros((0, 3)), ["tall", "low"])
     >>> decision = decide(Supports(["tall", "low"], [[0.0, 0.3], [0.0, 0.0]], heights=[0.0, 0.0]))
-    >>> decision.choice, picked(decision, scene, "hybrid").choice
+    >>> picked(decision, scene, "near-ties").choice, picked(decision, scene, "default").choice
     ('low', 'tall')
     """
     import dataclasses
 
     from unstack.errors import UnstackError
-    from unstack.height_veto import hybrid_choice
+    from unstack.height_veto import free_highest, hybrid_choice
     from unstack.reasoner.decision import choose
 
     if pick not in PICKS:
         raise UnstackError(f"unknown pick {pick!r}; expected one of {', '.join(PICKS)}")
     if pick == "default":
+        return free_highest(decision, scene)
+    if pick == "near-ties":
         return decision
     if pick == "min-cost":
         choice, ties = choose(tuple(decision.objects), decision.expected_costs)

@@ -137,6 +137,10 @@ class Decision:
         Wall time of the sampled groups (0 when none was sampled).
     near_tie_margin : float
         The near-tie margin the choice was made with (0: Eq. 13's minimum).
+    free_cost : float
+        When the choice is the highest box holding nothing up
+        (:func:`unstack.height_veto.free_highest`): the expected cost those boxes lie below
+        (0: the reasoner's own choice).
     reasons : tuple of dict
         With a cost that counts boxes (:data:`~unstack.reasoner.reasons.REASON_COSTS`): per
         box, the boxes it is expected to move as the cost counts them and what drives that
@@ -178,6 +182,7 @@ class Decision:
     warnings: tuple[str, ...] = ()
     sampling_seconds: float = 0.0
     near_tie_margin: float = 0.0
+    free_cost: float = 0.0
     reasons: tuple[dict[str, Any], ...] = ()
     disturbance_model: str = ""
     model: str = ""
@@ -248,6 +253,8 @@ class Decision:
         data["ties"] = list(self.ties)
         if self.near_tie_margin:
             data["near_tie_margin"] = self.near_tie_margin
+        if self.free_cost:
+            data["free_cost"] = self.free_cost
         data["components"] = [list(group) for group in self.components]
         data["component_methods"] = list(self.component_methods)
         if self.expected_cost_errors is not None and self.marginal_errors is not None:
