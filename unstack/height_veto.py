@@ -130,15 +130,13 @@ def free_highest(decision: Decision, scene: Scene, *, free_cost: float = FREE_CO
 
     Examples
     --------
-    >>> import numpy as np
-    >>> from unstack.reasoner.decision import decide
-    >>> from unstack.scene import Box
-    >>> from unstack.supports import Supports
-    >>> boxes = [Box("tall", [0.4, 0.4, 0.8], [1.0, 0.0, 0.4]), Box("low", [0.4, 0.4, 0.3], [1.0, 0.5, 0.15])]
-    >>> scene = Scene(boxes, np.zeros((0, 3)), ["tall", "low"])
-    >>> decision = decide(Supports(["tall", "low"], [[0.0, 0.3], [0.0, 0.0]], heights=[0.0, 0.0]))
-    >>> decision.choice, free_highest(decision, scene).choice, free_highest(decision, scene, free_cost=0.2).choice
-    ('low', 'tall', 'low')
+    'lean' leans on 'upright'; it and 'free' hold nothing up, and 'lean' is the higher:
+
+    >>> import unstack
+    >>> scene = unstack.load("examples/leaning.scene.json")
+    >>> reasoner = unstack.decide(scene, free_cost=0)  # the reasoner's own choice
+    >>> reasoner.choice, free_highest(reasoner, scene).choice, free_highest(reasoner, scene, free_cost=0.05).choice
+    ('free', 'lean', 'free')
     """
     import dataclasses
     import math
