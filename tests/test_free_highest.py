@@ -117,3 +117,19 @@ def test_decide_on_support_probabilities_refuses_a_free_cost() -> None:
 def test_the_moves_cost_refuses_a_free_cost() -> None:
     with pytest.raises(InvalidArgument, match="the moves cost ties by near_tie_margin alone"):
         unstack.decide(unstack.load("examples/scene3.json"), cost="moves", free_cost=0.5)
+
+
+def test_a_plan_on_a_scene_takes_the_highest_free_box_at_every_step() -> None:
+    scene = unstack.load("examples/leaning.scene.json")
+    document = unstack.plan(scene, seed=0).to_dict()
+    jsonschema.validate(document, load_schema("unstack.plan/1"))
+    assert document["order"][0] == unstack.decide(scene, seed=0).choice == "lean"
+    assert all(step["free_cost"] == FREE_COST for step in document["steps"])
+    assert unstack.plan(scene, seed=0, free_cost=0).order[0] == unstack.decide(scene, seed=0, free_cost=0).choice
+
+
+def test_a_plan_on_support_probabilities_refuses_a_free_cost() -> None:
+    supports = unstack.load("examples/stack5.supports.json")
+    assert "free_cost" not in unstack.plan(supports).to_dict()["steps"][0]
+    with pytest.raises(InvalidArgument, match="free_cost takes the highest box by its centre"):
+        unstack.plan(supports, free_cost=0.5)

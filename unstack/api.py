@@ -405,7 +405,7 @@ def _free_highest(
         if free_cost:
             raise InvalidArgument(
                 f"{given.source}: free_cost takes the highest box by its centre, which support probabilities do not "
-                "give; decide on the scene file"
+                "give; use the scene file"
             )
         return decision
     if free_cost is None:
@@ -434,6 +434,7 @@ def plan(
     time_limit: float | None = None,
     progress: Callable[[int, int], None] | None = None,
     near_tie_margin: float | None = None,
+    free_cost: float | None = None,
     statics: bool = True,
 ) -> Plan:
     """An unloading order: decide, take the chosen box out, decide again on the rest.
@@ -442,8 +443,9 @@ def plan(
     ----------
     scene_or_supports : Scene or Supports
         A scene gets its probabilities from ``model`` once, before the first step.
-    model, method, cost, seed, samples, time_limit, near_tie_margin, statics
-        As in :func:`decide` (the budget applies to each step; without one each step
+    model, method, cost, seed, samples, time_limit, near_tie_margin, free_cost, statics
+        As in :func:`decide` (the budget applies to each step, and on a scene each step takes
+        the highest box holding nothing up as :func:`decide` does; without a budget each step
         samples :data:`~unstack.reasoner.plan.PLAN_SAMPLES` sweeps per group, from where
         the previous step's chains ended).
     progress : callable, optional
@@ -473,7 +475,12 @@ def plan(
             "the moves cost decides the next pick on a scene as sensed now (a robot senses again after each "
             "pick); a plan is made on load, count or mass"
         )
+    from unstack.reasoner.arguments import check_margin
+
+    if free_cost is not None:
+        free_cost = check_margin(free_cost, "free_cost")
     supports = _supports(scene_or_supports, model, statics)
+    given = scene_or_supports
     return unloading_plan(
         supports,
         method=method,
@@ -483,4 +490,5 @@ def plan(
         time_limit=time_limit,
         progress=progress,
         near_tie_margin=near_tie_margin,
+        choose_step=lambda decision: _free_highest(decision, given, free_cost, near_tie_margin),
     )

@@ -149,6 +149,17 @@ def load_model_option(model: str | None) -> tuple[Any, str]:
     return loaded, model_label(loaded)
 
 
+#: ``--free-cost`` of ``decide`` and ``plan`` (a scene's rule; support probabilities refuse it).
+FREE_COST_OPTION = click.option(
+    "--free-cost",
+    "free_cost",
+    type=FREE_COST,
+    default=None,
+    help="For a scene: the highest box whose expected cost is below this holds nothing up and is taken "
+    "(default 0.5; 0 with --near-ties 0; 0: the reasoner's choice).",
+)
+
+
 def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
     """The options shared by ``decide`` and ``plan``: method, cost, sampling budget, seed."""
     from unstack.reasoner.costs import COSTS, DEFAULT_COST
@@ -244,14 +255,7 @@ def cli() -> None:
 )
 @click.option("--timing", is_flag=True, help="Add wall-clock seconds to the JSON (it is canonical without them).")
 @_reasoning_options
-@click.option(
-    "--free-cost",
-    "free_cost",
-    type=FREE_COST,
-    default=None,
-    help="For a scene: the highest box whose expected cost is below this holds nothing up and is taken "
-    "(default 0.5; 0 with --near-ties 0; 0: the reasoner's choice).",
-)
+@FREE_COST_OPTION
 @click.option("--model", "model", default=None, help=MODEL_HELP)
 @click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)
 def decide(file: str, as_json: bool, output: str | None, timing: bool, model: str | None, **reasoning: Any) -> None:
@@ -295,6 +299,7 @@ def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str, 
 @click.option("--json", "as_json", is_flag=True, help="Print the plan as unstack.plan/1 JSON.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON plan to this file.")
 @_reasoning_options
+@FREE_COST_OPTION
 @click.option("--model", "model", default=None, help=MODEL_HELP)
 @click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)
 def plan(file: str, as_json: bool, output: str | None, model: str | None, **reasoning: Any) -> None:

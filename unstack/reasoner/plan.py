@@ -102,6 +102,7 @@ class Plan:
                     "expected_cost_error": step.expected_cost_error,
                     "choice_probability": step.decision.choice_probability,
                     **({"near_tie_margin": step.decision.near_tie_margin} if step.decision.near_tie_margin else {}),
+                    **({"free_cost": step.decision.free_cost} if step.decision.free_cost else {}),
                 }
                 for step in self.steps
             ],
@@ -119,6 +120,7 @@ def unloading_plan(
     seed: int | None = None,
     progress: Callable[[int, int], None] | None = None,
     near_tie_margin: float | None = None,
+    choose_step: Callable[[Decision], Decision] | None = None,
 ) -> Plan:
     """Order every box by repeated minimum-EC decisions (see the module docstring).
 
@@ -133,6 +135,10 @@ def unloading_plan(
         :data:`PLAN_EXACT_MAX_BOXES` boxes exactly.
     progress : callable, optional
         Called as ``progress(done, total)`` after every step (``total`` picks in all).
+    choose_step : callable, optional
+        Makes each step's choice from its decision (returns the decision with its ``choice``
+        set; :func:`unstack.api.plan` passes the scene's free-box rule,
+        :func:`unstack.height_veto.free_highest`); default: the reasoner's choice.
 
     Returns
     -------
@@ -166,6 +172,8 @@ def unloading_plan(
             max_boxes=PLAN_EXACT_MAX_BOXES if method == "auto" else None,
             near_tie_margin=near_tie_margin,
         )
+        if choose_step is not None:
+            decision = choose_step(decision)
         chosen = decision.objects.index(decision.choice)
         steps.append(PlanStep(decision.choice, float(decision.expected_costs[chosen]), tuple(remaining), decision))
         remaining.remove(decision.choice)
