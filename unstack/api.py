@@ -480,7 +480,6 @@ def plan(
     if free_cost is not None:
         free_cost = check_margin(free_cost, "free_cost")
     supports = _supports(scene_or_supports, model, statics)
-    given = scene_or_supports
     return unloading_plan(
         supports,
         method=method,
@@ -490,5 +489,5 @@ def plan(
         time_limit=time_limit,
         progress=progress,
         near_tie_margin=near_tie_margin,
-        choose_step=lambda decision: _free_highest(decision, given, free_cost, near_tie_margin),
+        choose_step=lambda decision: _free_highest(decision, scene_or_supports, free_cost, near_tie_margin),
     )

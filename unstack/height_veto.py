@@ -151,7 +151,7 @@ def free_highest(decision: Decision, scene: Scene, *, free_cost: float = FREE_CO
     free = sorted(box_id for box_id in decision.objects if costs[box_id] < free_cost)
     if not free:
         return decision
-    choice = max(free, key=lambda box_id: (float(scene.box(box_id).position[2]), box_id))
+    choice = highest_free_box(scene, costs, max_cost=free_cost, candidates=free)
     errors = decision.expected_cost_errors
     error = 0.0 if errors is None else float(errors[decision.objects.index(choice)])
     below = 1.0 if error == 0.0 else 0.5 * (1.0 + math.erf((free_cost - costs[choice]) / (error * math.sqrt(2.0))))
