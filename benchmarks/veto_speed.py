@@ -8,12 +8,16 @@ sampled in four worlds, every candidate tried when the highest box is vetoed). A
 robot's pick takes about 4-5 s; the decision must take under 1 s median for 40 detected boxes
 and under 50 ms for 5 (issue 34, part 3). The first ``N`` boxes of each simulated pile are
 taken as detected (and as the boxes in view); the maker and ``unstack.decide`` with the load
-cost are timed alternately on the same scenes after one warm-up call each.
+cost are timed alternately on the same scenes after one warm-up call each. ``load`` is
+unstack's default decision on a scene (``unstack.decide(scene)``); ``--maker unstack`` times it
+beside the container maker of the same name (the same rule with the container runs' sample
+budget), the cheapest companion when the default alone is wanted.
 
 Usage::
 
     python benchmarks/veto_speed.py f30-stacked --piles 6 --repeat 2 --sizes 5,15
     python benchmarks/veto_speed.py f30-stacked --piles 6 --repeat 2 --sizes 5,15 --maker belief_scaled_veto
+    python benchmarks/veto_speed.py f30-four --piles 6 --repeat 2 --sizes 5,20 --maker unstack
 
 ``f30-stacked`` is made by::
 
@@ -40,5 +44,5 @@ if __name__ == "__main__":
     chosen, rest = chooser.parse_known_args()
     sys.argv[1:] = rest  # the rest is compare_by_size's
     veto = container_policies(load_model(None), seed=0, makers=(chosen.maker,))[chosen.maker]
-    calls = {"veto": veto, "load": lambda scene: unstack.decide(scene, seed=0)}
+    calls = {chosen.maker: veto, "load": lambda scene: unstack.decide(scene, seed=0)}
     compare_by_size(__doc__.splitlines()[0], calls, piles=6, repeat=2)

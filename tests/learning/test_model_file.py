@@ -149,6 +149,43 @@ def test_a_prediction_runs_on_the_calling_thread_alone_and_restores_its_openmp_l
     assert np.array_equal(probabilities, LogisticRegression().fit(features, labels).predict_proba(features)[:, 1])
 
 
+_LATE_RUNTIME = """
+import numpy as np
+from sklearn.linear_model import LogisticRegression
+from threadpoolctl import threadpool_info, threadpool_limits
+
+from unstack.learning.features import FeatureSettings
+from unstack.learning.model_file import SupportModel
+
+def openmp_threads():
+    return [info["num_threads"] for info in threadpool_info() if info["user_api"] == "openmp"]
+
+class Recording(LogisticRegression):
+    def predict_proba(self, features):
+        self.threads_seen_ = openmp_threads()
+        return super().predict_proba(features)
+
+rows = np.random.default_rng(3).normal(size=(40, 19))
+estimator = Recording().fit(rows, (rows[:, 0] > 0).astype(int))
+model = SupportModel(estimator=estimator, features=FeatureSettings(), metadata={})
+model.support_probability(rows)  # the thread pools found with scikit-learn's runtime alone
+from numba.np.ufunc import omppool  # noqa: F401  (loads the system's OpenMP runtime: a second one)
+with threadpool_limits(limits=2, user_api="openmp"):
+    model.support_probability(rows)
+print(len(openmp_threads()), estimator.threads_seen_)
+"""
+
+
+def test_a_runtime_loaded_after_the_first_prediction_is_limited_too() -> None:
+    import subprocess
+    import sys
+
+    result = subprocess.run([sys.executable, "-c", _LATE_RUNTIME], capture_output=True, text=True, check=True)
+    runtimes, seen = result.stdout.strip().split(" ", 1)
+    assert int(runtimes) == 2, result.stdout
+    assert seen == "[1, 1]"
+
+
 def _unusable_models() -> dict[str, tuple[object, dict[str, object] | None]]:
     """Classifiers that load but cannot give P(SUPP) for the 19 paper features (name: estimator, metadata)."""
     from sklearn.linear_model import LogisticRegression

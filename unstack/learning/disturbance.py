@@ -34,10 +34,9 @@ from typing import Any
 import numpy as np
 from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.utils.validation import check_is_fitted, validate_data
-from threadpoolctl import threadpool_limits
 
 from unstack.atomic import atomic_write_bytes
-from unstack.learning.model_file import PREDICT_OPENMP_THREADS, InvalidModel, read_payload
+from unstack.learning.model_file import InvalidModel, openmp_limit, read_payload
 from unstack.learning.pick_features import PICK_FEATURES
 
 __all__ = [
@@ -147,7 +146,7 @@ class DisturbanceModel:
             )
         if len(rows) == 0:
             return np.zeros(0)
-        with threadpool_limits(limits=PREDICT_OPENMP_THREADS, user_api="openmp"):
+        with openmp_limit():
             prediction = np.asarray(self.estimator.predict(rows), dtype=np.float64)
         return np.maximum(prediction, 0.0)
 

@@ -27,14 +27,16 @@ from __future__ import annotations
 import io
 import json
 import os
+import sys
 import zipfile
+from contextlib import AbstractContextManager
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from threadpoolctl import threadpool_limits
+from threadpoolctl import ThreadpoolController
 
 from unstack.atomic import atomic_write_bytes
 from unstack.errors import InvalidFile
@@ -54,6 +56,7 @@ __all__ = [
     "default_model_path",
     "feature_ranges",
     "load_model",
+    "openmp_limit",
     "read_payload",
     "save_model",
 ]
@@ -66,6 +69,35 @@ MODEL_FORMAT = "unstack.model/1"
 #: with 1. OpenMP limits are per thread (libgomp, libomp), so the limit covers the calling
 #: thread's prediction only and is restored after it.
 PREDICT_OPENMP_THREADS = 1
+
+
+_controller: tuple[int, ThreadpoolController] | None = None
+
+
+def _openmp_controller() -> ThreadpoolController:
+    """The process's thread pools, found again only when a module was imported since: finding
+    them walks every loaded library (about 1 ms a call, a fiftieth of a 5-box decision), and a
+    library that brings its own OpenMP runtime comes with an import."""
+    global _controller
+    cached = _controller
+    if cached is None or cached[0] != len(sys.modules):
+        cached = (len(sys.modules), ThreadpoolController())
+        _controller = cached  # one assignment: a thread reads the old pair or the new
+    return cached[1]
+
+
+def openmp_limit() -> AbstractContextManager[Any]:
+    """A context in which OpenMP runs :data:`PREDICT_OPENMP_THREADS` thread(s) on the calling thread.
+
+    Examples
+    --------
+    >>> with openmp_limit():
+    ...     pass
+    """
+    limiter: AbstractContextManager[Any] = _openmp_controller().limit(limits=PREDICT_OPENMP_THREADS, user_api="openmp")
+    return limiter
+
+
 #: File name of the model shipped with the package (``unstack/learning/models``).
 #: Models shipped with the package, by the name ``--model`` accepts: ``general`` (the
 #: default: gradient boosting on the pose-only general features, trained on five pile
@@ -178,7 +210,7 @@ class SupportModel:
             return np.zeros(0)
         classes = list(self.estimator.classes_)
         try:
-            with threadpool_limits(limits=PREDICT_OPENMP_THREADS, user_api="openmp"):
+            with openmp_limit():
                 probability: np.ndarray = self.estimator.predict_proba(features)[:, classes.index(1)]
         except (ValueError, TypeError, AttributeError, IndexError) as error:  # not a model of these features
             raise InvalidModel(self.source, "$.estimator", f"cannot predict P(SUPP): {error}") from error

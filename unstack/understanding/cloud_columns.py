@@ -76,12 +76,22 @@ class CloudColumns:
         last = np.minimum(self._cells(high_xy[None])[0], np.array(self._shape) - 1)
         if np.any(last < first):
             return np.zeros(0, dtype=np.int64)
-        rows = np.arange(first[0], last[0] + 1) * self._shape[1]
-        runs = [self._order[self._starts[row + first[1]] : self._starts[row + last[1] + 1]] for row in rows]
-        near = np.concatenate(runs)
+        # a column strictly between the rectangle's first and last (both ways) lies wholly in
+        # it: only the points of the border columns are checked
+        edge, inner = [], []
+        for across in range(first[0], last[0] + 1):
+            row = across * self._shape[1]
+            start, stop = self._starts[row + first[1]], self._starts[row + last[1] + 1]
+            if across in (first[0], last[0]) or last[1] - first[1] < 2:
+                edge.append(self._order[start:stop])
+                continue
+            inner_start, inner_stop = self._starts[row + first[1] + 1], self._starts[row + last[1]]
+            edge += [self._order[start:inner_start], self._order[inner_stop:stop]]
+            inner.append(self._order[inner_start:inner_stop])
+        near = np.concatenate(edge)
         xy = self.points[near, :2]
         inside = np.all((xy >= low_xy) & (xy <= high_xy), axis=1)
-        return np.sort(near[inside])
+        return np.sort(np.concatenate([near[inside], *inner]))
 
 
 def columns_of(points: Any, columns: CloudColumns | None = None) -> CloudColumns:

@@ -61,8 +61,30 @@ WARNED_OVERLAP = 0.05
 FLOAT_GAP = 0.05
 #: A box reaching deeper than this below the floor (z = 0) is warned about (metres).
 BELOW_FLOOR = 0.02
-#: A cloud whose points are mostly farther than this from every box is "far" (metres).
+#: A cloud whose points are mostly farther than this from every box is "far" (metres) ...
 FAR_CLOUD = 0.5
+#: ... when less than this share of its points is nearer.
+NEAR_CLOUD_SHARE = 0.05
+
+
+def _share_within(points: np.ndarray, low: np.ndarray, high: np.ndarray, enough: float) -> float:
+    """Share of the points within ``[low, high]``, counted a slice of the cloud at a time and
+    stopped once it reaches ``enough`` (then a share of at least ``enough``, not the whole one).
+
+    Examples
+    --------
+    >>> points = np.array([[0.0, 0.0, 0.0], [5.0, 0.0, 0.0]])
+    >>> _share_within(points, np.full(3, -1.0), np.full(3, 1.0), 0.9)
+    0.5
+    """
+    step = max(1, len(points) // 16)
+    inside = 0
+    for start in range(0, len(points), step):
+        part = points[start : start + step]
+        inside += int(np.count_nonzero(np.all((part >= low) & (part <= high), axis=1)))
+        if inside >= enough * len(points):
+            break
+    return inside / len(points)
 
 
 def _floating(scene: Scene, bounds: np.ndarray, index: int) -> float | None:
@@ -127,8 +149,8 @@ def scene_warnings(scene: Scene) -> list[str]:
         warnings.append(f"{source}: the point cloud is empty; undetected load and cloud features cannot be seen")
     else:
         low, high = bounds[:, :3].min(axis=0) - FAR_CLOUD, bounds[:, 3:].max(axis=0) + FAR_CLOUD
-        near = np.mean(np.all((scene.points >= low) & (scene.points <= high), axis=1))
-        if near < 0.05:
+        near = _share_within(scene.points, low, high, NEAR_CLOUD_SHARE)
+        if near < NEAR_CLOUD_SHARE:
             warnings.append(
                 f"{source}: only {100 * near:.1f} % of the cloud's points lie within {FAR_CLOUD} m of the boxes; "
                 "is the cloud in the same frame and unit (metres) as the boxes?"

@@ -242,14 +242,29 @@ def _near(bounds: np.ndarray, row: int, margin: float) -> np.ndarray:
     return near
 
 
+def _downward_top(box: Box) -> float:
+    """The highest point of the box's downward faces (outward normal's z at most ``-UPWARD``);
+    minus infinity when the box has none."""
+    rotation = rotation_matrix(box.orientation_xyzw)
+    half = box.size / 2.0
+    across = np.abs(rotation[2]) * half  # each axis's reach in z
+    tops = [
+        box.position[2] + sign * rotation[2, axis] * half[axis] + across.sum() - across[axis]
+        for axis in range(3)
+        for sign in (-1.0, 1.0)
+        if sign * rotation[2, axis] <= -UPWARD
+    ]
+    return float(max(tops, default=-np.inf))
+
+
 def _cloud_under(columns: CloudColumns, box: Box, bound: np.ndarray, others: Sequence[Box]) -> np.ndarray:
     """Points of the cloud just under the box's downward faces, away from its edges (its own
     visible faces, noisy near the edges, are not taken for something under it), and not on
     a detected box (whose contacts count already); in the order of the cloud sorted by x."""
     low, high = bound[:3] - CONTACT_GAP, bound[3:] + CONTACT_GAP
-    near = columns.indices_over(low[:2], high[:2])
-    near = near[np.all((columns.points[near] >= low) & (columns.points[near] <= high), axis=1)]
-    candidates: np.ndarray = columns.points[near[np.argsort(columns.points[near, 0], kind="stable")]]
+    high[2] = min(high[2], _downward_top(box) + CONTACT_GAP)  # no point higher lies that near a downward face
+    column = columns.points[columns.indices_over(low[:2], high[:2])]
+    candidates: np.ndarray = column[np.all((column >= low) & (column <= high), axis=1)]
     if len(candidates) == 0:
         return candidates[:, :2]
     distance, normals, _, rotation = _distances(candidates, box)
@@ -258,6 +273,7 @@ def _cloud_under(columns: CloudColumns, box: Box, bound: np.ndarray, others: Seq
     away_from_edges = excess.max(axis=1) <= -0.01
     under = (distance >= 0.002) & (distance <= CONTACT_GAP) & (normals[:, 2] <= -UPWARD) & away_from_edges
     candidates = candidates[under]  # each test holds point by point: the cheapest set is checked against the others
+    candidates = candidates[np.argsort(candidates[:, 0], kind="stable")]
     for other in others:
         if len(candidates) == 0:
             break
