@@ -21,9 +21,9 @@ import time
 from pathlib import Path
 
 from rich.console import Console
-from rich.table import Table
 
 from unstack.atomic import atomic_write_text
+from unstack.cli.text import number_table
 from unstack.sim.dataset import simulate_dataset
 from unstack.sim.settings import SimulationSettings
 
@@ -50,9 +50,10 @@ def main() -> None:
     arguments = parser.parse_args()
     low, high = (int(part) for part in arguments.boxes.split("-"))
     results = [run(arguments.configs, arguments.seed, jobs, (low, high)) for jobs in (1, 2)]
-    table = Table(title=f"simulator, {low}-{high} boxes, {arguments.configs} configurations, seed {arguments.seed}")
-    for column in ("workers", "generation CPU s", "ground truth CPU s", "scan CPU s", "configs / min", "wall s"):
-        table.add_column(column, justify="right")
+    table = number_table(
+        f"simulator, {low}-{high} boxes, {arguments.configs} configurations, seed {arguments.seed}",
+        ("workers", "generation CPU s", "ground truth CPU s", "scan CPU s", "configs / min", "wall s"),
+    )
     for result in results:
         table.add_row(
             str(result["jobs"]),

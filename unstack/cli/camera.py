@@ -98,10 +98,10 @@ def scene(
     gravity frame. Decide on the result with ``unstack decide OUT``.
     """
     from rich.console import Console
-    from rich.table import Table
 
     from unstack.atomic import atomic_write_text
     from unstack.camera import load_depth, load_intrinsics, load_mask, load_pose, scene_from_depth
+    from unstack.cli.text import number_table
 
     known = _sizes(sizes)
     target = Path(out)
@@ -147,10 +147,10 @@ def scene(
     if report_file is not None:
         atomic_write_text(Path(report_file), json.dumps(built.report(), indent=2) + "\n")
     console = Console()
-    table = Table(title=f"{len(built.scene.boxes)} boxes (gravity tilted {built.frame.tilt_deg:.1f} degrees from the "
-                  "input frame's z)")  # fmt: skip
-    for column in ("box", "face", "size (m)", "position (m)", "residual (mm)", "face seen"):
-        table.add_column(column, justify="right")
+    table = number_table(
+        f"{len(built.scene.boxes)} boxes (gravity tilted {built.frame.tilt_deg:.1f} degrees from the input frame's z)",
+        ("box", "face", "size (m)", "position (m)", "residual (mm)", "face seen"),
+    )
     fits = {item.box.id: item for item in built.fitted}
     for box in built.scene.boxes:
         item = fits.get(box.id)

@@ -13,6 +13,7 @@ from unstack.cli.learning import FEATURES_HELP, ISETS_FROM_HELP
 from unstack.cli.main import MODEL_HELP, SAMPLES, SECONDS, STATICS_HELP
 from unstack.cli.options import Checked, constrained
 from unstack.cli.progress import progress_bar
+from unstack.cli.text import number_table
 from unstack.errors import UnstackError
 from unstack.experiments.belief_calibration import belief_calibration
 from unstack.experiments.camera_roundtrip import camera_roundtrip
@@ -85,9 +86,10 @@ def table1(out: str, max_n: int, full: bool) -> None:
         max_n = 7
     rows = count(range(3, max_n + 1))
     save_results(results_folder(out), "table1.json", rows)
-    table = Table(title="Table I: consistent worlds q' of n boxes")
-    for column in ("n", "all worlds q", "exact engine", "SAT listing", "paper", "OEIS A000798"):
-        table.add_column(column, justify="right")
+    table = number_table(
+        "Table I: consistent worlds q' of n boxes",
+        ("n", "all worlds q", "exact engine", "SAT listing", "paper", "OEIS A000798"),
+    )
     for row in rows:
         table.add_row(
             str(row["n"]),
@@ -148,10 +150,10 @@ def fig5a(
         feature_set=feature_set,
     )  # fmt: skip
     written = save_results(results_folder(out), "fig5a.json", result, plot_fig5a)
-    table = Table(title=f"Fig. 5a: validation relations of {data_dir} ({result['relations']} relations, "
-                  f"{result['supp']} SUPP)")  # fmt: skip
-    for column in ("", "SUPP right", "not SUPP right"):
-        table.add_column(column, justify="right")
+    table = number_table(
+        f"Fig. 5a: validation relations of {data_dir} ({result['relations']} relations, {result['supp']} SUPP)",
+        ("", "SUPP right", "not SUPP right"),
+    )
     ours = result["validation"]
     balanced = result["validation_at_balanced_threshold"]
     table.add_row("paper (Fig. 5a)", "78.4 %", "87.5 %")
@@ -230,11 +232,11 @@ def decisions(
         except ValueError as error:
             raise UnstackError(f"{pair_with}: {error}") from None
     written = save_results(folder, "decisions.json", result, plot_fig4, "fig4.png")
-    table = Table(title=f"{result['isets']} test ISets of {r} boxes ({data_dir})")
-    columns = ("decision maker", "MSE(cost)", "first pick right", "boxes moved > 2 cm", "moved - unstack's (± s.e.)",
-               "displacement (m)")  # fmt: skip
-    for column in columns:
-        table.add_column(column, justify="right")
+    table = number_table(
+        f"{result['isets']} test ISets of {r} boxes ({data_dir})",
+        ("decision maker", "MSE(cost)", "first pick right", "boxes moved > 2 cm", "moved - unstack's (± s.e.)",
+         "displacement (m)"),
+    )  # fmt: skip
     for maker in DECISION_MAKERS:
         row = result["summary"][maker]
         paired = result["against_reasoner"].get(maker, {}).get("boxes_moved")
@@ -270,9 +272,10 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
         result = real7_experiment(data_dir, model, piles=piles, progress=report)
     result["model"] = name
     written = save_results(results_folder(out), "real7.json", result)
-    table = Table(title=f"first pick right, {result['piles']} simulated 7-box piles ({data_dir})")
-    for column in ("r", "ISets", "paper", "unstack", "highest first", "random"):
-        table.add_column(column, justify="right")
+    table = number_table(
+        f"first pick right, {result['piles']} simulated 7-box piles ({data_dir})",
+        ("r", "ISets", "paper", "unstack", "highest first", "random"),
+    )
     for row in summary_rows(result):
         table.add_row(*row)
     Console().print(table)
@@ -344,16 +347,11 @@ def unload(
             )  # fmt: skip
     result["model"] = name
     written = save_results(folder, "unloading.json", result, plot_unloading)
-    table = Table(title=f"Unloading every detected box of {result['configs']} piles ({data_dir}) in the simulator")
-    for column in (
-        "decision maker",
-        "boxes moved > 2 cm per pile",
-        "minus unstack's (± s.e.)",
-        "per pick",
-        "picks moving nothing",
-        "displacement (m)",
-    ):
-        table.add_column(column, justify="right")
+    table = number_table(
+        f"Unloading every detected box of {result['configs']} piles ({data_dir}) in the simulator",
+        ("decision maker", "boxes moved > 2 cm per pile", "minus unstack's (± s.e.)", "per pick",
+         "picks moving nothing", "displacement (m)"),
+    )  # fmt: skip
     for maker in result["makers"]:
         row = result["summary"][maker]
         paired = result["against_reasoner"].get(maker, {}).get("boxes_moved")
@@ -447,9 +445,10 @@ def container(
             )  # fmt: skip
     result["model"] = name
     written = save_results(folder, "container.json", result)
-    table = Table(title=f"Emptying {result['piles']} piles of {data_dir}, detecting again before every pick")
-    for column in ("decision maker", "picks", "boxes moved", "minus unstack's", "fallen", "minus unstack's", "calm"):
-        table.add_column(column, justify="right")
+    table = number_table(
+        f"Emptying {result['piles']} piles of {data_dir}, detecting again before every pick",
+        ("decision maker", "picks", "boxes moved", "minus unstack's", "fallen", "minus unstack's", "calm"),
+    )
     for maker in result["makers"]:
         row = result["summary"][maker]
         paired = result["against_unstack"].get(maker, {})
@@ -552,10 +551,11 @@ def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, pi
         result = camera_roundtrip(data_dir, model, piles=piles, n_jobs=jobs, progress=report)
     written = save_results(folder, "camera-roundtrip.json", result)
     summary = result["summary"]
-    table = Table(title=f"Camera files to scenes: {summary['boxes']} boxes fitted from {summary['masks']} masks "
-                  f"({summary['piles']} piles of {data_dir})")  # fmt: skip
-    for column in ("figure", "median", "90th percentile"):
-        table.add_column(column, justify="right")
+    table = number_table(
+        f"Camera files to scenes: {summary['boxes']} boxes fitted from {summary['masks']} masks "
+        f"({summary['piles']} piles of {data_dir})",
+        ("figure", "median", "90th percentile"),
+    )
     table.add_row("position error (mm)", f"{1000 * summary['position_error_m_median']:.1f}",
                   f"{1000 * summary['position_error_m_p90']:.1f}")  # fmt: skip
     table.add_row(
@@ -611,9 +611,10 @@ def belief_calibration_command(
             fill=fill, view=view, n_jobs=jobs, progress=report,
         )  # fmt: skip
     written = save_results(folder, "belief-calibration.json", result)
-    table = Table(title=f"Expected against actual boxes moved per candidate ({result['piles']} piles of {data_dir})")
-    for column in ("expected", "candidates", "mean expected", "mean actual"):
-        table.add_column(column, justify="right")
+    table = number_table(
+        f"Expected against actual boxes moved per candidate ({result['piles']} piles of {data_dir})",
+        ("expected", "candidates", "mean expected", "mean actual"),
+    )
     for row in result["calibration"]["bins"]:
         upper = "" if row["predicted_to"] is None else f"{row['predicted_to']:g}"
         table.add_row(f"{row['predicted_from']:g} - {upper}", str(row["picks"]), f"{row['mean_predicted']:.2f}",
@@ -689,9 +690,10 @@ def train_disturbance_command(states: str, out: str, model_path: str | None, fol
     disturbance.metadata["training"] = {"states": str(states), "support_model": name, "seed": seed}
     save_disturbance_model(disturbance, folder / "disturbance.skops")
     save_results(folder, "disturbance.json", result)
-    table = Table(title=f"Boxes the next pick moved, held out ({result['piles']} piles, {result['records']} views)")
-    for column in ("family / view", "states", "highest", "load cost", "moves", "look-ahead"):
-        table.add_column(column, justify="right")
+    table = number_table(
+        f"Boxes the next pick moved, held out ({result['piles']} piles, {result['records']} views)",
+        ("family / view", "states", "highest", "load cost", "moves", "look-ahead"),
+    )
     for key, row in result["pick_scores"].items():
         scores = (f"{row[policy]:.3f}" for policy in ("highest", "load", "moves", "lookahead"))
         table.add_row(key, str(row["states"]), *scores)

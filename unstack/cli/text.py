@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
-__all__ = ["counted", "printable"]
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from rich.table import Table
+
+__all__ = ["counted", "number_table", "printable"]
 
 
 def printable(text: str) -> str:
@@ -27,3 +33,19 @@ def counted(number: int, noun: str) -> str:
     ('1 configuration', '3 configurations')
     """
     return f"{number:,} {noun}{'' if number == 1 else 's'}"
+
+
+def number_table(title: str, columns: Sequence[str]) -> Table:
+    """A rich table of figures: its title and its columns, each aligned right.
+
+    Examples
+    --------
+    >>> [column.header for column in number_table("Table I", ("n", "worlds")).columns]
+    ['n', 'worlds']
+    """
+    from rich.table import Table
+
+    table = Table(title=title)
+    for column in columns:
+        table.add_column(column, justify="right")
+    return table
