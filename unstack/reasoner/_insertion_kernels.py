@@ -38,19 +38,12 @@ from numba import njit
 
 @njit(cache=True, nogil=True)
 def _child_lists(
-    j: int,
-    down_set: int,
-    up_set: int,
-    downs: np.ndarray,
-    above: np.ndarray,
-    n_downs: int,
-    ups: np.ndarray,
-    n_ups: int,
-    child_downs: np.ndarray,
-    child_above: np.ndarray,
-    child_ups: np.ndarray,
+    j: int, down_set: int, up_set: int, lists: tuple[np.ndarray, np.ndarray, np.ndarray], n_downs: int, n_ups: int
 ) -> tuple[int, int]:
-    """Write the admissible lists of the child that inserts box ``j`` with ``(D, U)``."""
+    """Write the admissible lists of the child that inserts box ``j`` with ``(D, U)``: from row
+    ``j`` of ``lists`` (``downs``, ``above``, ``ups``, one row per level) into row ``j + 1``."""
+    downs, above, ups = lists[0][j], lists[1][j], lists[2][j]
+    child_downs, child_above, child_ups = lists[0][j + 1], lists[1][j + 1], lists[2][j + 1]
     bit = np.int64(1) << j
     n_child_downs = 0
     for a in range(n_downs):
@@ -89,23 +82,23 @@ def _child_lists(
 def _last_level(
     j: int,
     path_weight: float,
-    downs: np.ndarray,
-    above: np.ndarray,
-    n_downs: int,
-    ups: np.ndarray,
-    n_ups: int,
-    down_weights: np.ndarray,
-    up_weights: np.ndarray,
-    down_allowed: np.ndarray,
-    up_allowed: np.ndarray,
-    down_table: np.ndarray,
-    up_table: np.ndarray,
-    scratch_ups: np.ndarray,
-    scratch_weights: np.ndarray,
-    scratch_sums: np.ndarray,
+    node: tuple[np.ndarray, np.ndarray, int, np.ndarray, int],
+    weights: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    tables: tuple[np.ndarray, np.ndarray],
+    scratch: np.ndarray,
+    index_scratch: np.ndarray,
     world_count: np.ndarray,
 ) -> float:
-    """Sum the last box's admissible ``(D, U)`` pairs without expanding leaves."""
+    """Sum the last box's admissible ``(D, U)`` pairs without expanding leaves.
+
+    ``node``: the node's ``downs``, ``above``, their number, ``ups`` and theirs; ``weights``:
+    ``down_weights``, ``up_weights``, ``down_allowed``, ``up_allowed``; ``tables``: the per-level
+    ``D`` and ``U`` tables.
+    """
+    downs, above, n_downs, ups, n_ups = node
+    down_weights, up_weights, down_allowed, up_allowed = weights
+    down_table, up_table = tables
+    scratch_ups, scratch_weights, scratch_sums = index_scratch[0], scratch[0], scratch[1]
     n_live = 0
     for b in range(n_ups):
         if up_allowed[j, ups[b]]:
@@ -181,16 +174,10 @@ def _lattice_sums2(
 def _last_two_levels(
     m: int,
     path_weight: float,
-    downs: np.ndarray,
-    above: np.ndarray,
-    n_downs: int,
-    ups: np.ndarray,
-    n_ups: int,
-    down_weights: np.ndarray,
-    up_weights: np.ndarray,
-    down_table: np.ndarray,
-    up_table: np.ndarray,
-    tables: bool,
+    node: tuple[np.ndarray, np.ndarray, int, np.ndarray, int],
+    node_weights: tuple[np.ndarray, np.ndarray],
+    tables: tuple[np.ndarray, np.ndarray],
+    with_tables: bool,
     scratch: np.ndarray,
     index_scratch: np.ndarray,
 ) -> float:
@@ -221,8 +208,13 @@ def _last_two_levels(
     sum, its marginal contribution is scattered at the sum's argument and gathered back by
     the opposite (superset) sum.
 
-    With ``tables`` false only the sum is returned (the world count uses 0/1 weights).
+    ``node``, ``tables``: as for :func:`_last_level`; ``node_weights``: ``down_weights`` and
+    ``up_weights``. With ``with_tables`` false only the sum is returned (the world count uses
+    0/1 weights).
     """
+    downs, above, n_downs, ups, n_ups = node
+    down_weights, up_weights = node_weights
+    down_table, up_table = tables
     a_bit = np.int64(1) << m
     b = m + 1
     # cube arrays, indexed by a mask of the m earlier boxes (only up-set or down-set masks used)
@@ -414,7 +406,7 @@ def _last_two_levels(
             down_m[i] += w1 * sub
             up_m[k] += w1 * sub
             total += w1 * sub
-    if not tables:
+    if not with_tables:
         return total
     x_at[0] += x_empty
     y_at[0] += y_empty
@@ -447,20 +439,17 @@ def _next_pair(
     j: int,
     a: int,
     b: int,
-    downs: np.ndarray,
-    above: np.ndarray,
-    ups: np.ndarray,
+    lists: tuple[np.ndarray, np.ndarray, np.ndarray],
     n_downs: int,
     n_ups: int,
-    down_weights: np.ndarray,
-    up_weights: np.ndarray,
-    down_allowed: np.ndarray,
-    up_allowed: np.ndarray,
+    weights: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
 ) -> tuple[int, int]:
-    """Return the next admissible non-zero ``(D, U)`` index pair at or after ``(a, b)``.
+    """Return the next admissible non-zero ``(D, U)`` index pair of level ``j`` at or after ``(a, b)``.
 
     Returns ``(n_downs, 0)`` when the node's pairs are exhausted.
     """
+    downs, above, ups = lists
+    down_allowed, up_allowed = weights[2], weights[3]
     while a < n_downs:
         if down_allowed[j, downs[j, a]]:
             outside = ~above[j, a]
@@ -479,81 +468,30 @@ def _finish(
     j: int,
     n: int,
     path_weight: float,
-    downs: np.ndarray,
-    above: np.ndarray,
+    lists: tuple[np.ndarray, np.ndarray, np.ndarray],
     n_downs: int,
-    ups: np.ndarray,
     n_ups: int,
     weights: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
-    down_ones: np.ndarray,
-    up_ones: np.ndarray,
-    down_table: np.ndarray,
-    up_table: np.ndarray,
+    ones: tuple[np.ndarray, np.ndarray],
+    tables: tuple[np.ndarray, np.ndarray],
     scratch: np.ndarray,
     index_scratch: np.ndarray,
     world_count: np.ndarray,
     counting: bool,
 ) -> float:
-    """Weight sum of the completions of the node at level ``j``, one of the last two levels.
+    """Weight sum of the completions of the node at level ``j`` (row ``j`` of ``lists``), one of
+    the last two levels.
 
     Level ``n - 1``: the last box's pairs directly; level ``n - 2``: the last two boxes
-    by transforms, and (``counting``) their worlds again with 0/1 weights.
+    by transforms, and (``counting``) their worlds again with 0/1 weights (``ones``).
     """
-    down_weights, up_weights, down_allowed, up_allowed = weights
+    node = (lists[0][j], lists[1][j], n_downs, lists[2][j], n_ups)
     if j == n - 1:
-        return _last_level(
-            j,
-            path_weight,
-            downs,
-            above,
-            n_downs,
-            ups,
-            n_ups,
-            down_weights,
-            up_weights,
-            down_allowed,
-            up_allowed,
-            down_table,
-            up_table,
-            index_scratch[0],
-            scratch[0],
-            scratch[1],
-            world_count,
-        )
+        return _last_level(j, path_weight, node, weights, tables, scratch, index_scratch, world_count)
     if counting:
-        worlds = _last_two_levels(
-            j,
-            1.0,
-            downs,
-            above,
-            n_downs,
-            ups,
-            n_ups,
-            down_ones,
-            up_ones,
-            down_table,
-            up_table,
-            False,
-            scratch,
-            index_scratch,
-        )
+        worlds = _last_two_levels(j, 1.0, node, ones, tables, False, scratch, index_scratch)
         world_count[0] += np.int64(worlds + 0.5)
-    return _last_two_levels(
-        j,
-        path_weight,
-        downs,
-        above,
-        n_downs,
-        ups,
-        n_ups,
-        down_weights,
-        up_weights,
-        down_table,
-        up_table,
-        True,
-        scratch,
-        index_scratch,
-    )
+    return _last_two_levels(j, path_weight, node, (weights[0], weights[1]), tables, True, scratch, index_scratch)
 
 
 @njit(cache=True, nogil=True)
@@ -562,16 +500,12 @@ def _subtree(
     n: int,
     collapse: int,
     start_weight: float,
-    downs: np.ndarray,
-    above: np.ndarray,
-    ups: np.ndarray,
+    lists: tuple[np.ndarray, np.ndarray, np.ndarray],
     n_downs: np.ndarray,
     n_ups: np.ndarray,
     weights: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
-    down_ones: np.ndarray,
-    up_ones: np.ndarray,
-    down_table: np.ndarray,
-    up_table: np.ndarray,
+    ones: tuple[np.ndarray, np.ndarray],
+    tables: tuple[np.ndarray, np.ndarray],
     scratch: np.ndarray,
     index_scratch: np.ndarray,
     world_count: np.ndarray,
@@ -580,32 +514,17 @@ def _subtree(
     """Weight sum of all completions of the node at level ``start`` (lists in its row).
 
     An explicit depth-first walk (numba's on-disk cache mishandles recursive functions):
-    row ``j`` of ``downs``/``above``/``ups`` holds the lists of the current node at level
-    ``j`` and ``n_downs[j]``/``n_ups[j]`` their lengths. Nodes of level ``n - collapse``
-    are not expanded (:func:`_finish`); ``start`` must not be deeper.
+    row ``j`` of ``lists`` (``downs``, ``above``, ``ups``) holds the lists of the current node
+    at level ``j`` and ``n_downs[j]``/``n_ups[j]`` their lengths. Nodes of level
+    ``n - collapse`` are not expanded (:func:`_finish`); ``start`` must not be deeper.
     """
-    down_weights, up_weights, down_allowed, up_allowed = weights
+    downs, _, ups = lists
+    down_weights, up_weights = weights[0], weights[1]
+    down_table, up_table = tables
+    finishing = (weights, ones, tables, scratch, index_scratch, world_count, counting)
     last = n - collapse
     if start == last:
-        return _finish(
-            start,
-            n,
-            start_weight,
-            downs[start],
-            above[start],
-            n_downs[start],
-            ups[start],
-            n_ups[start],
-            weights,
-            down_ones,
-            up_ones,
-            down_table,
-            up_table,
-            scratch,
-            index_scratch,
-            world_count,
-            counting,
-        )
+        return _finish(start, n, start_weight, lists, n_downs[start], n_ups[start], *finishing)
     cursor_down = np.zeros(n, dtype=np.int64)
     cursor_up = np.zeros(n, dtype=np.int64)
     chosen_weight = np.zeros(n)
@@ -615,20 +534,7 @@ def _subtree(
     level = start
     while True:
         j = level
-        a, b = _next_pair(
-            j,
-            cursor_down[j],
-            cursor_up[j],
-            downs,
-            above,
-            ups,
-            n_downs[j],
-            n_ups[j],
-            down_weights,
-            up_weights,
-            down_allowed,
-            up_allowed,
-        )
+        a, b = _next_pair(j, cursor_down[j], cursor_up[j], lists, n_downs[j], n_ups[j], weights)
         if a < n_downs[j]:
             d = downs[j, a]
             u = ups[j, b]
@@ -636,19 +542,7 @@ def _subtree(
             cursor_down[j] = a
             cursor_up[j] = b + 1
             chosen_weight[j] = w
-            n_downs[j + 1], n_ups[j + 1] = _child_lists(
-                j,
-                d,
-                u,
-                downs[j],
-                above[j],
-                n_downs[j],
-                ups[j],
-                n_ups[j],
-                downs[j + 1],
-                above[j + 1],
-                ups[j + 1],
-            )
+            n_downs[j + 1], n_ups[j + 1] = _child_lists(j, d, u, lists, n_downs[j], n_ups[j])
             if j + 1 < last:
                 level = j + 1
                 cursor_down[level] = 0
@@ -656,25 +550,7 @@ def _subtree(
                 path_weight[level] = path_weight[j] * w
                 subtotal[level] = 0.0
                 continue
-            sub = _finish(
-                j + 1,
-                n,
-                path_weight[j] * w,
-                downs[j + 1],
-                above[j + 1],
-                n_downs[j + 1],
-                ups[j + 1],
-                n_ups[j + 1],
-                weights,
-                down_ones,
-                up_ones,
-                down_table,
-                up_table,
-                scratch,
-                index_scratch,
-                world_count,
-                counting,
-            )
+            sub = _finish(j + 1, n, path_weight[j] * w, lists, n_downs[j + 1], n_ups[j + 1], *finishing)
         else:
             if j == start:
                 return float(subtotal[j])
@@ -722,6 +598,8 @@ def collect_tasks(
     cursor_down = np.zeros(n + 1, dtype=np.int64)
     cursor_up = np.zeros(n + 1, dtype=np.int64)
     path_weight = np.ones(n + 1)
+    lists = (downs, above, ups)
+    weights = (down_weights, up_weights, down_allowed, up_allowed)
     # The root: no box placed; the only down-set and up-set is the empty one.
     n_downs[0] = 1
     n_ups[0] = 1
@@ -744,20 +622,7 @@ def collect_tasks(
                 break
             level = j - 1
             continue
-        a, b = _next_pair(
-            j,
-            cursor_down[j],
-            cursor_up[j],
-            downs,
-            above,
-            ups,
-            n_downs[j],
-            n_ups[j],
-            down_weights,
-            up_weights,
-            down_allowed,
-            up_allowed,
-        )
+        a, b = _next_pair(j, cursor_down[j], cursor_up[j], lists, n_downs[j], n_ups[j], weights)
         if a == n_downs[j]:
             if j == 0:
                 break
@@ -767,19 +632,7 @@ def collect_tasks(
         u = ups[j, b]
         cursor_down[j] = a
         cursor_up[j] = b + 1
-        n_downs[j + 1], n_ups[j + 1] = _child_lists(
-            j,
-            d,
-            u,
-            downs[j],
-            above[j],
-            n_downs[j],
-            ups[j],
-            n_ups[j],
-            downs[j + 1],
-            above[j + 1],
-            ups[j + 1],
-        )
+        n_downs[j + 1], n_ups[j + 1] = _child_lists(j, d, u, lists, n_downs[j], n_ups[j])
         level = j + 1
         cursor_down[level] = 0
         cursor_up[level] = 0
@@ -846,23 +699,7 @@ def run_task(
     for b in range(n_ups[depth]):
         ups[depth, b] = task_ups[t, b]
     subtree_sum = _subtree(
-        depth,
-        n,
-        collapse,
-        task_weight[t],
-        downs,
-        above,
-        ups,
-        n_downs,
-        n_ups,
-        weights,
-        down_ones,
-        up_ones,
-        down_table,
-        up_table,
-        scratch,
-        index_scratch,
-        world_count,
-        counting,
-    )
+        depth, n, collapse, task_weight[t], (downs, above, ups), n_downs, n_ups, weights, (down_ones, up_ones),
+        (down_table, up_table), scratch, index_scratch, world_count, counting,
+    )  # fmt: skip
     return subtree_sum, down_table, up_table, world_count[0]
