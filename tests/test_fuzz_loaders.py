@@ -22,6 +22,16 @@ REPO = Path(__file__).resolve().parents[1]
 FUZZ = settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 
 ids = st.text(min_size=1, max_size=12)
+
+
+def _saved_and_loaded(original: Supports | Scene, file: Path) -> Any:
+    """``original`` saved to ``file`` and loaded back, checked to be of its own type."""
+    original.save(file)
+    loaded = unstack.load(file)
+    assert type(loaded) is type(original)
+    return loaded
+
+
 probability = st.floats(0.0, 1.0, allow_nan=False)
 
 
@@ -38,10 +48,7 @@ def supports(draw: st.DrawFn) -> Supports:
 @FUZZ
 @given(supports())
 def test_supports_round_trip_exactly(tmp_path: Path, original: Supports) -> None:
-    file = tmp_path / "supports.json"
-    original.save(file)
-    loaded = unstack.load(file)
-    assert isinstance(loaded, Supports)
+    loaded = _saved_and_loaded(original, tmp_path / "supports.json")
     assert loaded.objects == original.objects
     np.testing.assert_array_equal(loaded.probabilities, original.probabilities)
     if original.masses is None:
@@ -73,10 +80,7 @@ def scenes(draw: st.DrawFn) -> Scene:
 @FUZZ
 @given(scenes())
 def test_scenes_round_trip_exactly(tmp_path: Path, original: Scene) -> None:
-    file = tmp_path / "scene.json"
-    original.save(file)
-    loaded = unstack.load(file)
-    assert isinstance(loaded, Scene)
+    loaded = _saved_and_loaded(original, tmp_path / "scene.json")
     assert loaded.to_dict() == original.to_dict()
     np.testing.assert_array_equal(loaded.points, original.points)
 
