@@ -9,8 +9,8 @@ Every ``import`` counts, at module level or inside a function (imports under
   detector model) above it;
 - ``reasoner``, ``learning``, ``sim`` and ``pictures`` above that, none importing another;
 - the recipe scene -> probabilities (``pipeline``) above those;
-- the public API (``unstack``, ``api``, ``describe``, ``height_veto``, ``moves``, ``picture_inputs``, ``validation``,
-  ``warmup``) above that;
+- the public API (``unstack``, ``api``, ``describe``, ``height_veto``, ``moves``, ``physics_veto``, ``picture_inputs``,
+  ``validation``, ``warmup``) above that;
 - ``experiments`` above the API; ``cli`` on top.
 """
 
@@ -31,6 +31,7 @@ API = {
     "unstack.describe",
     "unstack.height_veto",
     "unstack.moves",
+    "unstack.physics_veto",
     "unstack.picture_inputs",
     "unstack.validation",
     "unstack.warmup",

@@ -286,6 +286,7 @@ def decide(
     free_cost: float | None = None,
     statics: bool = True,
     disturbance: Any = None,
+    physics_veto: bool = False,
 ) -> Decision:
     """Which box to unload first: from a scene (through a model) or from support probabilities.
 
@@ -327,6 +328,12 @@ def decide(
         without it (:func:`support_probabilities`); ``False`` keeps the model's probabilities.
     disturbance : path-like or DisturbanceModel, optional
         With ``cost="moves"``: the disturbance model (default: the shipped one).
+    physics_veto : bool
+        For a scene, with the physics engine installed (``unstack[sim]``): try the pick in
+        belief worlds built from the scene and, where it is expected to move a box, take the
+        box holding nothing up expected to move the fewest (:func:`unstack.physics_veto.physics_veto`,
+        seeded by ``seed``; tenths of a second to seconds). Not with support probabilities or
+        the ``moves`` cost.
 
     Returns
     -------
@@ -392,7 +399,23 @@ def decide(
             near_tie_margin=near_tie_margin,
         )
         decision = _free_highest(decision, scene_or_supports, free_cost, near_tie_margin)
+    if physics_veto:
+        decision = _physics_veto(decision, scene_or_supports, cost, seed)
     return _described(decision, scene_or_supports, supports)
+
+
+def _physics_veto(decision: Decision, given: Scene | Supports, cost: str, seed: int | None) -> Decision:
+    """The pick vetoed by physics on the belief (:func:`unstack.physics_veto.physics_veto`)."""
+    from unstack.physics_veto import physics_veto
+
+    if not isinstance(given, Scene):
+        raise InvalidArgument(
+            f"{given.source}: the physics veto builds the boxes' poses and the cloud in the engine, which support "
+            "probabilities do not give; use the scene file"
+        )
+    if cost == "moves":
+        raise InvalidArgument("the physics veto tries the pick of a cost that counts boxes held up; not the moves cost")
+    return physics_veto(decision, given, seed=0 if seed is None else seed)
 
 
 def _free_highest(

@@ -34,7 +34,7 @@ from unstack.scene import Scene
 if TYPE_CHECKING:
     from unstack.reasoner.decision import Decision
 
-__all__ = ["FREE_COST", "HYBRID_MAX_COST", "free_highest", "highest_free_box", "hybrid_choice"]
+__all__ = ["FREE_COST", "HYBRID_MAX_COST", "free_highest", "highest_free_box", "hybrid_choice", "probability_below"]
 
 #: A box whose expected cost is below this counts as holding nothing up.
 FREE_COST = 0.5
@@ -139,7 +139,6 @@ def free_highest(decision: Decision, scene: Scene, *, free_cost: float = FREE_CO
     ('free', 'lean', 'free')
     """
     import dataclasses
-    import math
 
     from unstack.reasoner.arguments import check_margin
 
@@ -152,7 +151,27 @@ def free_highest(decision: Decision, scene: Scene, *, free_cost: float = FREE_CO
     if not free:
         return decision
     choice = highest_free_box(scene, costs, max_cost=free_cost, candidates=free)
-    errors = decision.expected_cost_errors
-    error = 0.0 if errors is None else float(errors[decision.objects.index(choice)])
-    below = 1.0 if error == 0.0 else 0.5 * (1.0 + math.erf((free_cost - costs[choice]) / (error * math.sqrt(2.0))))
+    below = probability_below(decision, choice, free_cost)
     return dataclasses.replace(decision, choice=choice, ties=tuple(free), free_cost=free_cost, choice_probability=below)
+
+
+def probability_below(decision: Decision, box_id: str, bound: float) -> float:
+    """The probability that the true expected cost of ``box_id`` is below ``bound``: 0 or 1 for
+    an exact cost, else normal from its standard error.
+
+    Examples
+    --------
+    >>> import unstack
+    >>> decision = unstack.decide(unstack.Supports(["a", "b"], [[0, 0.2], [0.7, 0]]))
+    >>> probability_below(decision, "a", 0.5), probability_below(decision, "b", 0.5)
+    (1.0, 0.0)
+    """
+    import math
+
+    index = decision.objects.index(box_id)
+    cost = float(decision.expected_costs[index])
+    errors = decision.expected_cost_errors
+    error = 0.0 if errors is None else float(errors[index])
+    if error == 0.0:
+        return 1.0 if cost < bound else 0.0
+    return 0.5 * (1.0 + math.erf((bound - cost) / (error * math.sqrt(2.0))))

@@ -256,6 +256,12 @@ def cli() -> None:
 @click.option("--timing", is_flag=True, help="Add wall-clock seconds to the JSON (it is canonical without them).")
 @_reasoning_options
 @FREE_COST_OPTION
+@click.option(
+    "--physics-veto", is_flag=True,
+    help="For a scene, with the physics engine (unstack[sim]): try the pick in belief worlds built from the scene "
+    "and, where it is expected to move a box, take the box holding nothing up expected to move the fewest "
+    "(tenths of a second to seconds).",
+)  # fmt: skip
 @click.option("--model", "model", default=None, help=MODEL_HELP)
 @click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)
 def decide(file: str, as_json: bool, output: str | None, timing: bool, model: str | None, **reasoning: Any) -> None:

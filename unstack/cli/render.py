@@ -71,12 +71,16 @@ def decision_view(decision: Decision) -> Group:
         headline.append(f"  (P(truly {what}) = {decision.choice_probability:.3f})")
     if len(decision.ties) > 1:
         others = ", ".join(printable(t) for t in decision.ties if t != decision.choice)
-        rule = _tie_rule(near, decision.free_cost)
+        vetoed = decision.physics_veto is not None and decision.physics_veto["vetoed"]
+        rule = "expected to move as few in the belief; the box resting highest wins" if vetoed else None
+        rule = rule or _tie_rule(near, decision.free_cost)
         headline.append(f"  (tied with {others}: {rule})")
     if decision.pick is not None:
         headline.append(f"\nwhere: {place_in_words(decision.pick)}")
     headline.append(f"\n{cost_in_words(decision.cost)}", style="dim")
     parts: list[Any] = [headline]
+    if decision.physics_veto is not None:
+        parts.append(_physics(decision.physics_veto, decision.choice))
     if decision.reasons:
         parts.append(_why(decision))
     return Group(*parts, costs, matrix, _footer(decision, model_in_words(decision.model)))
@@ -109,6 +113,27 @@ def _footer(decision: Decision, model: str) -> Text:
             f"95 % of true values lie within 2 of them; --samples {4 * max(decision.sampling['samples'])} halves them)"
         )
     return footer
+
+
+def _physics(record: dict[str, Any], choice: str) -> Text:
+    """What physics on the belief expected the pick, and the boxes tried instead, to move."""
+    tried = record["tried"]
+    pick = tried[0]
+    text = Text(
+        f"physics on what the robot sees: in {record['worlds']} belief worlds taking {printable(pick['box'])} moved "
+        f"{pick['expected_moved']:.2f} boxes on average"
+    )
+    if not record["vetoed"]:
+        text.append(f" (a veto at {record['veto_at']:g}): kept\n")
+        return text
+    others = ", ".join(f"{printable(item['box'])} {item['expected_moved']:.2f}" for item in tried[1:])
+    text.append(f" (a veto at {record['veto_at']:g}): vetoed")
+    text.append(
+        f"; tried instead {others}; {printable(choice)} moves the fewest\n"
+        if others
+        else "; no box holding nothing up to take instead\n"
+    )
+    return text
 
 
 def _why(decision: Decision) -> Text:

@@ -376,19 +376,17 @@ def container_policies(
 
     def hybrid_faces_free(scene: Scene) -> str:
         """The hybrid's pick unless the faces belief expects its removal to move a box, then that
-        belief's fewest among the boxes the reasoner believes hold nothing up."""
-        from unstack.height_veto import HYBRID_MAX_COST, hybrid_choice
-        from unstack.sim.belief import BELIEF_VETO, BELIEF_WORLDS
+        belief's fewest among the boxes the reasoner believes hold nothing up
+        (:func:`unstack.physics_veto.physics_veto` on the boxes in view)."""
+        import dataclasses
+
+        from unstack.height_veto import hybrid_choice
+        from unstack.physics_veto import physics_veto
+        from unstack.sim.unloading import in_view_scene
 
         reasoned = decision(scene, "load")
-        top = hybrid_choice(scene, reasoned)
-        top_moves = in_view_moves(scene, [top], "faces", BELIEF_WORLDS)
-        if top_moves[top] < BELIEF_VETO:
-            return top
-        costs = expected_costs(reasoned)
-        others = [box_id for box_id in scene.detected if box_id != top and costs[box_id] < HYBRID_MAX_COST]
-        moves = {**top_moves, **(in_view_moves(scene, others, "faces", BELIEF_WORLDS) if others else {})}
-        return fewest(scene, {box_id: moves.get(box_id, np.inf) for box_id in scene.detected})
+        hybrid = dataclasses.replace(reasoned, choice=hybrid_choice(scene, reasoned))
+        return str(physics_veto(hybrid, scene, seed=seed, world_scene=in_view_scene(scene)).choice)
 
     def belief_seen(scene: Scene) -> str:
         import dataclasses

@@ -154,6 +154,10 @@ class Decision:
     pick : dict or None
         Where the chosen box is (:func:`unstack.describe.pick_place`): its centre and top
         for a scene, its resting height for supports with heights.
+    physics_veto : dict or None
+        When physics on the belief tried the pick (:func:`unstack.physics_veto.physics_veto`):
+        the boxes tried with the boxes each is expected to move, and whether the reasoner's
+        pick was vetoed.
 
     Examples
     --------
@@ -187,6 +191,7 @@ class Decision:
     disturbance_model: str = ""
     model: str = ""
     pick: dict[str, Any] | None = None
+    physics_veto: dict[str, Any] | None = None
 
     def ranking(self) -> list[tuple[str, float, float]]:
         """Every box with its expected cost and that cost's standard error, best first.
@@ -255,6 +260,8 @@ class Decision:
             data["near_tie_margin"] = self.near_tie_margin
         if self.free_cost:
             data["free_cost"] = self.free_cost
+        if self.physics_veto is not None:
+            data["physics_veto"] = self.physics_veto
         data["components"] = [list(group) for group in self.components]
         data["component_methods"] = list(self.component_methods)
         if self.expected_cost_errors is not None and self.marginal_errors is not None:

@@ -97,6 +97,7 @@ __all__ = [
     "belief_blocks",
     "belief_choice",
     "belief_removals",
+    "belief_settings",
     "choose_by_expected_moves",
     "occlusion_blocks",
     "scaled_occupancy",
@@ -306,7 +307,7 @@ def occlusion_blocks(scene: Scene, settings: Any = None) -> list[BeliefBlock]:
     """
     from unstack.understanding.occlusion import occluded_space
 
-    simulation = _settings(scene, settings)
+    simulation = belief_settings(scene, settings)
     container = simulation.container
     interior = [[0.0, -container.width / 2.0, 0.0], [container.depth, container.width / 2.0, container.height]]
     space = occluded_space(
@@ -391,7 +392,9 @@ def _faced(blocks: Sequence[BeliefBlock], behind: np.ndarray) -> tuple[list[Beli
     return fronts, rests
 
 
-def _settings(scene: Scene, settings: Any) -> Any:
+def belief_settings(scene: Scene, settings: Any = None) -> Any:
+    """The simulation settings belief worlds of ``scene`` are built with: ``settings`` when
+    given, else a simulated scene's own (``metadata.settings``), else the defaults."""
     from unstack.sim.settings import SimulationSettings
 
     if settings is not None:
@@ -624,7 +627,7 @@ def belief_removals(
         raise UnstackError(f"unknown belief fill {fill!r}; expected one of {', '.join(FILLS)}")
     if not 0.0 <= occupancy <= 1.0:
         raise UnstackError(f"occupancy must lie between 0 and 1, got {occupancy}")
-    simulation = _settings(scene, settings)
+    simulation = belief_settings(scene, settings)
     rng = np.random.default_rng(seed)
     if fill in ("sampled", "scaled", "faces"):
         from unstack.understanding.occlusion import THINNEST  # the rest of a block split at a face may be thinner
