@@ -19,7 +19,7 @@ a pick for 5 detected boxes (benchmarks page).
 The scene must be in the container frame of the simulator (x from the door inwards, y across
 the container about its middle, the floor at z = 0): the container's walls of the scene's
 simulation settings (a simulated scene's own, else the defaults) stand in the belief worlds,
-and a detected box outside them (or beyond the floor's apron in front of the door) is refused.
+and a detected box beyond them is refused (boxes may spill out of the door: x < 0).
 
 Examples
 --------
@@ -66,18 +66,18 @@ def _check_in_container(scene: Scene) -> None:
     """Refuse a scene whose detected boxes lie outside the container the belief worlds build."""
     from unstack.geometry import bounding_boxes
     from unstack.sim.belief import belief_settings
-    from unstack.sim.world import APRON
 
     container = belief_settings(scene).container
-    low = np.array([-APRON, -container.width / 2.0, 0.0])  # the floor reaches out over an apron before the door
+    # boxes may spill out of the door (x < 0) onto the floor before it, nowhere else
+    low = np.array([-np.inf, -container.width / 2.0, 0.0])
     high = np.array([container.depth, container.width / 2.0, container.height])
     slack = 0.02  # poses from a camera reach a little into the walls
     for box_id, bounds in zip(scene.detected, bounding_boxes([scene.box(b) for b in scene.detected]), strict=True):
         if np.any(bounds[:3] < low - slack) or np.any(bounds[3:] > high + slack):
             raise InvalidArgument(
-                f"{scene.source}: box {box_id!r} lies outside the container the physics veto builds (x from "
-                f"{-APRON:g} m, the floor before the door, to {container.depth:g} m, y within {container.width / 2:g} "
-                f"m of the middle, z 0 to {container.height:g} m); the veto needs the scene in that frame"
+                f"{scene.source}: box {box_id!r} lies outside the container the physics veto builds (x up to "
+                f"{container.depth:g} m from the door, y within {container.width / 2:g} m of the middle, z 0 to "
+                f"{container.height:g} m); the veto needs the scene in that frame"
             )
 
 
