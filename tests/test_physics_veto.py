@@ -11,7 +11,7 @@ from jsonschema import Draft202012Validator
 
 import unstack
 from tests.conftest import unstack as run_unstack
-from unstack.errors import InvalidArgument
+from unstack.errors import InvalidArgument, UnstackError
 from unstack.geometry import bounding_boxes
 from unstack.height_veto import FREE_COST
 from unstack.jsonio import load_schema
@@ -87,6 +87,19 @@ def test_a_box_outside_the_container_is_refused_with_the_container_it_would_need
         physics_veto(decision, scene)
     with pytest.raises(InvalidArgument, match=r"boxes \['ghost'\] are not detected"):
         physics_veto(dataclasses.replace(decision, objects=("ghost", "inside")), scene)
+
+
+def test_a_deeper_container_is_read_from_the_scene_and_a_wrong_one_refused() -> None:
+    boxes = [Box("low", [0.4, 0.4, 0.3], [9.0, 0.0, 0.15]), Box("top", [0.4, 0.4, 0.3], [9.0, 0.0, 0.45])]
+    shallow = Scene(boxes, np.zeros((0, 3)), ["low", "top"], source="deep.json")
+    with pytest.raises(InvalidArgument, match=r"deep.json: box 'low' lies outside .* metadata.container"):
+        unstack.decide(shallow, seed=0, physics_veto=True)
+    deep = dataclasses.replace(shallow, metadata={"container": {"depth": 12.0, "width": 2.35, "height": 2.39}})
+    decided = unstack.decide(deep, seed=0, physics_veto=True)
+    assert decided.choice == "top" and decided.physics_veto is not None and not decided.physics_veto["vetoed"]
+    wrong = dataclasses.replace(shallow, metadata={"container": {"depth": -1.0, "width": 2.35, "height": 2.39}})
+    with pytest.raises(UnstackError, match=r"deep.json: \$\.metadata\.container\[0\]: expected a positive number"):
+        unstack.decide(wrong, seed=0, physics_veto=True)
 
 
 def test_the_cli_says_what_the_belief_expects_and_refuses_a_supports_file(small_dataset: Path) -> None:

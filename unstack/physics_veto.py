@@ -17,9 +17,10 @@ every seen box detected, 1.41 +- 0.27 fewer with a detector missing half the box
 a pick for 5 detected boxes (benchmarks page).
 
 The scene must be in the container frame of the simulator (x from the door inwards, y across
-the container about its middle, the floor at z = 0): the container's walls of the scene's
-simulation settings (a simulated scene's own, else the defaults) stand in the belief worlds,
-and a detected box beyond them is refused (boxes may spill out of the door: x < 0).
+the container about its middle, the floor at z = 0): the container's walls stand in the belief
+worlds (:func:`world_settings`: a simulated scene's own, the scene's ``metadata.container``, else
+the simulator's 2 m section), and a detected box beyond them is refused (boxes may spill out of
+the door: x < 0).
 
 Examples
 --------
@@ -45,7 +46,7 @@ from unstack.scene import Scene
 if TYPE_CHECKING:
     from unstack.reasoner.decision import Decision
 
-__all__ = ["PHYSICS_FILL", "PHYSICS_VETO", "PHYSICS_WORLDS", "physics_veto"]
+__all__ = ["PHYSICS_FILL", "PHYSICS_VETO", "PHYSICS_WORLDS", "physics_veto", "world_settings"]
 
 #: Belief worlds the pick (and, when it is vetoed, each alternative) is tried in.
 PHYSICS_WORLDS = 4
@@ -55,19 +56,59 @@ PHYSICS_VETO = 1.0
 PHYSICS_FILL = "faces"
 
 
-def _expected_moved(world_scene: Scene, boxes: list[str], seed: int) -> dict[str, float]:
+def _expected_moved(world_scene: Scene, boxes: list[str], seed: int, settings: Any) -> dict[str, float]:
     from unstack.sim.belief import belief_removals
 
-    outcomes = belief_removals(world_scene, boxes, worlds=PHYSICS_WORLDS, fill=PHYSICS_FILL, seed=seed)
+    outcomes = belief_removals(
+        world_scene, boxes, worlds=PHYSICS_WORLDS, fill=PHYSICS_FILL, seed=seed, settings=settings
+    )
     return {box_id: float(outcome.expected_moved) for box_id, outcome in outcomes.items()}
 
 
-def _check_in_container(scene: Scene) -> None:
+def world_settings(scene: Scene) -> Any:
+    """The simulation settings the belief worlds of ``scene`` are built with: a simulated scene's
+    own, else the defaults; ``metadata.container`` (``depth``, ``width``, ``height`` in metres)
+    sets the container's inner extent.
+
+    Raises
+    ------
+    InvalidScene
+        ``metadata.container`` is not three positive extents.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from unstack.scene import Box
+    >>> box = Box("a", [0.4, 0.4, 0.4], [9.0, 0.0, 0.2])
+    >>> deep = {"container": {"depth": 12.0, "width": 2.35, "height": 2.39}}  # a 40-foot container
+    >>> scene = Scene([box], np.zeros((0, 3)), ["a"], metadata=deep)
+    >>> world_settings(scene).container.depth
+    12.0
+    """
+    from unstack.checks import check_vector
+    from unstack.sim.belief import belief_settings
+    from unstack.sim.settings import Container
+
+    settings = belief_settings(scene)
+    given = scene.metadata.get("container")
+    if given is None:
+        return settings
+    keys = ("depth", "width", "height")
+    if not isinstance(given, dict) or sorted(given) != sorted(keys):
+        from unstack.errors import InvalidScene
+
+        raise InvalidScene(scene.source, "$.metadata.container", f"expected an object with {', '.join(keys)}")
+    extent = check_vector(
+        [given[key] for key in keys], 3, positive=True, source=scene.source, path="$.metadata.container"
+    )
+    return dataclasses.replace(settings, container=Container(*(float(value) for value in extent)))
+
+
+def _check_in_container(scene: Scene, settings: Any) -> None:
     """Refuse a scene whose detected boxes lie outside the container the belief worlds build."""
     from unstack.geometry import bounding_boxes
-    from unstack.sim.belief import belief_settings
 
-    container = belief_settings(scene).container
+    container = settings.container
     # boxes may spill out of the door (x < 0) onto the floor before it, nowhere else
     low = np.array([-np.inf, -container.width / 2.0, 0.0])
     high = np.array([container.depth, container.width / 2.0, container.height])
@@ -77,7 +118,8 @@ def _check_in_container(scene: Scene) -> None:
             raise InvalidArgument(
                 f"{scene.source}: box {box_id!r} lies outside the container the physics veto builds (x up to "
                 f"{container.depth:g} m from the door, y within {container.width / 2:g} m of the middle, z 0 to "
-                f"{container.height:g} m); the veto needs the scene in that frame"
+                f"{container.height:g} m): a pose error, a scene in another frame, or another container (give its "
+                "inner extent in the scene's metadata.container: depth, width, height)"
             )
 
 
@@ -130,15 +172,16 @@ def physics_veto(
     if missing:
         raise InvalidArgument(f"{scene.source}: the decision's boxes {missing} are not detected boxes of the scene")
     built = scene if world_scene is None else world_scene
-    _check_in_container(built)
+    settings = world_settings(built)
+    _check_in_container(built, settings)
     pick = decision.choice
-    expected = _expected_moved(built, [pick], seed)
+    expected = _expected_moved(built, [pick], seed, settings)
     vetoed = expected[pick] >= PHYSICS_VETO
     if vetoed:
         costs = dict(zip(decision.objects, (float(cost) for cost in decision.expected_costs), strict=True))
         others = [box_id for box_id in decision.objects if box_id != pick and costs[box_id] < free_cost]
         if others:
-            expected.update(_expected_moved(built, others, seed))
+            expected.update(_expected_moved(built, others, seed, settings))
     record = _record(expected, pick, vetoed)
     if not vetoed:
         return dataclasses.replace(decision, physics_veto=record)
