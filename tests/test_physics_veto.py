@@ -102,6 +102,25 @@ def test_a_deeper_container_is_read_from_the_scene_and_a_wrong_one_refused() -> 
         unstack.decide(wrong, seed=0, physics_veto=True)
 
 
+WITHOUT_PYBULLET = """
+import sys
+sys.modules["pybullet"] = None  # as if it were not installed: importing it raises ImportError
+sys.argv = ["unstack", "decide", {file!r}, "--physics-veto"]
+from unstack.cli.main import main
+main()
+"""
+
+
+def test_without_the_physics_engine_the_veto_is_one_line_saying_what_to_install() -> None:
+    import subprocess
+    import sys
+
+    probe = WITHOUT_PYBULLET.format(file=str(PILE5))
+    result = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300, cwd=REPO)
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert "pip install 'unstack[sim]'" in result.stderr
+
+
 def test_the_cli_says_what_the_belief_expects_and_refuses_a_supports_file(small_dataset: Path) -> None:
     vetoed = run_unstack("decide", str(small_dataset / "config-0005.json"), "--physics-veto", "--seed", "0")
     assert vetoed.returncode == 0, vetoed.stderr
