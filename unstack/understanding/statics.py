@@ -262,7 +262,7 @@ def _cloud_under(columns: CloudColumns, box: Box, bound: np.ndarray, others: Seq
     visible faces, noisy near the edges, are not taken for something under it), and not on
     a detected box (whose contacts count already); in the order of the cloud sorted by x."""
     low, high = bound[:3] - CONTACT_GAP, bound[3:] + CONTACT_GAP
-    high[2] = min(high[2], _downward_top(box) + CONTACT_GAP)  # no point higher lies that near a downward face
+    high[2] = min(high[2], _downward_top(box) + CONTACT_GAP + 1e-9)  # none higher lies that near a downward face
     column = columns.points[columns.indices_over(low[:2], high[:2])]
     candidates: np.ndarray = column[np.all((column >= low) & (column <= high), axis=1)]
     if len(candidates) == 0:
