@@ -165,9 +165,19 @@ def physics_veto(
         container.
     UnstackError
         The physics engine is not installed.
+
+    Examples
+    --------
+    >>> import unstack
+    >>> scene = unstack.load("examples/pile5.scene.json")
+    >>> kept = physics_veto(unstack.decide(scene, seed=0), scene, seed=0)
+    >>> kept.physics_veto["vetoed"], kept.choice == unstack.decide(scene, seed=0).choice
+    (False, True)
     """
     from unstack.geometry import bounding_boxes
+    from unstack.reasoner.arguments import check_margin
 
+    free_cost = check_margin(free_cost, "free_cost")
     missing = [box_id for box_id in decision.objects if box_id not in scene.detected]
     if missing:
         raise InvalidArgument(f"{scene.source}: the decision's boxes {missing} are not detected boxes of the scene")
