@@ -362,6 +362,7 @@ def decide(
 
     if free_cost is not None:
         free_cost = check_margin(free_cost, "free_cost")
+    veto_scene = _physics_veto_scene(scene_or_supports, cost) if physics_veto else None
     supports = _supports(scene_or_supports, model, statics)
     if cost == "moves":
         if not isinstance(scene_or_supports, Scene):
@@ -399,15 +400,18 @@ def decide(
             near_tie_margin=near_tie_margin,
         )
         decision = _free_highest(decision, scene_or_supports, free_cost, near_tie_margin)
-    if physics_veto:
-        decision = _physics_veto(decision, scene_or_supports, cost, seed)
+    if veto_scene is not None:
+        from unstack.height_veto import FREE_COST
+        from unstack.physics_veto import physics_veto as vetoed
+
+        seeded = 0 if seed is None else seed
+        decision = vetoed(decision, veto_scene, seed=seeded, free_cost=decision.free_cost or FREE_COST)
     return _described(decision, scene_or_supports, supports)
 
 
-def _physics_veto(decision: Decision, given: Scene | Supports, cost: str, seed: int | None) -> Decision:
-    """The pick vetoed by physics on the belief (:func:`unstack.physics_veto.physics_veto`)."""
-    from unstack.physics_veto import physics_veto
-
+def _physics_veto_scene(given: Scene | Supports, cost: str) -> Scene:
+    """The scene a physics veto runs on, refused before any work where it cannot run: no poses,
+    or the moves cost."""
     if not isinstance(given, Scene):
         raise InvalidArgument(
             f"{given.source}: the physics veto builds the boxes' poses and the cloud in the engine, which support "
@@ -415,7 +419,7 @@ def _physics_veto(decision: Decision, given: Scene | Supports, cost: str, seed: 
         )
     if cost == "moves":
         raise InvalidArgument("the physics veto tries the pick of a cost that counts boxes held up; not the moves cost")
-    return physics_veto(decision, given, seed=0 if seed is None else seed)
+    return given
 
 
 def _free_highest(
