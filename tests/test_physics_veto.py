@@ -83,10 +83,26 @@ def test_a_box_outside_the_container_is_refused_with_the_container_it_would_need
     boxes = [Box("inside", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2]), Box("beyond", [0.4, 0.4, 0.4], [1.0, 3.0, 0.2])]
     scene = Scene(boxes, np.zeros((0, 3)), ["inside", "beyond"], source="far.json")
     decision = unstack.decide(scene, seed=0)
-    with pytest.raises(InvalidArgument, match=r"far.json: box 'beyond' lies outside the container .* y within 1.175"):
+    with pytest.raises(
+        InvalidArgument,
+        match=r"far.json: box 'beyond' lies outside the container .* y within 1.175 m .* by 2.03 m, more than its own",
+    ):
         physics_veto(decision, scene)
     with pytest.raises(InvalidArgument, match=r"boxes \['ghost'\] are not detected"):
         physics_veto(dataclasses.replace(decision, objects=("ghost", "inside")), scene)
+
+
+def test_a_box_reaching_into_a_wall_is_slid_inside_recorded_and_warned_about() -> None:
+    # 'side' reaches 0.10 m into the wall at y = -1.175 (a camera's fit of a box seen in part)
+    boxes = [Box("low", [0.4, 0.4, 0.3], [1.0, 0.0, 0.15]), Box("side", [0.4, 0.4, 0.3], [1.0, -1.075, 0.15])]
+    scene = Scene(boxes, np.zeros((0, 3)), ["low", "side"], source="wall.json")
+    decided = unstack.decide(scene, seed=0, physics_veto=True)
+    assert decided.physics_veto is not None
+    assert decided.physics_veto["slid_inside"] == {"side": pytest.approx(0.10, abs=1e-9)}
+    assert any("slid inside for the belief worlds (side 0.10 m)" in warning for warning in decided.warnings)
+    Draft202012Validator(load_schema("unstack.decision/1")).validate(decided.to_dict())
+    nearly = Scene([boxes[0], Box("side", [0.4, 0.4, 0.3], [1.0, -0.99, 0.15])], np.zeros((0, 3)), ["low", "side"])
+    assert "slid_inside" not in unstack.decide(nearly, seed=0, physics_veto=True).physics_veto  # within 2 cm
 
 
 def test_a_deeper_container_is_read_from_the_scene_and_a_wrong_one_refused() -> None:

@@ -19,8 +19,10 @@ a pick for 5 detected boxes (benchmarks page).
 The scene must be in the container frame of the simulator (x from the door inwards, y across
 the container about its middle, the floor at z = 0): the container's walls stand in the belief
 worlds (:func:`world_settings`: a simulated scene's own, the scene's ``metadata.container``, else
-the simulator's 2 m section), and a detected box beyond them is refused (boxes may spill out of
-the door: x < 0).
+the simulator's 2 m section). A detected box that reaches into them is slid inside for the belief
+worlds and the decision warns (a camera's fit of a box seen in part guesses its unseen extent);
+one beyond them by more than its own longest side is refused (boxes may spill out of the door:
+x < 0).
 
 Examples
 --------
@@ -54,6 +56,11 @@ PHYSICS_WORLDS = 4
 PHYSICS_VETO = 1.0
 #: What stands in the space the sensor cannot see (:data:`unstack.sim.belief.FILLS`).
 PHYSICS_FILL = "faces"
+#: A detected box may reach this far (metres) into the container's walls, floor or ceiling and
+#: stay where it is (poses from a camera do); further, it is slid inside for the belief worlds
+#: (a box seen in part is placed from the part seen, its unseen extent a guess) and the
+#: decision warns, and beyond by more than its own longest side it is refused.
+WALL_SLACK = 0.02
 
 
 def _expected_moved(world_scene: Scene, boxes: list[str], seed: int, settings: Any) -> dict[str, float]:
@@ -104,23 +111,38 @@ def world_settings(scene: Scene) -> Any:
     return dataclasses.replace(settings, container=Container(*(float(value) for value in extent)))
 
 
-def _check_in_container(scene: Scene, settings: Any) -> None:
-    """Refuse a scene whose detected boxes lie outside the container the belief worlds build."""
+def _inside_container(scene: Scene, settings: Any) -> tuple[Scene, dict[str, float]]:
+    """``scene`` with every detected box that reaches into the container's walls, floor or ceiling
+    slid inside by the least shift, and the shifts (metres) of those slid more than
+    :data:`WALL_SLACK`; a box beyond them by more than its own longest side is refused."""
     from unstack.geometry import bounding_boxes
 
     container = settings.container
     # boxes may spill out of the door (x < 0) onto the floor before it, nowhere else
     low = np.array([-np.inf, -container.width / 2.0, 0.0])
     high = np.array([container.depth, container.width / 2.0, container.height])
-    slack = 0.02  # poses from a camera reach a little into the walls
+    boxes = {box.id: box for box in scene.boxes}
+    slid: dict[str, float] = {}
     for box_id, bounds in zip(scene.detected, bounding_boxes([scene.box(b) for b in scene.detected]), strict=True):
-        if np.any(bounds[:3] < low - slack) or np.any(bounds[3:] > high + slack):
+        below, above = np.maximum(low - bounds[:3], 0.0), np.maximum(bounds[3:] - high, 0.0)
+        shift = below - above
+        distance = float(np.linalg.norm(shift))
+        if distance <= WALL_SLACK:
+            continue
+        box = scene.box(box_id)
+        if np.any((below > 0) & (above > 0)) or distance > float(np.max(box.size)):
             raise InvalidArgument(
                 f"{scene.source}: box {box_id!r} lies outside the container the physics veto builds (x up to "
                 f"{container.depth:g} m from the door, y within {container.width / 2:g} m of the middle, z 0 to "
-                f"{container.height:g} m): a pose error, a scene in another frame, or another container (give its "
-                "inner extent in the scene's metadata.container: depth, width, height)"
+                f"{container.height:g} m) by {distance:.2f} m, more than its own size: a pose error, a scene in "
+                "another frame, or another container (give its inner extent in the scene's metadata.container: "
+                "depth, width, height)"
             )
+        boxes[box_id] = dataclasses.replace(box, position=np.asarray(box.position) + shift)
+        slid[box_id] = distance
+    if not slid:
+        return scene, slid
+    return dataclasses.replace(scene, boxes=tuple(boxes[box.id] for box in scene.boxes)), slid
 
 
 def physics_veto(
@@ -162,7 +184,9 @@ def physics_veto(
     ------
     InvalidArgument
         A box of the decision not detected in the scene, or a detected box outside the
-        container.
+        container by more than its own longest side (one reaching less far into a wall is
+        slid inside for the belief worlds, listed in ``physics_veto["slid_inside"]`` and
+        warned about).
     UnstackError
         The physics engine is not installed.
 
@@ -181,9 +205,8 @@ def physics_veto(
     missing = [box_id for box_id in decision.objects if box_id not in scene.detected]
     if missing:
         raise InvalidArgument(f"{scene.source}: the decision's boxes {missing} are not detected boxes of the scene")
-    built = scene if world_scene is None else world_scene
-    settings = world_settings(built)
-    _check_in_container(built, settings)
+    settings = world_settings(scene if world_scene is None else world_scene)
+    built, slid = _inside_container(scene if world_scene is None else world_scene, settings)
     pick = decision.choice
     expected = _expected_moved(built, [pick], seed, settings)
     vetoed = expected[pick] >= PHYSICS_VETO
@@ -193,14 +216,20 @@ def physics_veto(
         if others:
             expected.update(_expected_moved(built, others, seed, settings))
     record = _record(expected, pick, vetoed)
+    warnings = decision.warnings
+    if slid:
+        record["slid_inside"] = {box_id: round(distance, 6) for box_id, distance in slid.items()}
+        reached = ", ".join(f"{box_id} {distance:.2f} m" for box_id, distance in slid.items())
+        warnings = (*warnings, f"physics veto: boxes reaching into the container's walls were slid inside for the "
+                    f"belief worlds ({reached}); check their poses or give the container's inner extent")  # fmt: skip
     if not vetoed:
-        return dataclasses.replace(decision, physics_veto=record)
+        return dataclasses.replace(decision, physics_veto=record, warnings=warnings)
     resting = {box_id: float(bounding_boxes([scene.box(box_id)])[0, 2]) for box_id in expected}
     choice = min(expected, key=lambda box_id: (expected[box_id], -resting[box_id], box_id))
     fewest = tuple(sorted(box_id for box_id in expected if expected[box_id] == expected[choice]))
     below = probability_below(decision, choice, decision.free_cost) if decision.free_cost else 1.0
     return dataclasses.replace(
-        decision, choice=choice, ties=fewest, choice_probability=below, physics_veto=record,
+        decision, choice=choice, ties=fewest, choice_probability=below, physics_veto=record, warnings=warnings,
     )  # fmt: skip
 
 
