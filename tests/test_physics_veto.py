@@ -59,6 +59,18 @@ def test_a_vetoed_pick_goes_to_the_box_holding_nothing_up_expected_to_move_fewes
     assert vetoes >= 1, "no pile of the small data set has a pick the belief vetoes"
 
 
+def test_a_lower_veto_vetoes_whatever_the_default_veto_does_and_is_recorded(small_dataset: Path) -> None:
+    scene = unstack.load(small_dataset / "config-0005.json")
+    default = unstack.decide(scene, seed=0)
+    usual, low = (physics_veto(default, scene, seed=0, veto_at=level) for level in (PHYSICS_VETO, 0.25))
+    assert low.physics_veto is not None and usual.physics_veto is not None
+    assert low.physics_veto["veto_at"] == 0.25 and usual.physics_veto["veto_at"] == PHYSICS_VETO
+    assert low.physics_veto["tried"][0] == usual.physics_veto["tried"][0]  # the same worlds for the pick
+    assert low.physics_veto["vetoed"] >= usual.physics_veto["vetoed"]
+    with pytest.raises(InvalidArgument, match="veto_at must be positive"):
+        physics_veto(default, scene, veto_at=0.0)
+
+
 def test_the_same_seed_gives_the_same_worlds_and_choice(small_dataset: Path) -> None:
     scene = unstack.load(small_dataset / "config-0005.json")
     first, second = (unstack.decide(scene, seed=3, physics_veto=True).to_dict() for _ in range(2))

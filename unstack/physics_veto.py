@@ -152,6 +152,7 @@ def physics_veto(
     seed: int = 0,
     world_scene: Scene | None = None,
     free_cost: float = FREE_COST,
+    veto_at: float = PHYSICS_VETO,
 ) -> Decision:
     """The decision with its pick vetoed where physics on the belief expects it to move boxes.
 
@@ -169,6 +170,9 @@ def physics_veto(
         the candidates (the closed loop's boxes in view); default ``scene``.
     free_cost : float
         The alternatives to a vetoed pick: the boxes whose expected cost is below it.
+    veto_at : float
+        A pick expected to move at least this many boxes is vetoed (positive; default
+        :data:`PHYSICS_VETO`).
 
     Returns
     -------
@@ -202,6 +206,8 @@ def physics_veto(
     from unstack.reasoner.arguments import check_margin
 
     free_cost = check_margin(free_cost, "free_cost")
+    if not check_margin(veto_at, "veto_at") > 0:
+        raise InvalidArgument(f"veto_at must be positive (a pick moving no box is never vetoed), got {veto_at!r}")
     missing = [box_id for box_id in decision.objects if box_id not in scene.detected]
     if missing:
         raise InvalidArgument(f"{scene.source}: the decision's boxes {missing} are not detected boxes of the scene")
@@ -209,13 +215,13 @@ def physics_veto(
     built, slid = _inside_container(scene if world_scene is None else world_scene, settings)
     pick = decision.choice
     expected = _expected_moved(built, [pick], seed, settings)
-    vetoed = expected[pick] >= PHYSICS_VETO
+    vetoed = expected[pick] >= veto_at
     if vetoed:
         costs = dict(zip(decision.objects, (float(cost) for cost in decision.expected_costs), strict=True))
         others = [box_id for box_id in decision.objects if box_id != pick and costs[box_id] < free_cost]
         if others:
             expected.update(_expected_moved(built, others, seed, settings))
-    record = _record(expected, pick, vetoed)
+    record = _record(expected, pick, vetoed, veto_at)
     warnings = decision.warnings
     if slid:
         record["slid_inside"] = {box_id: round(distance, 6) for box_id, distance in slid.items()}
@@ -233,12 +239,12 @@ def physics_veto(
     )  # fmt: skip
 
 
-def _record(expected: Mapping[str, float], pick: str, vetoed: bool) -> dict[str, Any]:
+def _record(expected: Mapping[str, float], pick: str, vetoed: bool, veto_at: float) -> dict[str, Any]:
     """The ``physics_veto`` object of ``unstack.decision/1``."""
     return {
         "fill": PHYSICS_FILL,
         "worlds": PHYSICS_WORLDS,
-        "veto_at": PHYSICS_VETO,
+        "veto_at": veto_at,
         "vetoed": vetoed,
         "tried": [{"box": box_id, "expected_moved": round(moved, 6)} for box_id, moved in expected.items()],
     }

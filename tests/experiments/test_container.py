@@ -78,7 +78,7 @@ def test_the_hybrid_takes_the_highest_box_the_model_does_not_believe_loaded() ->
     assert policies["hybrid"](scene) == "free"
 
 
-@pytest.mark.parametrize("maker", ["hybrid_faces_veto", "hybrid_faces_free"])
+@pytest.mark.parametrize("maker", ["hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any", "hybrid_moves_free"])
 def test_the_hybrid_vetoes_start_from_the_hybrids_pick_not_the_highest_box(maker: str) -> None:
     policies = container_policies(load_model(default_model_path()), seed=0, makers=(maker,))
     assert policies[maker](_tall_loaded_and_short_free()) == "free"  # its removal moves nothing

@@ -112,6 +112,13 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     the same, the alternatives to a vetoed pick only the boxes the reasoner believes hold
     nothing up (expected cost below :data:`~unstack.height_veto.HYBRID_MAX_COST`); the faces
     belief's fewest among them.
+``hybrid_faces_free_any``
+    the same, vetoed where the pick moves a box in any of the belief worlds (expected moves
+    of at least one box over :data:`~unstack.physics_veto.PHYSICS_WORLDS`).
+``hybrid_moves_free``
+    the default's pick unless the disturbance model (``moves``) expects its removal to move
+    :data:`~unstack.moves.MOVES_VETO` boxes or more; then the fewest expected moves among the
+    boxes the reasoner believes hold nothing up.
 
 Metrics per pile and per maker: boxes moved more than 2 cm, boxes fallen (dropped more than
 0.2 m or tipped more than 45 degrees), the share of picks that move nothing, and paired
@@ -163,7 +170,8 @@ CONTAINER_MAKERS = (
     "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_fixed", "belief_seen", "belief_occlusion",
     "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
-    "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free",
+    "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any",
+    "hybrid_moves_free",
 )  # fmt: skip
 #: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
 #: run only when named.
@@ -174,12 +182,15 @@ ORACLE_MAKERS = ("rebuilt", "rebuilt_typical", "rebuilt_draws", "rebuilt_hidden_
 TRIED_MAKERS = (
     "belief_occlusion", "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
-    "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free",
+    "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any",
+    "hybrid_moves_free",
 )  # fmt: skip
 #: The makers run when none are named.
 DEFAULT_CONTAINER_MAKERS = tuple(
     maker for maker in CONTAINER_MAKERS if maker not in ORACLE_MAKERS and maker not in TRIED_MAKERS
 )
+#: Makers that read the disturbance model (:mod:`unstack.moves`).
+MOVES_MAKERS = ("moves", "moves_veto", "hybrid_moves_free")
 #: Makers whose policy is told what every candidate's removal does in the engine (the true pile).
 PROBING_MAKERS = ("lookahead",)
 #: Recorded sweeps per sampled group in each decision: 512 when a sweep re-inserted every box,
@@ -212,6 +223,7 @@ def container_policies(
     (those of :data:`PROBING_MAKERS` take the probe's outcomes as well); ``occupancy``: the
     ``sampled`` fill's (default :data:`~unstack.sim.belief.OCCUPANCY`)."""
     from unstack.experiments.decisions import free_pick
+    from unstack.physics_veto import PHYSICS_VETO, PHYSICS_WORLDS
     from unstack.sim.belief import OCCUPANCY
 
     kept_share = OCCUPANCY if occupancy is None else occupancy
@@ -374,19 +386,45 @@ def container_policies(
 
         return policy
 
-    def hybrid_faces_free(scene: Scene) -> str:
-        """The hybrid's pick unless the faces belief expects its removal to move a box, then that
-        belief's fewest among the boxes the reasoner believes hold nothing up
-        (:func:`unstack.physics_veto.physics_veto` on the boxes in view)."""
-        import dataclasses
+    def faces_free(veto_at: float) -> Callable[[Scene], str]:
+        def policy(scene: Scene) -> str:
+            """The hybrid's pick unless the faces belief expects its removal to move ``veto_at``
+            boxes, then that belief's fewest among the boxes the reasoner believes hold nothing
+            up (:func:`unstack.physics_veto.physics_veto` on the boxes in view)."""
+            import dataclasses
 
-        from unstack.height_veto import hybrid_choice
-        from unstack.physics_veto import physics_veto
-        from unstack.sim.unloading import in_view_scene
+            from unstack.height_veto import hybrid_choice
+            from unstack.physics_veto import physics_veto
+            from unstack.sim.unloading import in_view_scene
 
-        reasoned = decision(scene, "load")
-        hybrid = dataclasses.replace(reasoned, choice=hybrid_choice(scene, reasoned))
-        return str(physics_veto(hybrid, scene, seed=seed, world_scene=in_view_scene(scene)).choice)
+            reasoned = decision(scene, "load")
+            hybrid = dataclasses.replace(reasoned, choice=hybrid_choice(scene, reasoned))
+            vetoed = physics_veto(hybrid, scene, seed=seed, world_scene=in_view_scene(scene), veto_at=veto_at)
+            return str(vetoed.choice)
+
+        return policy
+
+    def hybrid_moves_free(scene: Scene) -> str:
+        """The default's pick unless the disturbance model expects its removal to move
+        :data:`~unstack.moves.MOVES_VETO` boxes or more; then the fewest expected moves among the
+        boxes the reasoner believes hold nothing up, ties to the box resting highest."""
+        from unstack.height_veto import FREE_COST, free_highest
+        from unstack.learning.pick_features import pick_features
+        from unstack.moves import MOVES_VETO
+        from unstack.pipeline import scene_support_probabilities
+        from unstack.reasoner.decision import decide
+
+        supports = scene_support_probabilities(scene, model)
+        reasoned = decide(supports, cost="load", samples=samples, seed=seed)
+        pick = str(free_highest(reasoned, scene).choice)
+        features = pick_features(scene, supports, reasoned.marginals, reasoned.expected_costs)
+        predicted = disturbance_model().expected_moves(features)
+        expected = dict(zip(supports.objects, (float(moved) for moved in predicted), strict=True))
+        if expected[pick] < MOVES_VETO:
+            return pick
+        costs = expected_costs(reasoned)
+        free = [box_id for box_id in scene.detected if costs[box_id] < FREE_COST] or list(scene.detected)
+        return fewest(scene, {box_id: expected[box_id] if box_id in free else np.inf for box_id in scene.detected})
 
     def belief_seen(scene: Scene) -> str:
         import dataclasses
@@ -405,16 +443,22 @@ def container_policies(
 
         return policy
 
-    def moves(scene: Scene, rule: str) -> str:
+    def disturbance_model() -> Any:
         from unstack.learning.disturbance import load_disturbance_model
-        from unstack.moves import decide_on_moves
-        from unstack.pipeline import scene_support_probabilities
 
         if not loaded:  # once per set of policies, at the first pick
             given = disturbance
             loaded.append(load_disturbance_model(given) if isinstance(given, str | os.PathLike | None) else given)
+        return loaded[0]
+
+    def moves(scene: Scene, rule: str) -> str:
+        from unstack.moves import decide_on_moves
+        from unstack.pipeline import scene_support_probabilities
+
         supports = scene_support_probabilities(scene, model)
-        decision = decide_on_moves(scene, supports, disturbance=loaded[0], samples=samples, seed=seed, rule=rule)
+        decision = decide_on_moves(
+            scene, supports, disturbance=disturbance_model(), samples=samples, seed=seed, rule=rule
+        )
         return str(decision.choice)
 
     def believing(rule: str) -> Callable[[Scene], str]:
@@ -455,7 +499,9 @@ def container_policies(
         "belief_scaled_veto": sampled_veto("scaled"),
         "belief_faces_veto": sampled_veto("faces"),
         "hybrid_faces_veto": sampled_veto("faces", hybrid),
-        "hybrid_faces_free": hybrid_faces_free,
+        "hybrid_faces_free": faces_free(PHYSICS_VETO),
+        "hybrid_faces_free_any": faces_free(1.0 / PHYSICS_WORLDS),
+        "hybrid_moves_free": hybrid_moves_free,
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:
@@ -543,7 +589,7 @@ def container_experiment(
     container_policies(model, seed=seed, makers=makers)  # unknown makers fail before any work
     if disturbance is not None and not isinstance(disturbance, str | os.PathLike):
         disturbance = disturbance.source  # sent to the workers by path
-    if {"moves", "moves_veto"} & set(makers):
+    if set(MOVES_MAKERS) & set(makers):
         from unstack.learning.disturbance import default_disturbance_path
 
         disturbance_path = Path(default_disturbance_path() if disturbance is None else disturbance)
@@ -561,7 +607,7 @@ def container_experiment(
         # detector_misses and occupancy join the key only when set: earlier runs keep their checkpoints
         unset = {"detector_misses": 0.0, "occupancy": None}
         kept = {name: value for name, value in settings.items() if name not in unset or value != unset[name]}
-        if {"moves", "moves_veto"} & set(makers):  # the disturbance model joins the key only where it is used
+        if set(MOVES_MAKERS) & set(makers):  # the disturbance model joins the key only where it is used
             kept["disturbance_sha256"] = disturbance_digest
         return {"scene_sha256": digest, "model_sha256": model_digest, "makers": list(makers),
                 **kept, "seed": seed + number}  # fmt: skip
