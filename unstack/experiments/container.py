@@ -10,6 +10,9 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     cost is below :data:`~unstack.height_veto.FREE_COST` (:func:`unstack.height_veto.free_highest`);
     when none is, near ties in expected cost to the box resting highest
     (:data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`).
+``unstack_strict``
+    the default with a box counted as holding nothing up below an expected cost of
+    :data:`STRICT_FREE_COST` instead of :data:`~unstack.height_veto.FREE_COST`.
 ``near_ties``
     the reasoner's own choice: near ties alone (the default before 2026-12-06).
 ``min_cost``
@@ -171,7 +174,7 @@ CONTAINER_MAKERS = (
     "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
     "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any",
-    "hybrid_moves_free",
+    "hybrid_moves_free", "unstack_strict",
 )  # fmt: skip
 #: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
 #: run only when named.
@@ -183,12 +186,14 @@ TRIED_MAKERS = (
     "belief_occlusion", "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
     "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any",
-    "hybrid_moves_free",
+    "hybrid_moves_free", "unstack_strict",
 )  # fmt: skip
 #: The makers run when none are named.
 DEFAULT_CONTAINER_MAKERS = tuple(
     maker for maker in CONTAINER_MAKERS if maker not in ORACLE_MAKERS and maker not in TRIED_MAKERS
 )
+#: The free cost of the maker ``unstack_strict``.
+STRICT_FREE_COST = 0.2
 #: Makers that read the disturbance model (:mod:`unstack.moves`).
 MOVES_MAKERS = ("moves", "moves_veto", "hybrid_moves_free")
 #: Makers whose policy is told what every candidate's removal does in the engine (the true pile).
@@ -223,6 +228,7 @@ def container_policies(
     (those of :data:`PROBING_MAKERS` take the probe's outcomes as well); ``occupancy``: the
     ``sampled`` fill's (default :data:`~unstack.sim.belief.OCCUPANCY`)."""
     from unstack.experiments.decisions import free_pick
+    from unstack.height_veto import FREE_COST
     from unstack.physics_veto import PHYSICS_VETO, PHYSICS_WORLDS
     from unstack.sim.belief import OCCUPANCY
 
@@ -246,10 +252,13 @@ def container_policies(
     def height(scene: Scene, box_id: str) -> float:
         return float(scene.box(box_id).position[2])
 
-    def default(scene: Scene) -> str:
-        from unstack.height_veto import free_highest
+    def free_below(free_cost: float) -> Callable[[Scene], str]:
+        def policy(scene: Scene) -> str:
+            from unstack.height_veto import free_highest
 
-        return str(free_highest(decision(scene, "load"), scene).choice)
+            return str(free_highest(decision(scene, "load"), scene, free_cost=free_cost).choice)
+
+        return policy
 
     def hybrid(scene: Scene) -> str:
         from unstack.height_veto import hybrid_choice
@@ -470,7 +479,8 @@ def container_policies(
         return policy
 
     every: dict[str, Callable[..., str]] = {
-        "unstack": default,
+        "unstack": free_below(FREE_COST),
+        "unstack_strict": free_below(STRICT_FREE_COST),
         "near_ties": deciding("load"),
         "min_cost": deciding("load", 0.0),
         "unstack_count": deciding("count", 0.0),
