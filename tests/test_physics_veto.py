@@ -69,6 +69,8 @@ def test_a_lower_veto_vetoes_whatever_the_default_veto_does_and_is_recorded(smal
     assert low.physics_veto["vetoed"] >= usual.physics_veto["vetoed"]
     with pytest.raises(InvalidArgument, match="veto_at must be positive"):
         physics_veto(default, scene, veto_at=0.0)
+    with pytest.raises(InvalidArgument, match="worlds must be a positive integer, got 0"):
+        physics_veto(default, scene, worlds=0)
 
 
 def test_the_same_seed_gives_the_same_worlds_and_choice(small_dataset: Path) -> None:

@@ -63,12 +63,10 @@ PHYSICS_FILL = "faces"
 WALL_SLACK = 0.02
 
 
-def _expected_moved(world_scene: Scene, boxes: list[str], seed: int, settings: Any) -> dict[str, float]:
+def _expected_moved(world_scene: Scene, boxes: list[str], seed: int, settings: Any, worlds: int) -> dict[str, float]:
     from unstack.sim.belief import belief_removals
 
-    outcomes = belief_removals(
-        world_scene, boxes, worlds=PHYSICS_WORLDS, fill=PHYSICS_FILL, seed=seed, settings=settings
-    )
+    outcomes = belief_removals(world_scene, boxes, worlds=worlds, fill=PHYSICS_FILL, seed=seed, settings=settings)
     return {box_id: float(outcome.expected_moved) for box_id, outcome in outcomes.items()}
 
 
@@ -153,6 +151,7 @@ def physics_veto(
     world_scene: Scene | None = None,
     free_cost: float = FREE_COST,
     veto_at: float = PHYSICS_VETO,
+    worlds: int = PHYSICS_WORLDS,
 ) -> Decision:
     """The decision with its pick vetoed where physics on the belief expects it to move boxes.
 
@@ -173,6 +172,8 @@ def physics_veto(
     veto_at : float
         A pick expected to move at least this many boxes is vetoed (positive; default
         :data:`PHYSICS_VETO`).
+    worlds : int
+        Belief worlds each box is tried in (default :data:`PHYSICS_WORLDS`).
 
     Returns
     -------
@@ -208,20 +209,22 @@ def physics_veto(
     free_cost = check_margin(free_cost, "free_cost")
     if not check_margin(veto_at, "veto_at") > 0:
         raise InvalidArgument(f"veto_at must be positive (a pick moving no box is never vetoed), got {veto_at!r}")
+    if isinstance(worlds, bool) or not isinstance(worlds, int) or worlds < 1:
+        raise InvalidArgument(f"worlds must be a positive integer, got {worlds!r}")
     missing = [box_id for box_id in decision.objects if box_id not in scene.detected]
     if missing:
         raise InvalidArgument(f"{scene.source}: the decision's boxes {missing} are not detected boxes of the scene")
     settings = world_settings(scene if world_scene is None else world_scene)
     built, slid = _inside_container(scene if world_scene is None else world_scene, settings)
     pick = decision.choice
-    expected = _expected_moved(built, [pick], seed, settings)
+    expected = _expected_moved(built, [pick], seed, settings, worlds)
     vetoed = expected[pick] >= veto_at
     if vetoed:
         costs = dict(zip(decision.objects, (float(cost) for cost in decision.expected_costs), strict=True))
         others = [box_id for box_id in decision.objects if box_id != pick and costs[box_id] < free_cost]
         if others:
-            expected.update(_expected_moved(built, others, seed, settings))
-    record = _record(expected, pick, vetoed, veto_at)
+            expected.update(_expected_moved(built, others, seed, settings, worlds))
+    record = _record(expected, pick, vetoed, veto_at, worlds)
     warnings = decision.warnings
     if slid:
         record["slid_inside"] = {box_id: round(distance, 6) for box_id, distance in slid.items()}
@@ -239,11 +242,11 @@ def physics_veto(
     )  # fmt: skip
 
 
-def _record(expected: Mapping[str, float], pick: str, vetoed: bool, veto_at: float) -> dict[str, Any]:
+def _record(expected: Mapping[str, float], pick: str, vetoed: bool, veto_at: float, worlds: int) -> dict[str, Any]:
     """The ``physics_veto`` object of ``unstack.decision/1``."""
     return {
         "fill": PHYSICS_FILL,
-        "worlds": PHYSICS_WORLDS,
+        "worlds": worlds,
         "veto_at": veto_at,
         "vetoed": vetoed,
         "tried": [{"box": box_id, "expected_moved": round(moved, 6)} for box_id, moved in expected.items()],

@@ -118,6 +118,8 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
 ``hybrid_faces_free_any``
     the same, vetoed where the pick moves a box in any of the belief worlds (expected moves
     of at least one box over :data:`~unstack.physics_veto.PHYSICS_WORLDS`).
+``hybrid_faces_free_8``
+    ``hybrid_faces_free`` in twice :data:`~unstack.physics_veto.PHYSICS_WORLDS` belief worlds.
 ``hybrid_moves_free``
     the default's pick unless the disturbance model (``moves``) expects its removal to move
     :data:`~unstack.moves.MOVES_VETO` boxes or more; then the fewest expected moves among the
@@ -174,7 +176,7 @@ CONTAINER_MAKERS = (
     "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
     "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any",
-    "hybrid_moves_free", "unstack_strict",
+    "hybrid_faces_free_8", "hybrid_moves_free", "unstack_strict",
 )  # fmt: skip
 #: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
 #: run only when named.
@@ -186,7 +188,7 @@ TRIED_MAKERS = (
     "belief_occlusion", "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
     "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any",
-    "hybrid_moves_free", "unstack_strict",
+    "hybrid_faces_free_8", "hybrid_moves_free", "unstack_strict",
 )  # fmt: skip
 #: The makers run when none are named.
 DEFAULT_CONTAINER_MAKERS = tuple(
@@ -395,7 +397,7 @@ def container_policies(
 
         return policy
 
-    def faces_free(veto_at: float) -> Callable[[Scene], str]:
+    def faces_free(veto_at: float, worlds: int = PHYSICS_WORLDS) -> Callable[[Scene], str]:
         def policy(scene: Scene) -> str:
             """The hybrid's pick unless the faces belief expects its removal to move ``veto_at``
             boxes, then that belief's fewest among the boxes the reasoner believes hold nothing
@@ -408,7 +410,9 @@ def container_policies(
 
             reasoned = decision(scene, "load")
             hybrid = dataclasses.replace(reasoned, choice=hybrid_choice(scene, reasoned))
-            vetoed = physics_veto(hybrid, scene, seed=seed, world_scene=in_view_scene(scene), veto_at=veto_at)
+            vetoed = physics_veto(
+                hybrid, scene, seed=seed, world_scene=in_view_scene(scene), veto_at=veto_at, worlds=worlds
+            )
             return str(vetoed.choice)
 
         return policy
@@ -511,6 +515,7 @@ def container_policies(
         "hybrid_faces_veto": sampled_veto("faces", hybrid),
         "hybrid_faces_free": faces_free(PHYSICS_VETO),
         "hybrid_faces_free_any": faces_free(1.0 / PHYSICS_WORLDS),
+        "hybrid_faces_free_8": faces_free(PHYSICS_VETO, 2 * PHYSICS_WORLDS),
         "hybrid_moves_free": hybrid_moves_free,
     }
     unknown = [maker for maker in makers if maker not in every]
