@@ -78,10 +78,33 @@ def test_the_hybrid_takes_the_highest_box_the_model_does_not_believe_loaded() ->
     assert policies["hybrid"](scene) == "free"
 
 
-@pytest.mark.parametrize("maker", ["hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any", "hybrid_moves_free"])
+@pytest.mark.parametrize(
+    "maker",
+    ["hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any", "hybrid_faces_free_8", "hybrid_moves_free"],
+)
 def test_the_hybrid_vetoes_start_from_the_hybrids_pick_not_the_highest_box(maker: str) -> None:
     policies = container_policies(load_model(default_model_path()), seed=0, makers=(maker,))
     assert policies[maker](_tall_loaded_and_short_free()) == "free"  # its removal moves nothing
+
+
+def test_the_strict_default_takes_the_highest_box_below_the_strict_free_cost(small_dataset: Path) -> None:
+    from unstack.experiments.container import CONTAINER_SAMPLES, STRICT_FREE_COST
+    from unstack.pipeline import scene_support_probabilities
+    from unstack.reasoner.decision import decide
+    from unstack.scene import load_scene
+
+    model = load_model(default_model_path())
+    policies = container_policies(model, seed=0, makers=("unstack_strict",))
+    for path in sorted(small_dataset.glob("config-*.json"))[:3]:
+        scene = load_scene(path)
+        decision = decide(scene_support_probabilities(scene, model), cost="load", samples=CONTAINER_SAMPLES, seed=0)
+        costs = dict(zip(decision.objects, decision.expected_costs, strict=True))
+        free = [box for box in scene.detected if costs[box] < STRICT_FREE_COST]
+        pick = policies["unstack_strict"](scene)
+        if free:
+            assert pick == max(free, key=lambda box: (scene.box(box).position[2], box))
+        else:
+            assert pick == decision.choice
 
 
 def test_unstack_gives_near_ties_to_the_box_resting_highest_and_min_cost_keeps_eq13() -> None:
