@@ -17,6 +17,7 @@ from unstack.height_veto import FREE_COST
 from unstack.jsonio import load_schema
 from unstack.physics_veto import PHYSICS_VETO, physics_veto
 from unstack.scene import Box, Scene
+from unstack.sim.belief import restless_boxes
 
 pytestmark = pytest.mark.slow  # belief worlds in the physics engine
 
@@ -51,6 +52,7 @@ def test_a_vetoed_pick_goes_to_the_box_holding_nothing_up_expected_to_move_fewes
             assert decided.choice == default.choice and list(tried) == [default.choice]
             continue
         vetoes += 1
+        assert record.get("restless", []) == list(restless_boxes(scene))  # the record is the rest check
         costs = dict(zip(default.objects, default.expected_costs, strict=True))
         free = {box for box in default.objects if costs[box] < FREE_COST} - {default.choice}
         assert set(tried) == free | {default.choice}

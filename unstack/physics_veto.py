@@ -226,6 +226,15 @@ def physics_veto(
             expected.update(_expected_moved(built, others, seed, settings, worlds))
     record = _record(expected, pick, vetoed, veto_at, worlds)
     warnings = decision.warnings
+    if vetoed:  # a world that does not come to rest moves boxes whatever is taken
+        from unstack.sim.belief import restless_boxes
+
+        restless = restless_boxes(built, seed=seed, settings=settings, fill=PHYSICS_FILL)
+        if restless:
+            record["restless"] = list(restless)
+            warnings = (*warnings, f"physics veto: with nothing taken, {', '.join(restless)} move in the belief "
+                        "world (poses that cannot stand as reported); the moves expected of every pick count "
+                        "them")  # fmt: skip
     if slid:
         record["slid_inside"] = {box_id: round(distance, 6) for box_id, distance in slid.items()}
         reached = ", ".join(f"{box_id} {distance:.2f} m" for box_id, distance in slid.items())

@@ -17,6 +17,7 @@ from unstack.sim.belief import (
     belief_removals,
     choose_by_expected_moves,
     occlusion_blocks,
+    restless_boxes,
     scaled_occupancy,
 )
 from unstack.understanding.clouds import surface_cloud
@@ -203,3 +204,15 @@ def test_an_unknown_fill_is_refused(column: list[Box]) -> None:
         UnstackError, match="unknown belief fill 'air'; expected one of cloud, occlusion, sampled, scaled, faces"
     ):
         belief_removals(_scene(column, ["bottom"]), fill="air")
+
+
+def test_a_box_that_cannot_stand_as_reported_is_restless_and_a_calm_pile_is_not() -> None:
+    stack = [Box("base", [0.4, 0.4, 0.3], [1.2, -0.4, 0.151]), Box("top", [0.4, 0.4, 0.3], [1.2, -0.4, 0.452])]
+    floating = Box("floating", [0.4, 0.4, 0.3], [1.2, 0.5, 1.75])  # still falling when the world should rest
+    calm = Scene(stack, surface_cloud(stack, viewpoint=[-2.0, 0.0, 1.5], seed=0), ["base", "top"])
+    assert restless_boxes(calm) == ()
+    boxes = [*stack, floating]
+    scene = Scene(boxes, surface_cloud(boxes, viewpoint=[-2.0, 0.0, 1.5], seed=0), ["base", "top", "floating"])
+    assert restless_boxes(scene) == ("floating",)
+    with pytest.raises(UnstackError, match="unknown belief fill 'cloud' for a rest check"):
+        restless_boxes(scene, fill="cloud")

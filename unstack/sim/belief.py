@@ -100,6 +100,7 @@ __all__ = [
     "belief_settings",
     "choose_by_expected_moves",
     "occlusion_blocks",
+    "restless_boxes",
     "scaled_occupancy",
     "seen_boxes",
     "unseen_supports",
@@ -575,6 +576,73 @@ def _try_removals(
     return outcomes
 
 
+def _drawn_worlds(
+    scene: Scene, simulation: Any, fill: str, occupancy: float, worlds: int, rng: np.random.Generator
+) -> list[list[BeliefBlock]]:
+    """The blocks of each world of a fill that draws the unseen space kept (``sampled``,
+    ``scaled``, ``faces``)."""
+    from unstack.understanding.occlusion import THINNEST  # the rest of a block split at a face may be thinner
+
+    space = occlusion_blocks(scene, simulation)
+    kept_share = occupancy if fill == "sampled" else scaled_occupancy(space)
+    solid, drawn = _faced(space, behind_seen_faces(scene, space)) if fill == "faces" else ([], space)
+    return [
+        solid + [block for block in drawn if rng.random() < kept_share and block.size[0] > THINNEST]
+        for _ in range(worlds)
+    ]
+
+
+def restless_boxes(
+    scene: Scene, *, seed: int = 0, settings: Any = None, fill: str = "faces", occupancy: float = OCCUPANCY
+) -> tuple[str, ...]:
+    """The detected boxes that move in the first belief world with nothing taken.
+
+    A belief world built from poses that cannot stand as reported (boxes inside one another,
+    a box floating or reaching into another) does not come to rest: what such boxes do is
+    counted in every candidate's expected moves (:func:`belief_removals`, the same first
+    world: the same ``seed``, ``settings``, ``fill`` and ``occupancy``).
+
+    Parameters
+    ----------
+    scene, seed, settings, occupancy
+        As in :func:`belief_removals`.
+    fill : {"occlusion", "sampled", "scaled", "faces"}
+        A fill without the cloud fill's rounds of holding what falls.
+
+    Returns
+    -------
+    tuple of str
+        In the order of ``scene.detected``; empty when the world is at rest.
+
+    Examples
+    --------
+    >>> import unstack
+    >>> restless_boxes(unstack.load("examples/pile5.scene.json"))
+    ()
+    """
+    from unstack.sim.ground_truth import run_horizon
+    from unstack.sim.unloading import RESETTLE_SECONDS
+    from unstack.sim.world import PhysicsWorld
+
+    if fill not in FILLS or fill == "cloud":
+        raise UnstackError(f"unknown belief fill {fill!r} for a rest check; expected one of {', '.join(FILLS[1:])}")
+    simulation = belief_settings(scene, settings)
+    if fill == "occlusion":
+        blocks = occlusion_blocks(scene, simulation)
+    else:
+        blocks = _drawn_worlds(scene, simulation, fill, occupancy, 1, np.random.default_rng(seed))[0]
+    low_mass, high_mass = simulation.pile.mass_range
+    masses = {box_id: (low_mass + high_mass) / 2.0 for box_id in scene.detected}
+    with PhysicsWorld(simulation, door=False) as world:
+        bodies = _build(world, scene, blocks, masses, set())
+        world.step(RESETTLE_SECONDS)
+        watched = [bodies[box_id] for box_id in scene.detected]
+        before = world.poses(watched)
+        run_horizon(world, simulation.ground_truth, watched)
+        moved = _disturbed(before, world.poses(watched), simulation.ground_truth)
+    return tuple(scene.detected[k] for k in np.flatnonzero(moved))
+
+
 def belief_removals(
     scene: Scene,
     candidates: Sequence[str] | None = None,
@@ -630,15 +698,10 @@ def belief_removals(
     simulation = belief_settings(scene, settings)
     rng = np.random.default_rng(seed)
     if fill in ("sampled", "scaled", "faces"):
-        from unstack.understanding.occlusion import THINNEST  # the rest of a block split at a face may be thinner
-
-        space = occlusion_blocks(scene, simulation)
-        kept_share = occupancy if fill == "sampled" else scaled_occupancy(space)
-        solid, drawn = _faced(space, behind_seen_faces(scene, space)) if fill == "faces" else ([], space)
-        runs = []
-        for _ in range(worlds):
-            kept = [block for block in drawn if rng.random() < kept_share and block.size[0] > THINNEST]
-            runs.append(_try_removals(scene, solid + kept, tried, simulation, None, 0))
+        runs = [
+            _try_removals(scene, blocks, tried, simulation, None, 0)
+            for blocks in _drawn_worlds(scene, simulation, fill, occupancy, worlds, rng)
+        ]
     else:
         blocks = belief_blocks(scene) if fill == "cloud" else occlusion_blocks(scene, simulation)
         hold_rounds = HOLD_ROUNDS if fill == "cloud" else 0
