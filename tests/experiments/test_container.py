@@ -80,7 +80,14 @@ def test_the_hybrid_takes_the_highest_box_the_model_does_not_believe_loaded() ->
 
 @pytest.mark.parametrize(
     "maker",
-    ["hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any", "hybrid_faces_free_8", "hybrid_moves_free"],
+    [
+        "hybrid_faces_veto",
+        "hybrid_faces_free",
+        "hybrid_faces_free_any",
+        "hybrid_faces_free_8",
+        "hybrid_faces_free_sure",
+        "hybrid_moves_free",
+    ],
 )
 def test_the_hybrid_vetoes_start_from_the_hybrids_pick_not_the_highest_box(maker: str) -> None:
     policies = container_policies(load_model(default_model_path()), seed=0, makers=(maker,))

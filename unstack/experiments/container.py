@@ -120,6 +120,9 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     of at least one box over :data:`~unstack.physics_veto.PHYSICS_WORLDS`).
 ``hybrid_faces_free_8``
     ``hybrid_faces_free`` in twice :data:`~unstack.physics_veto.PHYSICS_WORLDS` belief worlds.
+``hybrid_faces_free_sure``
+    ``hybrid_faces_free``, a vetoed pick replaced only by a box expected to move fewer than
+    :data:`~unstack.physics_veto.PHYSICS_VETO` boxes (among boxes as bad, height stands).
 ``hybrid_moves_free``
     the default's pick unless the disturbance model (``moves``) expects its removal to move
     :data:`~unstack.moves.MOVES_VETO` boxes or more; then the fewest expected moves among the
@@ -176,7 +179,7 @@ CONTAINER_MAKERS = (
     "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
     "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any",
-    "hybrid_faces_free_8", "hybrid_moves_free", "unstack_strict",
+    "hybrid_faces_free_8", "hybrid_faces_free_sure", "hybrid_moves_free", "unstack_strict",
 )  # fmt: skip
 #: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
 #: run only when named.
@@ -188,7 +191,7 @@ TRIED_MAKERS = (
     "belief_occlusion", "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
     "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any",
-    "hybrid_faces_free_8", "hybrid_moves_free", "unstack_strict",
+    "hybrid_faces_free_8", "hybrid_faces_free_sure", "hybrid_moves_free", "unstack_strict",
 )  # fmt: skip
 #: The makers run when none are named.
 DEFAULT_CONTAINER_MAKERS = tuple(
@@ -417,6 +420,25 @@ def container_policies(
 
         return policy
 
+    def hybrid_faces_free_sure(scene: Scene) -> str:
+        """``hybrid_faces_free``, but a vetoed pick is replaced only by a box the belief expects
+        to move fewer than :data:`~unstack.physics_veto.PHYSICS_VETO` boxes; else it stands."""
+        import dataclasses
+
+        from unstack.height_veto import hybrid_choice
+        from unstack.physics_veto import physics_veto
+        from unstack.sim.unloading import in_view_scene
+
+        reasoned = decision(scene, "load")
+        pick = hybrid_choice(scene, reasoned)
+        vetoed = physics_veto(dataclasses.replace(reasoned, choice=pick), scene, seed=seed,
+                              world_scene=in_view_scene(scene))  # fmt: skip
+        record = vetoed.physics_veto or {}
+        moved = {item["box"]: item["expected_moved"] for item in record.get("tried", [])}
+        if record.get("vetoed") and moved[str(vetoed.choice)] >= PHYSICS_VETO:
+            return pick
+        return str(vetoed.choice)
+
     def hybrid_moves_free(scene: Scene) -> str:
         """The default's pick unless the disturbance model expects its removal to move
         :data:`~unstack.moves.MOVES_VETO` boxes or more; then the fewest expected moves among the
@@ -516,6 +538,7 @@ def container_policies(
         "hybrid_faces_free": faces_free(PHYSICS_VETO),
         "hybrid_faces_free_any": faces_free(1.0 / PHYSICS_WORLDS),
         "hybrid_faces_free_8": faces_free(PHYSICS_VETO, 2 * PHYSICS_WORLDS),
+        "hybrid_faces_free_sure": hybrid_faces_free_sure,
         "hybrid_moves_free": hybrid_moves_free,
     }
     unknown = [maker for maker in makers if maker not in every]
