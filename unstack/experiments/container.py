@@ -400,29 +400,11 @@ def container_policies(
 
         return policy
 
-    def faces_free(veto_at: float, worlds: int = PHYSICS_WORLDS) -> Callable[[Scene], str]:
-        def policy(scene: Scene) -> str:
-            """The hybrid's pick unless the faces belief expects its removal to move ``veto_at``
-            boxes, then that belief's fewest among the boxes the reasoner believes hold nothing
-            up (:func:`unstack.physics_veto.physics_veto` on the boxes in view)."""
-            import dataclasses
-
-            from unstack.height_veto import hybrid_choice
-            from unstack.physics_veto import physics_veto
-            from unstack.sim.unloading import in_view_scene
-
-            reasoned = decision(scene, "load")
-            hybrid = dataclasses.replace(reasoned, choice=hybrid_choice(scene, reasoned))
-            vetoed = physics_veto(
-                hybrid, scene, seed=seed, world_scene=in_view_scene(scene), veto_at=veto_at, worlds=worlds
-            )
-            return str(vetoed.choice)
-
-        return policy
-
-    def hybrid_faces_free_sure(scene: Scene) -> str:
-        """``hybrid_faces_free``, but a vetoed pick is replaced only by a box the belief expects
-        to move fewer than :data:`~unstack.physics_veto.PHYSICS_VETO` boxes; else it stands."""
+    def faces_vetoed(scene: Scene, veto_at: float = PHYSICS_VETO, worlds: int = PHYSICS_WORLDS) -> tuple[str, Any]:
+        """The hybrid's pick, and the decision with it vetoed where the faces belief expects its
+        removal to move ``veto_at`` boxes: then that belief's fewest among the boxes the
+        reasoner believes hold nothing up (:func:`unstack.physics_veto.physics_veto` on the
+        boxes in view)."""
         import dataclasses
 
         from unstack.height_veto import hybrid_choice
@@ -431,11 +413,25 @@ def container_policies(
 
         reasoned = decision(scene, "load")
         pick = hybrid_choice(scene, reasoned)
-        vetoed = physics_veto(dataclasses.replace(reasoned, choice=pick), scene, seed=seed,
-                              world_scene=in_view_scene(scene))  # fmt: skip
-        record = vetoed.physics_veto or {}
-        moved = {item["box"]: item["expected_moved"] for item in record.get("tried", [])}
-        if record.get("vetoed") and moved[str(vetoed.choice)] >= PHYSICS_VETO:
+        vetoed = physics_veto(
+            dataclasses.replace(reasoned, choice=pick), scene, seed=seed, world_scene=in_view_scene(scene),
+            veto_at=veto_at, worlds=worlds,
+        )  # fmt: skip
+        return pick, vetoed
+
+    def faces_free(veto_at: float, worlds: int = PHYSICS_WORLDS) -> Callable[[Scene], str]:
+        def policy(scene: Scene) -> str:
+            return str(faces_vetoed(scene, veto_at, worlds)[1].choice)
+
+        return policy
+
+    def hybrid_faces_free_sure(scene: Scene) -> str:
+        """``hybrid_faces_free``, but a vetoed pick is replaced only by a box the belief expects
+        to move fewer than :data:`~unstack.physics_veto.PHYSICS_VETO` boxes; else it stands."""
+        pick, vetoed = faces_vetoed(scene)
+        record = vetoed.physics_veto
+        moved = {item["box"]: item["expected_moved"] for item in record["tried"]}
+        if record["vetoed"] and moved[str(vetoed.choice)] >= PHYSICS_VETO:
             return pick
         return str(vetoed.choice)
 
