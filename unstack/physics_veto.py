@@ -214,8 +214,9 @@ def physics_veto(
     missing = [box_id for box_id in decision.objects if box_id not in scene.detected]
     if missing:
         raise InvalidArgument(f"{scene.source}: the decision's boxes {missing} are not detected boxes of the scene")
-    settings = world_settings(scene if world_scene is None else world_scene)
-    built, slid = _inside_container(scene if world_scene is None else world_scene, settings)
+    given = scene if world_scene is None else world_scene
+    settings = world_settings(given)
+    built, slid = _inside_container(given, settings)
     pick = decision.choice
     expected = _expected_moved(built, [pick], seed, settings, worlds)
     vetoed = expected[pick] >= veto_at

@@ -625,7 +625,8 @@ def restless_boxes(
     from unstack.sim.world import PhysicsWorld
 
     if fill not in FILLS or fill == "cloud":
-        raise UnstackError(f"unknown belief fill {fill!r} for a rest check; expected one of {', '.join(FILLS[1:])}")
+        resting = ", ".join(name for name in FILLS if name != "cloud")
+        raise UnstackError(f"unknown belief fill {fill!r} for a rest check; expected one of {resting}")
     simulation = belief_settings(scene, settings)
     if fill == "occlusion":
         blocks = occlusion_blocks(scene, simulation)
