@@ -53,6 +53,17 @@ def unstack(
     )
 
 
+def assert_one_line_error(
+    result: subprocess.CompletedProcess[str], *messages: str, nothing_written_in: Path | None = None
+) -> None:
+    """The CLI's answer to bad input: exit code 2, one line naming each of ``messages``, no file left behind."""
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    for message in messages:
+        assert message in result.stderr, result.stderr
+    if nothing_written_in is not None:
+        assert not list(nothing_written_in.iterdir())
+
+
 def random_probabilities(n: int, rng: np.random.Generator, *, hard: float = 0.0) -> np.ndarray:
     """Off-diagonal p ~ U(0.05, 0.95); a share ``hard`` of pairs set to exactly 0."""
     probabilities = rng.uniform(0.05, 0.95, size=(n, n))

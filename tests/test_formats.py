@@ -25,6 +25,13 @@ def supports_document(**changes: Any) -> dict[str, Any]:
     return document
 
 
+def with_probability(row: int, column: int, value: Any) -> dict[str, Any]:
+    """The valid supports document with one cell of its matrix replaced."""
+    probabilities: list[list[Any]] = [list(values) for values in supports_document()["probabilities"]]
+    probabilities[row][column] = value
+    return supports_document(probabilities=probabilities)
+
+
 def scene_document(**changes: Any) -> dict[str, Any]:
     document: dict[str, Any] = {
         "format": "unstack.scene/1",
@@ -69,9 +76,7 @@ BAD_SUPPORTS = [
         id="ragged",
     ),
     pytest.param(
-        supports_document(probabilities=[[0, "x", 0.2], [0.1, 0, 0.3], [0.4, 0.6, 0]]),
-        r"\$\.probabilities\[0\]\[1\]: expected number, got 'x'",
-        id="non-numeric",
+        with_probability(0, 1, "x"), r"\$\.probabilities\[0\]\[1\]: expected number, got 'x'", id="non-numeric"
     ),
     pytest.param(
         '{"format": "unstack.supports/1", "objects": ["a", "b"], "probabilities": [[0, NaN], [0.1, 0]]}',
@@ -84,19 +89,13 @@ BAD_SUPPORTS = [
         id="infinite",
     ),
     pytest.param(
-        supports_document(probabilities=[[0, 1.5, 0.2], [0.1, 0, 0.3], [0.4, 0.6, 0]]),
-        r"\$\.probabilities\[0\]\[1\]: expected a number <= 1, got 1.5",
-        id="above-one",
+        with_probability(0, 1, 1.5), r"\$\.probabilities\[0\]\[1\]: expected a number <= 1, got 1.5", id="above-one"
     ),
     pytest.param(
-        supports_document(probabilities=[[0, 0.5, 0.2], [-0.1, 0, 0.3], [0.4, 0.6, 0]]),
-        r"\$\.probabilities\[1\]\[0\]: expected a number >= 0, got -0.1",
-        id="negative",
+        with_probability(1, 0, -0.1), r"\$\.probabilities\[1\]\[0\]: expected a number >= 0, got -0.1", id="negative"
     ),
     pytest.param(
-        supports_document(probabilities=[[0, 0.5, 0.2], [0.1, 0.3, 0.3], [0.4, 0.6, 0]]),
-        r"\$\.probabilities\[1\]\[1\]: expected 0 on the diagonal, got 0.3",
-        id="diagonal",
+        with_probability(1, 1, 0.3), r"\$\.probabilities\[1\]\[1\]: expected 0 on the diagonal, got 0.3", id="diagonal"
     ),
     pytest.param(
         supports_document(objects=["a", "b", "a"]),

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import unstack
+from tests.conftest import assert_one_line_error
 from tests.conftest import unstack as unstack_cli
 from unstack import jsonio, scene
 from unstack.errors import InvalidFile, InvalidScene
@@ -97,4 +98,4 @@ def test_the_cli_refuses_a_document_above_the_limit_with_exit_2(tmp_path: Path) 
         handle.truncate(jsonio.MAX_DOCUMENT_BYTES + 1)
     for command in ("decide", "validate"):
         result = unstack_cli(command, str(huge))
-        assert result.returncode == 2 and result.stderr.count("\n") == 1 and "at most 64.0 MiB" in result.stderr
+        assert_one_line_error(result, "at most 64.0 MiB")

@@ -10,6 +10,7 @@ import pytest
 from jsonschema import Draft202012Validator
 
 import unstack
+from tests.conftest import assert_one_line_error
 from tests.conftest import unstack as run_unstack
 from unstack.errors import InvalidArgument, UnstackError
 from unstack.geometry import bounding_boxes
@@ -149,8 +150,7 @@ def test_without_the_physics_engine_the_veto_is_one_line_saying_what_to_install(
 
     probe = WITHOUT_PYBULLET.format(file=str(PILE5))
     result = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300, cwd=REPO)
-    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
-    assert "pip install 'unstack[sim]'" in result.stderr
+    assert_one_line_error(result, "pip install 'unstack[sim]'")
 
 
 def test_the_cli_says_what_the_belief_expects_and_refuses_a_supports_file(small_dataset: Path) -> None:

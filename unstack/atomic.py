@@ -162,10 +162,6 @@ def atomic_write(path: str | os.PathLike[str], write: Callable[[BinaryIO], Any])
     write : callable
         Receives the open binary stream.
 
-    Returns
-    -------
-    None
-
     Examples
     --------
     >>> import tempfile, pathlib
@@ -232,10 +228,6 @@ def atomic_save_figure(figure: Any, path: str | os.PathLike[str], *, dpi: int = 
     dpi : int
     **savefig
         Passed on to ``Figure.savefig`` (``bbox_inches``, ...).
-
-    Returns
-    -------
-    None
 
     Examples
     --------

@@ -10,7 +10,7 @@ import jsonschema
 import numpy as np
 import pytest
 
-from tests.conftest import REPO, unstack
+from tests.conftest import REPO, assert_one_line_error, unstack
 from unstack.dataset_folders import list_configurations
 from unstack.jsonio import load_schema
 
@@ -117,9 +117,7 @@ def test_decide_on_a_scene_with_a_given_model(model: Path) -> None:
 )
 def test_bad_input_is_one_line(arguments: list[str], message: str, tmp_path: Path) -> None:
     result = unstack(*[argument.format(tmp=tmp_path) for argument in arguments])
-    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
-    assert message in result.stderr
-    assert not list(tmp_path.iterdir())
+    assert_one_line_error(result, message, nothing_written_in=tmp_path)
 
 
 def test_an_empty_point_cloud_is_a_one_line_warning(tmp_path: Path) -> None:
@@ -164,5 +162,4 @@ def test_no_statics_keeps_the_models_probabilities(tmp_path: Path) -> None:
 
 def test_no_statics_on_a_supports_file_is_one_line() -> None:
     result = unstack("decide", "examples/stack5.supports.json", "--no-statics")
-    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
-    assert "--no-statics applies to a scene file" in result.stderr
+    assert_one_line_error(result, "--no-statics applies to a scene file")

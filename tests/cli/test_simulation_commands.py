@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.conftest import unstack
+from tests.conftest import assert_one_line_error, unstack
 
 pytestmark = pytest.mark.slow  # simulates piles in subprocesses
 
@@ -91,9 +91,7 @@ def test_simulate_refuses_to_mix_data_sets(dataset: Path) -> None:
 )
 def test_render_bad_input_is_one_line(tmp_path: Path, arguments: list[str], message: str) -> None:
     result = unstack("render", *[argument.format(tmp=tmp_path) for argument in arguments])
-    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
-    assert message in result.stderr
-    assert not list(tmp_path.iterdir())
+    assert_one_line_error(result, message, nothing_written_in=tmp_path)
 
 
 def test_render_draws_the_learned_probabilities(tmp_path: Path) -> None:

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.conftest import unstack
+from tests.conftest import assert_one_line_error, unstack
 from unstack.errors import UnstackError
 from unstack.experiments.container import CONTAINER_MAKERS, container_experiment, container_policies
 from unstack.learning.model_file import default_model_path, load_model
@@ -147,7 +147,7 @@ def test_containers_run_on_a_dask_cluster_with_the_same_results(small_dataset: P
 
 def test_an_unreachable_scheduler_is_one_line(small_dataset: Path, tmp_path: Path) -> None:
     result = unstack("experiment", "container", str(small_dataset), "--out", str(tmp_path), "--scheduler", "nonsense")
-    assert result.returncode == 2 and result.stderr.count("\n") == 1 and "tcp://HOST:PORT" in result.stderr
+    assert_one_line_error(result, "tcp://HOST:PORT")
 
 
 def test_the_oracles_and_the_makers_measured_no_better_run_only_when_named() -> None:

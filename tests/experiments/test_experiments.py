@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.conftest import unstack
+from tests.conftest import assert_one_line_error, unstack
 from unstack.experiments.decisions import (
     DECISION_MAKERS,
     IsetOutcome,
@@ -142,9 +142,7 @@ def test_experiment_commands(small_dataset: Path, tmp_path: Path) -> None:
 )
 def test_experiment_bad_input(arguments: list[str], message: str, tmp_path: Path, small_dataset: Path) -> None:
     result = unstack("experiment", *[argument.format(tmp=tmp_path, data=small_dataset) for argument in arguments])
-    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
-    assert message in result.stderr
-    assert not list(tmp_path.iterdir())
+    assert_one_line_error(result, message, nothing_written_in=tmp_path)
 
 
 @pytest.mark.parametrize(("split", "features"), [("pairs", "paper"), ("configuration", "extended")])

@@ -43,6 +43,13 @@ MAX_SAMPLES = 100_000_000
 MAX_SECONDS = 86_400.0
 
 
+def _real_number(value: Any, name: str, unit: str) -> float:
+    """``value`` as a float when it is a real number (not a bool); else the error naming ``unit``."""
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        raise InvalidArgument(f"{name} must be a number of {unit}, got {value!r}")
+    return float(value)
+
+
 def check_budget(value: Any, name: str) -> float:
     """A positive, finite number of seconds (``time_limit``).
 
@@ -62,9 +69,7 @@ def check_budget(value: Any, name: str) -> float:
     >>> check_budget(1, "time_limit")
     1.0
     """
-    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
-        raise InvalidArgument(f"{name} must be a number of seconds, got {value!r}")
-    seconds = float(value)
+    seconds = _real_number(value, name, "seconds")
     if not (math.isfinite(seconds) and seconds > 0):
         raise InvalidArgument(f"{name} must be a positive, finite number of seconds, got {seconds}")
     if seconds > MAX_SECONDS:
@@ -97,9 +102,7 @@ def check_margin(value: Any, name: str) -> float:
     >>> check_margin(0, "near_tie_margin")
     0.0
     """
-    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
-        raise InvalidArgument(f"{name} must be a number of expected boxes moved, got {value!r}")
-    margin = float(value)
+    margin = _real_number(value, name, "expected boxes moved")
     if not (math.isfinite(margin) and margin >= 0):
         raise InvalidArgument(f"{name} must be a finite number >= 0 (expected boxes moved), got {margin}")
     return margin

@@ -6,7 +6,6 @@ Shared by the ways a pile is made (:mod:`unstack.sim.piles`, :mod:`unstack.sim.s
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from types import TracebackType
 
 import numpy as np
 
@@ -39,9 +38,7 @@ class Pile:
     def __enter__(self) -> Pile:
         return self
 
-    def __exit__(
-        self, kind: type[BaseException] | None, value: BaseException | None, traceback: TracebackType | None
-    ) -> None:
+    def __exit__(self, *exc_info: object) -> None:
         self.close()
 
 
