@@ -10,7 +10,7 @@ from rich.console import Console
 from rich.table import Table
 
 from unstack.cli.learning import FEATURES_HELP, ISETS_FROM_HELP
-from unstack.cli.main import MODEL_HELP, SAMPLES, SECONDS, STATICS_HELP
+from unstack.cli.main import SAMPLES, SECONDS, STATICS_HELP, data_dir_argument, model_path_option
 from unstack.cli.options import Checked, constrained
 from unstack.cli.progress import progress_bar
 from unstack.cli.text import number_table
@@ -103,7 +103,7 @@ def table1(out: str, max_n: int, full: bool) -> None:
 
 
 @experiment.command(short_help="Fig. 5a: the validation confusion matrix of the SVM, beside the paper's.")
-@click.argument("data_dir", type=click.Path(file_okay=False))
+@data_dir_argument
 @click.option("--out", required=True, type=click.Path(), help="Folder for fig5a.json.")
 @click.option("--r", "r", type=FIG5A("r"), default=5, show_default=True,
               help="Boxes per ISet.")  # fmt: skip
@@ -181,9 +181,9 @@ def fig5a(
 
 
 @experiment.command(short_help="Fig. 4 and beyond: MSE(cost), first pick right, disturbance per decision maker.")
-@click.argument("data_dir", type=click.Path(file_okay=False))
+@data_dir_argument
 @click.option("--out", required=True, type=click.Path(), help="Folder for decisions.json and fig4.png.")
-@click.option("--model", "model_path", default=None, help=MODEL_HELP)
+@model_path_option
 @click.option("--r", "r", type=DECISIONS("r"), default=5, show_default=True,
               help="Boxes per ISet.")  # fmt: skip
 @click.option("--isets", type=DECISIONS("isets"), default=50, show_default=True,
@@ -256,7 +256,7 @@ def decisions(
 
 
 @experiment.command()
-@click.argument("data_dir", type=click.Path(file_okay=False))
+@data_dir_argument
 @click.option("--out", required=True, type=click.Path(), help="Folder for real7.json.")
 @click.option("--model", "model_path", default=None, help="Model trained on piles of the same four sizes.")
 @click.option("--piles", type=REAL7("piles"), default=None, help="Use only the first N piles.")
@@ -287,9 +287,9 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
 
 
 @experiment.command()
-@click.argument("data_dir", type=click.Path(file_okay=False))
+@data_dir_argument
 @click.option("--out", required=True, type=click.Path(), help="Folder for unloading.json and unloading.png.")
-@click.option("--model", "model_path", default=None, help=MODEL_HELP)
+@model_path_option
 @click.option("--configs", type=UNLOAD("configs"), default=4, show_default=True, help="Piles (the first N).")
 @click.option("--samples", type=SAMPLES, default=UNLOAD_SAMPLES, show_default=True,
               help="Recorded sweeps per sampled group in each decision (reproducible with the seed).")  # fmt: skip
@@ -368,9 +368,9 @@ def unload(
 
 
 @experiment.command()
-@click.argument("data_dir", type=click.Path(file_okay=False))
+@data_dir_argument
 @click.option("--out", required=True, type=click.Path(), help="Folder for container.json.")
-@click.option("--model", "model_path", default=None, help=MODEL_HELP)
+@model_path_option
 @click.option("--piles", type=CONTAINER("piles"), default=2, show_default=True, help="Piles (the first N).")
 @click.option("--makers", default=",".join(DEFAULT_CONTAINER_MAKERS), show_default=True,
               help=f"Comma-separated decision makers; the oracles {', '.join(ORACLE_MAKERS)} (they read every box "
@@ -467,7 +467,7 @@ def container(
 
 @experiment.command()
 @click.option("--out", required=True, type=click.Path(), help="Folder for generalisation.json and the pictures.")
-@click.option("--model", "model_path", default=None, help=MODEL_HELP)
+@model_path_option
 @click.option("--seeds", type=click.IntRange(min=1), default=3, show_default=True, help="Scenes drawn per kind.")
 @click.option("--first-seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of the first scene of each kind (later ones follow).")  # fmt: skip
@@ -530,9 +530,9 @@ def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int
 
 
 @experiment.command("camera-roundtrip")
-@click.argument("data_dir", type=click.Path(file_okay=False))
+@data_dir_argument
 @click.option("--out", required=True, type=click.Path(), help="Folder for camera-roundtrip.json.")
-@click.option("--model", "model_path", default=None, help=MODEL_HELP)
+@model_path_option
 @click.option("--piles", type=ROUNDTRIP("piles"), default=2, show_default=True, help="Piles (the first N).")
 @click.option("--jobs", type=ROUNDTRIP("n_jobs"), default=1, show_default=True, help="Piles run in parallel.")
 def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, piles: int, jobs: int) -> None:
@@ -577,7 +577,7 @@ def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, pi
 
 
 @experiment.command("belief-calibration")
-@click.argument("data_dir", type=click.Path(file_okay=False))
+@data_dir_argument
 @click.option("--out", required=True, type=click.Path(), help="Folder for belief-calibration.json.")
 @click.option("--piles", type=CALIBRATION("piles"), default=2, show_default=True, help="Piles (the first N).")
 @click.option("--detector-misses", type=CALIBRATION("detector_misses"), default=0.0, show_default=True,
@@ -664,7 +664,7 @@ def pick_responses(
 @experiment.command("train-disturbance")
 @click.argument("states", type=click.Path(file_okay=False, exists=True))
 @click.option("--out", required=True, type=click.Path(), help="Folder for disturbance.skops and disturbance.json.")
-@click.option("--model", "model_path", default=None, help=MODEL_HELP)
+@model_path_option
 @click.option("--folds", type=TRAINING("folds"), default=5, show_default=True,
               help="Grouped folds (piles held out together) of the held-out figures.")  # fmt: skip
 @click.option("--seed", type=TRAINING("random_state"), default=0, show_default=True)

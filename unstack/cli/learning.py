@@ -10,7 +10,7 @@ from rich.console import Console, Group
 from rich.table import Table
 from rich.text import Text
 
-from unstack.cli.main import MODEL_HELP, STATICS_HELP
+from unstack.cli.main import STATICS_HELP, data_dir_argument, model_path_option
 from unstack.cli.text import counted
 from unstack.errors import UnstackError
 from unstack.learning.choices import LEARNERS, SPLITS
@@ -204,7 +204,7 @@ def train(
 
 @click.command()
 @click.argument("model_file", type=str)
-@click.argument("data_dir", type=click.Path(file_okay=False))
+@data_dir_argument
 @click.option("--r", "r", type=click.IntRange(min=2), default=5, show_default=True, help="Boxes per ISet.")
 @click.option("--isets", type=click.IntRange(min=1), default=3, show_default=True, help="ISets per configuration.")
 @click.option("--isets-from", "draw", type=click.Choice(list(ISET_DRAWS)), default="random",
@@ -256,7 +256,7 @@ def evaluate(
 
 @click.command()
 @click.argument("scene_file", type=str)
-@click.option("--model", "model_path", default=None, help=MODEL_HELP)
+@model_path_option
 @click.option("-o", "--output", type=click.Path(dir_okay=False), default=None, help="Write the JSON here (atomically).")
 @click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)
 def probabilities(scene_file: str, model_path: str | None, output: str | None, statics: bool) -> None:

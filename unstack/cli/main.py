@@ -34,6 +34,12 @@ MODEL_HELP = (
     "Model file, or a shipped model: general (the default: pose features, five pile families), paper (the "
     "paper's SVM, for the reproduction) or extended (the paper's piles with contact features)."
 )
+#: ``--model`` of every command that reads scenes through a model (the library's ``model_path``).
+model_path_option = click.option("--model", "model_path", default=None, help=MODEL_HELP)
+#: ``--model`` of the commands that hand it to :mod:`unstack.api` as ``model``.
+model_option = click.option("--model", "model", default=None, help=MODEL_HELP)
+#: The folder of a simulated data set (``unstack simulate --out``).
+data_dir_argument = click.argument("data_dir", type=click.Path(file_okay=False))
 STATICS_HELP = (
     "For a scene: a box that cannot stand without another (leaning on it, or across a gap on it) makes that "
     "one its supporter (P raised to at least 0.65, with a warning); --no-statics keeps the model's probabilities."
@@ -262,7 +268,7 @@ def cli() -> None:
     "and, where it is expected to move a box, take the box holding nothing up expected to move the fewest "
     "(tenths of a second to seconds).",
 )  # fmt: skip
-@click.option("--model", "model", default=None, help=MODEL_HELP)
+@model_option
 @click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)
 def decide(file: str, as_json: bool, output: str | None, timing: bool, model: str | None, **reasoning: Any) -> None:
     """Print which box to unload first, the expected cost of every box and P(support | consistent).
@@ -287,7 +293,7 @@ def decide(file: str, as_json: bool, output: str | None, timing: bool, model: st
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON payoff matrix to this file.")
 @click.option("--limit", type=click.IntRange(min=1), default=20, show_default=True, help="Worlds shown in the table.")
 @click.option("--cost", type=click.Choice(list(PAYOFF_COSTS)), default="count", show_default=True)
-@click.option("--model", "model", default=None, help=MODEL_HELP)
+@model_option
 def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str, model: str | None) -> None:
     """Print the payoff matrix (Table II): consistent worlds, their probabilities and action costs.
 
@@ -306,7 +312,7 @@ def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str, 
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON plan to this file.")
 @_reasoning_options
 @FREE_COST_OPTION
-@click.option("--model", "model", default=None, help=MODEL_HELP)
+@model_option
 @click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)
 def plan(file: str, as_json: bool, output: str | None, model: str | None, **reasoning: Any) -> None:
     """Order all detected boxes by repeated decisions: pick, remove from the set, decide again.

@@ -11,7 +11,7 @@ from typing import Any
 
 import click
 
-from unstack.cli.main import MODEL_HELP, _warn
+from unstack.cli.main import _warn, model_option
 from unstack.errors import UnstackError
 from unstack.picture_inputs import decision_values, scene_camera
 from unstack.pictures.render import COLOURINGS
@@ -58,7 +58,7 @@ def _check_suffix(output: str, suffixes: tuple[str, ...]) -> None:
               "file).")  # fmt: skip
 @click.option("--threshold", type=float, default=0.5, show_default=True, help="Smallest probability drawn as an arrow.")
 @click.option("--plan", "with_plan", is_flag=True, help="Number the boxes in unloading order (decide, remove, repeat).")
-@click.option("--model", "model", default=None, help=MODEL_HELP)
+@model_option
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Seed of sampled decisions.")
 @click.option("--title", default=None, help="Title of the picture (default: the file name).")
 @click.option("--dpi", type=click.IntRange(20, 600), default=110, show_default=True, help="Resolution of a PNG.")
@@ -126,7 +126,7 @@ def render(
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="HTML file to write.")
 @click.option("--decision", "decision_file", default=None, help=DECISION_HELP)
 @click.option("--plan", "with_plan", is_flag=True, help="Add a slider through the unloading order.")
-@click.option("--model", "model", default=None, help=MODEL_HELP)
+@model_option
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of sampled decisions and of the cloud subset.")  # fmt: skip
 @click.option("--max-points", type=click.IntRange(min=0), default=20_000, show_default=True,
