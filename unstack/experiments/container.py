@@ -127,6 +127,9 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     the default's pick unless the disturbance model (``moves``) expects its removal to move
     :data:`~unstack.moves.MOVES_VETO` boxes or more; then the fewest expected moves among the
     boxes the reasoner believes hold nothing up.
+``hybrid_moves_free_1``
+    the same, vetoed at :data:`~unstack.physics_veto.PHYSICS_VETO` expected boxes (as the
+    physics veto), not :data:`~unstack.moves.MOVES_VETO`.
 
 Metrics per pile and per maker: boxes moved more than 2 cm, boxes fallen (dropped more than
 0.2 m or tipped more than 45 degrees), the share of picks that move nothing, and paired
@@ -179,7 +182,7 @@ CONTAINER_MAKERS = (
     "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
     "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any",
-    "hybrid_faces_free_8", "hybrid_faces_free_sure", "hybrid_moves_free", "unstack_strict",
+    "hybrid_faces_free_8", "hybrid_faces_free_sure", "hybrid_moves_free", "unstack_strict", "hybrid_moves_free_1",
 )  # fmt: skip
 #: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
 #: run only when named.
@@ -191,7 +194,7 @@ TRIED_MAKERS = (
     "belief_occlusion", "belief_occlusion_free", "belief_bracket", "belief_occlusion_veto", "belief_guard",
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
     "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any",
-    "hybrid_faces_free_8", "hybrid_faces_free_sure", "hybrid_moves_free", "unstack_strict",
+    "hybrid_faces_free_8", "hybrid_faces_free_sure", "hybrid_moves_free", "unstack_strict", "hybrid_moves_free_1",
 )  # fmt: skip
 #: The makers run when none are named.
 DEFAULT_CONTAINER_MAKERS = tuple(
@@ -200,7 +203,7 @@ DEFAULT_CONTAINER_MAKERS = tuple(
 #: The free cost of the maker ``unstack_strict``.
 STRICT_FREE_COST = 0.2
 #: Makers that read the disturbance model (:mod:`unstack.moves`).
-MOVES_MAKERS = ("moves", "moves_veto", "hybrid_moves_free")
+MOVES_MAKERS = ("moves", "moves_veto", "hybrid_moves_free", "hybrid_moves_free_1")
 #: Makers whose policy is told what every candidate's removal does in the engine (the true pile).
 PROBING_MAKERS = ("lookahead",)
 #: Recorded sweeps per sampled group in each decision: 512 when a sweep re-inserted every box,
@@ -234,6 +237,7 @@ def container_policies(
     ``sampled`` fill's (default :data:`~unstack.sim.belief.OCCUPANCY`)."""
     from unstack.experiments.decisions import free_pick
     from unstack.height_veto import FREE_COST
+    from unstack.moves import MOVES_VETO
     from unstack.physics_veto import PHYSICS_VETO, PHYSICS_WORLDS
     from unstack.sim.belief import OCCUPANCY
 
@@ -435,27 +439,29 @@ def container_policies(
             return pick
         return str(vetoed.choice)
 
-    def hybrid_moves_free(scene: Scene) -> str:
-        """The default's pick unless the disturbance model expects its removal to move
-        :data:`~unstack.moves.MOVES_VETO` boxes or more; then the fewest expected moves among the
-        boxes the reasoner believes hold nothing up, ties to the box resting highest."""
-        from unstack.height_veto import FREE_COST, free_highest
-        from unstack.learning.pick_features import pick_features
-        from unstack.moves import MOVES_VETO
-        from unstack.pipeline import scene_support_probabilities
-        from unstack.reasoner.decision import decide
+    def moves_free(veto_at: float) -> Callable[[Scene], str]:
+        def policy(scene: Scene) -> str:
+            """The default's pick unless the disturbance model expects its removal to move
+            ``veto_at`` boxes or more; then the fewest expected moves among the boxes the
+            reasoner believes hold nothing up, ties to the box resting highest."""
+            from unstack.height_veto import FREE_COST, free_highest
+            from unstack.learning.pick_features import pick_features
+            from unstack.pipeline import scene_support_probabilities
+            from unstack.reasoner.decision import decide
 
-        supports = scene_support_probabilities(scene, model)
-        reasoned = decide(supports, cost="load", samples=samples, seed=seed)
-        pick = str(free_highest(reasoned, scene).choice)
-        features = pick_features(scene, supports, reasoned.marginals, reasoned.expected_costs)
-        predicted = disturbance_model().expected_moves(features)
-        expected = dict(zip(supports.objects, (float(moved) for moved in predicted), strict=True))
-        if expected[pick] < MOVES_VETO:
-            return pick
-        costs = expected_costs(reasoned)
-        free = [box_id for box_id in scene.detected if costs[box_id] < FREE_COST] or list(scene.detected)
-        return fewest(scene, {box_id: expected[box_id] if box_id in free else np.inf for box_id in scene.detected})
+            supports = scene_support_probabilities(scene, model)
+            reasoned = decide(supports, cost="load", samples=samples, seed=seed)
+            pick = str(free_highest(reasoned, scene).choice)
+            features = pick_features(scene, supports, reasoned.marginals, reasoned.expected_costs)
+            predicted = disturbance_model().expected_moves(features)
+            expected = dict(zip(supports.objects, (float(moved) for moved in predicted), strict=True))
+            if expected[pick] < veto_at:
+                return pick
+            costs = expected_costs(reasoned)
+            free = [box_id for box_id in scene.detected if costs[box_id] < FREE_COST] or list(scene.detected)
+            return fewest(scene, {box_id: expected[box_id] if box_id in free else np.inf for box_id in scene.detected})
+
+        return policy
 
     def belief_seen(scene: Scene) -> str:
         import dataclasses
@@ -535,7 +541,8 @@ def container_policies(
         "hybrid_faces_free_any": faces_free(1.0 / PHYSICS_WORLDS),
         "hybrid_faces_free_8": faces_free(PHYSICS_VETO, 2 * PHYSICS_WORLDS),
         "hybrid_faces_free_sure": hybrid_faces_free_sure,
-        "hybrid_moves_free": hybrid_moves_free,
+        "hybrid_moves_free": moves_free(MOVES_VETO),
+        "hybrid_moves_free_1": moves_free(PHYSICS_VETO),
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:
