@@ -63,10 +63,14 @@ PHYSICS_FILL = "faces"
 WALL_SLACK = 0.02
 
 
-def _expected_moved(world_scene: Scene, boxes: list[str], seed: int, settings: Any, worlds: int) -> dict[str, float]:
+def _expected_moved(
+    world_scene: Scene, boxes: list[str], seed: int, settings: Any, worlds: int, net: bool = False
+) -> dict[str, float]:
     from unstack.sim.belief import belief_removals
 
-    outcomes = belief_removals(world_scene, boxes, worlds=worlds, fill=PHYSICS_FILL, seed=seed, settings=settings)
+    outcomes = belief_removals(
+        world_scene, boxes, worlds=worlds, fill=PHYSICS_FILL, seed=seed, settings=settings, net=net
+    )
     return {box_id: float(outcome.expected_moved) for box_id, outcome in outcomes.items()}
 
 
@@ -152,6 +156,7 @@ def physics_veto(
     free_cost: float = FREE_COST,
     veto_at: float = PHYSICS_VETO,
     worlds: int = PHYSICS_WORLDS,
+    net: bool = False,
 ) -> Decision:
     """The decision with its pick vetoed where physics on the belief expects it to move boxes.
 
@@ -174,6 +179,9 @@ def physics_veto(
         :data:`PHYSICS_VETO`).
     worlds : int
         Belief worlds each box is tried in (default :data:`PHYSICS_WORLDS`).
+    net : bool
+        Count, in each world, only the boxes that stay still there with nothing taken (measured
+        no better than counting every box: the results page, maker ``hybrid_faces_free_net``).
 
     Returns
     -------
@@ -218,13 +226,13 @@ def physics_veto(
     settings = world_settings(given)
     built, slid = _inside_container(given, settings)
     pick = decision.choice
-    expected = _expected_moved(built, [pick], seed, settings, worlds)
+    expected = _expected_moved(built, [pick], seed, settings, worlds, net)
     vetoed = expected[pick] >= veto_at
     if vetoed:
         costs = dict(zip(decision.objects, (float(cost) for cost in decision.expected_costs), strict=True))
         others = [box_id for box_id in decision.objects if box_id != pick and costs[box_id] < free_cost]
         if others:
-            expected.update(_expected_moved(built, others, seed, settings, worlds))
+            expected.update(_expected_moved(built, others, seed, settings, worlds, net))
     record = _record(expected, pick, vetoed, veto_at, worlds)
     warnings = decision.warnings
     if vetoed:  # a world that does not come to rest moves boxes whatever is taken

@@ -216,3 +216,15 @@ def test_a_box_that_cannot_stand_as_reported_is_restless_and_a_calm_pile_is_not(
     assert restless_boxes(scene) == ("floating",)
     with pytest.raises(UnstackError, match="unknown belief fill 'cloud' for a rest check"):
         restless_boxes(scene, fill="cloud")
+
+
+def test_net_outcomes_leave_out_what_moves_with_nothing_taken() -> None:
+    stack = [Box("base", [0.4, 0.4, 0.3], [1.2, -0.4, 0.151]), Box("top", [0.4, 0.4, 0.3], [1.2, -0.4, 0.452])]
+    floating = Box("floating", [0.4, 0.4, 0.3], [1.2, 0.5, 1.75])  # falls whatever is taken
+    boxes = [*stack, floating]
+    scene = Scene(boxes, surface_cloud(boxes, viewpoint=VIEWPOINT, seed=0), ["base", "top", "floating"])
+    gross = belief_removals(scene, ["top", "base"], worlds=2, fill="faces")
+    net = belief_removals(scene, ["top", "base"], worlds=2, fill="faces", net=True)
+    assert "floating" in gross["top"].moved and gross["top"].expected_moved >= 1.0
+    assert net["top"].moved == () and net["top"].expected_moved == 0.0
+    assert set(net["base"].moved) == {"top"}  # what the pick itself sets moving is still counted

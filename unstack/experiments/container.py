@@ -120,6 +120,9 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     of at least one box over :data:`~unstack.physics_veto.PHYSICS_WORLDS`).
 ``hybrid_faces_free_8``
     ``hybrid_faces_free`` in twice :data:`~unstack.physics_veto.PHYSICS_WORLDS` belief worlds.
+``hybrid_faces_free_net``
+    ``hybrid_faces_free`` counting, in each belief world, only the boxes that stay still there
+    with nothing taken (``net=True`` of :func:`unstack.physics_veto.physics_veto`).
 ``hybrid_faces_free_sure``
     ``hybrid_faces_free``, a vetoed pick replaced only by a box expected to move fewer than
     :data:`~unstack.physics_veto.PHYSICS_VETO` boxes (among boxes as bad, height stands).
@@ -183,6 +186,7 @@ CONTAINER_MAKERS = (
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
     "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any",
     "hybrid_faces_free_8", "hybrid_faces_free_sure", "hybrid_moves_free", "unstack_strict", "hybrid_moves_free_1",
+    "hybrid_faces_free_net",
 )  # fmt: skip
 #: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
 #: run only when named.
@@ -195,6 +199,7 @@ TRIED_MAKERS = (
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
     "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any",
     "hybrid_faces_free_8", "hybrid_faces_free_sure", "hybrid_moves_free", "unstack_strict", "hybrid_moves_free_1",
+    "hybrid_faces_free_net",
 )  # fmt: skip
 #: The makers run when none are named.
 DEFAULT_CONTAINER_MAKERS = tuple(
@@ -404,7 +409,9 @@ def container_policies(
 
         return policy
 
-    def faces_vetoed(scene: Scene, veto_at: float = PHYSICS_VETO, worlds: int = PHYSICS_WORLDS) -> tuple[str, Any]:
+    def faces_vetoed(
+        scene: Scene, veto_at: float = PHYSICS_VETO, worlds: int = PHYSICS_WORLDS, net: bool = False
+    ) -> tuple[str, Any]:
         """The hybrid's pick, and the decision with it vetoed where the faces belief expects its
         removal to move ``veto_at`` boxes: then that belief's fewest among the boxes the
         reasoner believes hold nothing up (:func:`unstack.physics_veto.physics_veto` on the
@@ -419,13 +426,13 @@ def container_policies(
         pick = hybrid_choice(scene, reasoned)
         vetoed = physics_veto(
             dataclasses.replace(reasoned, choice=pick), scene, seed=seed, world_scene=in_view_scene(scene),
-            veto_at=veto_at, worlds=worlds,
+            veto_at=veto_at, worlds=worlds, net=net,
         )  # fmt: skip
         return pick, vetoed
 
-    def faces_free(veto_at: float, worlds: int = PHYSICS_WORLDS) -> Callable[[Scene], str]:
+    def faces_free(veto_at: float, worlds: int = PHYSICS_WORLDS, net: bool = False) -> Callable[[Scene], str]:
         def policy(scene: Scene) -> str:
-            return str(faces_vetoed(scene, veto_at, worlds)[1].choice)
+            return str(faces_vetoed(scene, veto_at, worlds, net)[1].choice)
 
         return policy
 
@@ -540,6 +547,7 @@ def container_policies(
         "hybrid_faces_free": faces_free(PHYSICS_VETO),
         "hybrid_faces_free_any": faces_free(1.0 / PHYSICS_WORLDS),
         "hybrid_faces_free_8": faces_free(PHYSICS_VETO, 2 * PHYSICS_WORLDS),
+        "hybrid_faces_free_net": faces_free(PHYSICS_VETO, net=True),
         "hybrid_faces_free_sure": hybrid_faces_free_sure,
         "hybrid_moves_free": moves_free(MOVES_VETO),
         "hybrid_moves_free_1": moves_free(PHYSICS_VETO),

@@ -516,11 +516,13 @@ def _try_removals(
     simulation: Any,
     rng: np.random.Generator | None,
     hold_rounds: int = HOLD_ROUNDS,
+    net: bool = False,
 ) -> dict[str, tuple[str, ...]]:
     """One belief world: build, support or hold what it cannot hold, try each removal and undo it.
 
     ``rng`` None: every detected box of the typical mass; else masses drawn uniformly from the
-    settings' range. Returns what moved per candidate.
+    settings' range. ``net``: the bodies that move in this world with nothing taken (over the
+    same horizon) are not counted for any candidate. Returns what moved per candidate.
     """
     from unstack.sim.ground_truth import PARKING, run_horizon
     from unstack.sim.unloading import RESETTLE_SECONDS
@@ -558,6 +560,14 @@ def _try_removals(
         state = client.saveState()
         outcomes = {}
         try:
+            anyway: set[str] = set()
+            if net:
+                watched_names = [name for name in names if name not in held]
+                watched = [bodies[name] for name in watched_names]
+                before = world.poses(watched)
+                run_horizon(world, truth, watched)
+                anyway = {watched_names[k] for k in np.flatnonzero(_disturbed(before, world.poses(watched), truth))}
+                client.restoreState(stateId=state)
             for box_id in tried:
                 watched_names = [name for name in names if name != box_id and name not in held]
                 watched = [bodies[name] for name in watched_names]
@@ -569,7 +579,9 @@ def _try_removals(
                 client.resetBaseVelocity(bodies[box_id], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
                 run_horizon(world, truth, watched)
                 moved = _disturbed(before, world.poses(watched), truth)
-                outcomes[box_id] = tuple(watched_names[k] for k in np.flatnonzero(moved)) + leaning
+                outcomes[box_id] = (
+                    tuple(watched_names[k] for k in np.flatnonzero(moved) if watched_names[k] not in anyway) + leaning
+                )
                 client.restoreState(stateId=state)
         finally:
             client.removeState(state)
@@ -653,6 +665,7 @@ def belief_removals(
     settings: Any = None,
     fill: str = "cloud",
     occupancy: float = OCCUPANCY,
+    net: bool = False,
 ) -> dict[str, BeliefOutcome]:
     """What removing each candidate moves in the belief worlds built from ``scene``.
 
@@ -679,6 +692,9 @@ def belief_removals(
     occupancy : float
         With ``fill="sampled"``: the chance that a run of unseen space is kept solid
         (:data:`OCCUPANCY`); ``"scaled"`` and ``"faces"`` take :func:`scaled_occupancy` instead.
+    net : bool
+        Count, in each world, only the boxes that stay still there when nothing is taken (a
+        world that does not come to rest moves some boxes whatever is taken).
 
     Returns
     -------
@@ -700,14 +716,14 @@ def belief_removals(
     rng = np.random.default_rng(seed)
     if fill in ("sampled", "scaled", "faces"):
         runs = [
-            _try_removals(scene, blocks, tried, simulation, None, 0)
+            _try_removals(scene, blocks, tried, simulation, None, 0, net)
             for blocks in _drawn_worlds(scene, simulation, fill, occupancy, worlds, rng)
         ]
     else:
         blocks = belief_blocks(scene) if fill == "cloud" else occlusion_blocks(scene, simulation)
         hold_rounds = HOLD_ROUNDS if fill == "cloud" else 0
         runs = [
-            _try_removals(scene, blocks, tried, simulation, None if world == 0 else rng, hold_rounds)
+            _try_removals(scene, blocks, tried, simulation, None if world == 0 else rng, hold_rounds, net)
             for world in range(worlds)
         ]
     return {
