@@ -86,7 +86,10 @@ def test_the_hybrid_takes_the_highest_box_the_model_does_not_believe_loaded() ->
         "hybrid_faces_free_any",
         "hybrid_faces_free_8",
         "hybrid_faces_free_sure",
+        "hybrid_faces_free_net",
+        "hybrid_faces_free_gated",
         "hybrid_moves_free",
+        "hybrid_moves_free_1",
     ],
 )
 def test_the_hybrid_vetoes_start_from_the_hybrids_pick_not_the_highest_box(maker: str) -> None:
