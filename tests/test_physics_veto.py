@@ -74,6 +74,12 @@ def test_a_lower_veto_vetoes_whatever_the_default_veto_does_and_is_recorded(smal
         physics_veto(default, scene, veto_at=0.0)
     with pytest.raises(InvalidArgument, match="worlds must be a positive integer, got 0"):
         physics_veto(default, scene, worlds=0)
+    with pytest.raises(InvalidArgument, match="net must be True or False, got 1"):
+        physics_veto(default, scene, net=1)  # type: ignore[arg-type]
+    netted = physics_veto(default, scene, seed=0, net=True)
+    assert netted.physics_veto is not None and netted.physics_veto["net"] is True
+    assert "net" not in usual.physics_veto
+    Draft202012Validator(load_schema("unstack.decision/1")).validate(netted.to_dict())
 
 
 def test_the_same_seed_gives_the_same_worlds_and_choice(small_dataset: Path) -> None:

@@ -181,7 +181,8 @@ def physics_veto(
         Belief worlds each box is tried in (default :data:`PHYSICS_WORLDS`).
     net : bool
         Count, in each world, only the boxes that stay still there with nothing taken (measured
-        no better than counting every box: the results page, maker ``hybrid_faces_free_net``).
+        no better than counting every box: the results page, maker ``hybrid_faces_free_net``);
+        recorded as ``physics_veto["net"]``.
 
     Returns
     -------
@@ -219,6 +220,8 @@ def physics_veto(
         raise InvalidArgument(f"veto_at must be positive (a pick moving no box is never vetoed), got {veto_at!r}")
     if isinstance(worlds, bool) or not isinstance(worlds, int) or worlds < 1:
         raise InvalidArgument(f"worlds must be a positive integer, got {worlds!r}")
+    if not isinstance(net, bool):
+        raise InvalidArgument(f"net must be True or False, got {net!r}")
     missing = [box_id for box_id in decision.objects if box_id not in scene.detected]
     if missing:
         raise InvalidArgument(f"{scene.source}: the decision's boxes {missing} are not detected boxes of the scene")
@@ -234,6 +237,8 @@ def physics_veto(
         if others:
             expected.update(_expected_moved(built, others, seed, settings, worlds, net))
     record = _record(expected, pick, vetoed, veto_at, worlds)
+    if net:
+        record["net"] = True
     warnings = decision.warnings
     if vetoed:  # a world that does not come to rest moves boxes whatever is taken
         from unstack.sim.belief import restless_boxes
