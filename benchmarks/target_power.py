@@ -78,6 +78,15 @@ def family_power(highest_run: Path, lookahead_run: Path, policy_run: Path, polic
     }
 
 
+def table_row(name: str, row: dict[str, float]) -> str:
+    """One family's printed row (see the header :func:`main` prints)."""
+    return (
+        f"{name} | {row['piles']} | {row['gap']:.2f} | {row['difference']:+.2f} +- {row['standard_error']:.2f} "
+        f"(sd {row['spread']:.2f}) | {row['expected_z']:.1f}, {row['chance']:.0%} | "
+        f"{math.ceil(row['piles_for_z'])} / {math.ceil(row['piles_for_power'])}"
+    )
+
+
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("families", nargs="+", help="NAME=HIGHEST_RUN,LOOKAHEAD_RUN,POLICY_RUN")
@@ -95,13 +104,7 @@ def main(argv: list[str]) -> int:
                 f"target_power.py: error: {item}: expected NAME=HIGHEST_RUN,LOOKAHEAD_RUN,POLICY_RUN", file=sys.stderr
             )
             return 2
-        row = family_power(runs[0], runs[1], runs[2], arguments.policy)
-        print(
-            f"{name} | {row['piles']} | {row['gap']:.2f} | {row['difference']:+.2f} +- {row['standard_error']:.2f} "
-            f"(sd {row['spread']:.2f}) | {row['expected_z']:.1f}, {row['chance']:.0%} | "
-            f"{math.ceil(row['piles_for_z'])} / {math.ceil(row['piles_for_power'])}",
-            flush=True,
-        )
+        print(table_row(name, family_power(runs[0], runs[1], runs[2], arguments.policy)), flush=True)
     return 0
 
 
