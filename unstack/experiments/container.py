@@ -419,19 +419,24 @@ def container_policies(
         return policy
 
     def faces_vetoed(
-        scene: Scene, veto_at: float = PHYSICS_VETO, worlds: int = PHYSICS_WORLDS, net: bool = False
+        scene: Scene,
+        veto_at: float = PHYSICS_VETO,
+        worlds: int = PHYSICS_WORLDS,
+        net: bool = False,
+        reasoned: Any = None,
     ) -> tuple[str, Any]:
         """The hybrid's pick, and the decision with it vetoed where the faces belief expects its
         removal to move ``veto_at`` boxes: then that belief's fewest among the boxes the
         reasoner believes hold nothing up (:func:`unstack.physics_veto.physics_veto` on the
-        boxes in view)."""
+        boxes in view). ``reasoned``: the load decision on ``scene``, when already made."""
         import dataclasses
 
         from unstack.height_veto import hybrid_choice
         from unstack.physics_veto import physics_veto
         from unstack.sim.unloading import in_view_scene
 
-        reasoned = decision(scene, "load")
+        if reasoned is None:
+            reasoned = decision(scene, "load")
         pick = hybrid_choice(scene, reasoned)
         vetoed = physics_veto(
             dataclasses.replace(reasoned, choice=pick), scene, seed=seed, world_scene=in_view_scene(scene),
@@ -460,7 +465,7 @@ def container_policies(
         score = float(disturbance_model().expected_moves(features)[list(supports.objects).index(pick)])
         if score < GATE_MOVES:
             return pick
-        return str(faces_vetoed(scene)[1].choice)
+        return str(faces_vetoed(scene, reasoned=reasoned)[1].choice)
 
     def hybrid_faces_free_sure(scene: Scene) -> str:
         """``hybrid_faces_free``, but a vetoed pick is replaced only by a box the belief expects
