@@ -487,12 +487,12 @@ def _build(
         bodies[box_id] = world.add_box(box.size, box.position, box.orientation_xyzw, mass=mass)
     typical_mass = float(np.mean(list(masses.values()))) if masses else 1.0
     for block in blocks:
-        if block.resting_on is None:
-            world.add_fixed_block(block.size, block.center)
-        else:
+        if block.resting_on is not None:
             volume = float(np.prod(scene.box(block.resting_on).size))
             load_mass = typical_mass * min(1.0, float(np.prod(block.size)) / volume)
             bodies[f"load:{block.resting_on}"] = world.add_box(block.size, block.center, [0, 0, 0, 1], mass=load_mass)
+    fixed = [block for block in blocks if block.resting_on is None]
+    world.add_fixed_blocks([block.size for block in fixed], [block.center for block in fixed])
     return bodies
 
 

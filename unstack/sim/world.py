@@ -196,11 +196,46 @@ class PhysicsWorld:
         self.boxes.append(body)
         return body
 
-    def add_fixed_block(self, size: Any, center: Any) -> int:
-        """Add a static, axis-aligned block (unseen material that holds up what rests on it)."""
-        body = self._static_box([float(value) / 2.0 for value in size], [float(value) for value in center])
-        self.static.append(body)
-        return body
+    def add_fixed_blocks(self, sizes: Any, centers: Any) -> list[int]:
+        """Add static, axis-aligned blocks (unseen material that holds up what rests on it);
+        their body ids in the order given.
+
+        Blocks of one size share a collision shape and are created in one batched call, about
+        eight times faster than a call each (the unseen space of a belief world is a few
+        hundred blocks of a few dozen sizes).
+
+        Examples
+        --------
+        >>> from unstack.sim.settings import SimulationSettings
+        >>> with PhysicsWorld(SimulationSettings(boxes=(1, 1))) as world:
+        ...     blocks = world.add_fixed_blocks([[0.2, 0.2, 0.2]] * 3, [[1.0, y, 0.1] for y in (-0.5, 0.0, 0.5)])
+        ...     len(blocks), len(world.static)
+        (3, 8)
+        """
+        halves = [tuple(float(value) / 2.0 for value in size) for size in sizes]
+        places = [[float(value) for value in center] for center in centers]
+        if len(halves) != len(places):
+            raise ValueError(f"{len(halves)} block sizes for {len(places)} centres")
+        by_size: dict[tuple[float, ...], list[int]] = {}
+        for row, half in enumerate(halves):
+            by_size.setdefault(half, []).append(row)
+        client = self.client
+        bodies = [0] * len(places)
+        for half, rows in by_size.items():
+            shape = client.createCollisionShape(client.GEOM_BOX, halfExtents=list(half))
+            if len(rows) == 1:  # pybullet returns one id, not a tuple, for a batch of one
+                created = [
+                    client.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=shape, basePosition=places[rows[0]])
+                ]
+            else:
+                created = client.createMultiBody(
+                    baseMass=0.0, baseCollisionShapeIndex=shape, batchPositions=[places[row] for row in rows]
+                )
+            for row, body in zip(rows, created, strict=True):
+                client.changeDynamics(body, -1, lateralFriction=self.settings.pile.friction)
+                bodies[row] = int(body)
+        self.static.extend(bodies)
+        return bodies
 
     def remove_box(self, body: int) -> None:
         """Delete a box for good (only while building a pile, never after ``saveState``)."""
