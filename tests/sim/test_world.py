@@ -60,3 +60,22 @@ def test_a_pile_has_the_requested_boxes_inside_the_container(settings: Simulatio
 def test_rotation_angle_of_a_quarter_turn() -> None:
     quarter = np.array([[0.0, 0.0, np.sin(np.pi / 4), np.cos(np.pi / 4)]])
     assert np.allclose(rotation_angles_deg(np.array([[0.0, 0.0, 0.0, 1.0]]), quarter), 90.0)
+
+
+def test_fixed_blocks_of_several_sizes_stand_where_given_and_hold_a_box(settings: SimulationSettings) -> None:
+    sizes = [[0.3, 0.3, 0.2], [0.2, 0.2, 0.2], [0.3, 0.3, 0.2], [0.3, 0.3, 0.4]]
+    centres = [[0.5, -0.6, 0.1], [0.5, 0.0, 0.1], [0.5, 0.6, 0.1], [1.2, 0.0, 0.2]]
+    with PhysicsWorld(settings, door=False) as world:
+        blocks = world.add_fixed_blocks(sizes, centres)
+        on_block = world.add_box([0.2, 0.2, 0.2], [1.2, 0.0, 0.55], [0, 0, 0, 1], mass=5.0)
+        world.settle()
+        resting, _ = world.poses([on_block])
+        standing = [world.client.getBasePositionAndOrientation(body)[0] for body in blocks]
+    assert len(set(blocks)) == 4 and world.static[-len(blocks) :] == blocks
+    np.testing.assert_allclose(standing, centres)
+    assert abs(resting[0, 2] - 0.5) < 2e-3  # on the tall block: 0.4 m + half its 0.2 m
+
+
+def test_fixed_blocks_need_a_centre_for_each_size(settings: SimulationSettings) -> None:
+    with PhysicsWorld(settings, door=False) as world, pytest.raises(ValueError, match=r"2 block sizes for 1 centres"):
+        world.add_fixed_blocks([[0.2, 0.2, 0.2]] * 2, [[0.5, 0.0, 0.1]])
