@@ -69,16 +69,12 @@ def scene_camera(scene: Scene) -> Any:
     """The sensor that scanned a simulated scene, as a :class:`~unstack.pictures.camera.Camera`
     (the default camera for a scene without simulation settings)."""
     from unstack.pictures.camera import Camera
+    from unstack.sim.settings import scene_settings
 
-    settings = scene.metadata.get("settings")
-    if not isinstance(settings, dict):
+    settings = scene_settings(scene)
+    if settings is None:
         return Camera()
-    from unstack.sim.settings import SimulationSettings
-
-    try:
-        sensor = SimulationSettings.from_dict(settings).sensor
-    except (KeyError, TypeError, ValueError, UnstackError):
-        return Camera()
+    sensor = settings.sensor
     return Camera(
         position=(float(sensor.position[0]), float(sensor.position[1]), float(sensor.position[2])),
         target=(float(sensor.target[0]), float(sensor.target[1]), float(sensor.target[2])),

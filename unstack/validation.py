@@ -80,14 +80,19 @@ def validate(path: str | os.PathLike[str]) -> Validated:
         detail = f"{supports.n_objects} objects"
     elif tag == "unstack.scene/1":
         from unstack.scene import Scene
+        from unstack.sim.settings import scene_settings
         from unstack.understanding.plausibility import scene_warnings
 
         scene = Scene.from_document(document)
+        scene_settings(scene)
         detail = f"{len(scene.boxes)} boxes, {len(scene.detected)} detected, {len(scene.points):,} points"
         return Validated(document.source, tag, detail, tuple(scene_warnings(scene)))
     elif tag == "unstack.plan/1":
         detail = f"{len(document.data['order'])} boxes in order"
     elif tag == "unstack.dataset/1":
+        from unstack.sim.settings import settings_from_json
+
+        settings_from_json(document.data["settings"], source=document.source, path="$.settings")
         detail = f"{document.data['configs']} configurations, seed {document.data['seed']}"
     elif tag == "unstack.payoff/1":
         detail = f"{document.data['consistent_worlds']} consistent worlds"

@@ -232,3 +232,36 @@ def test_chains_that_have_not_mixed_are_warned_about_once_on_stderr_and_in_the_j
     document = json.loads(as_json.stdout)
     assert document["sampling"]["warning"] in document["warnings"]
     assert as_json.stderr.startswith("unstack: warning: the chains disagree")
+
+
+@pytest.mark.parametrize(
+    ("command", "setting", "value", "fragment"),
+    [
+        (["decide", "--physics-veto"], "pile", "x", "$.metadata.settings.pile: expected an object, got 'x'"),
+        (["decide", "--physics-veto"], "ground_truth", {"horizon": 1e6}, "$.metadata.settings.ground_truth.horizon"),
+        (["validate"], "sensor", {"width": "wide"}, "$.metadata.settings.sensor.width: expected a whole number"),
+        (["render", "--output", "PICTURE"], "sensor", {"position": [0, 0]}, "$.metadata.settings.sensor.position"),
+    ],
+)
+def test_simulation_settings_of_a_scene_are_checked_where_they_are_read(
+    tmp_path: Path, examples: Path, command: list[str], setting: str, value: object, fragment: str
+) -> None:
+    scene = json.loads((examples / "pile5.scene.json").read_text())
+    scene["metadata"]["settings"][setting] = value
+    (tmp_path / "pile5.scene.points.npy").write_bytes((examples / "pile5.scene.points.npy").read_bytes())
+    path = tmp_path / "pile5.scene.json"
+    path.write_text(json.dumps(scene))
+    arguments = [str(tmp_path / "out.png") if part == "PICTURE" else part for part in command]
+    one_line_error(unstack(*arguments, str(path)), str(path), fragment)
+    assert not (tmp_path / "out.png").exists()
+
+
+def test_validate_checks_the_settings_of_a_data_set_manifest(tmp_path: Path) -> None:
+    from unstack.sim.settings import SimulationSettings
+
+    settings = SimulationSettings().to_dict()
+    settings["pile"]["mass_range"] = [15.0, 5.0]
+    manifest = {"format": "unstack.dataset/1", "seed": 0, "configs": 1, "settings": settings}
+    path = tmp_path / "manifest.json"
+    path.write_text(json.dumps(manifest))
+    one_line_error(unstack("validate", str(path)), "$.settings.pile.mass_range: expected [low, high] with low <= high")

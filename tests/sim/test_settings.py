@@ -6,7 +6,16 @@ import json
 
 import pytest
 
-from unstack.sim.settings import SIZE_SETS, Container, InvalidSettings, SimulationSettings
+from unstack.errors import InvalidFile, InvalidScene
+from unstack.sim.settings import (
+    SIZE_SETS,
+    Container,
+    InvalidSettings,
+    PileSettings,
+    SensorSettings,
+    SimulationSettings,
+    settings_from_json,
+)
 
 
 def test_defaults_are_the_papers_setting() -> None:
@@ -42,3 +51,60 @@ def test_bad_settings_are_one_line_errors(arguments: dict[str, object], message:
     with pytest.raises(InvalidSettings, match=message) as caught:
         SimulationSettings(**arguments)  # type: ignore[arg-type]
     assert "\n" not in str(caught.value)
+
+
+@pytest.mark.parametrize(
+    ("section", "key", "value", "message"),
+    [
+        (
+            "pile",
+            "time_step",
+            -0.5,
+            r"\$\.pile\.time_step: expected a physics step above 0 and at most 0\.02 s, got -0\.5",
+        ),
+        ("pile", "time_step", 0.1, r"\$\.pile\.time_step: expected a physics step"),
+        ("pile", "mass_range", [5.0], r"\$\.pile\.mass_range: expected a list of 2 numbers"),
+        ("pile", "mass_range", [15.0, 5.0], r"\$\.pile\.mass_range: expected \[low, high\] with low <= high"),
+        ("pile", "mass_range", [float("nan"), 5.0], r"\$\.pile\.mass_range\[0\]: expected a finite number, got nan"),
+        ("pile", "friction", "high", r"\$\.pile\.friction: expected a finite number, got 'high'"),
+        ("pile", "settle_windows", 2.5, r"\$\.pile\.settle_windows: expected a whole number, got 2\.5"),
+        ("ground_truth", "horizon", 1e6, r"\$\.ground_truth\.horizon: expected a number from 0\.001 to 60"),
+        ("ground_truth", "displacement_threshold", True, r"displacement_threshold: expected a finite number, got True"),
+        ("ground_truth", "rotation_threshold_deg", 0.0, r"rotation_threshold_deg: expected a number from 0\.01 to 90"),
+        ("sensor", "width", 10**9, r"\$\.sensor\.width: expected a number from 1 to 8192"),
+        ("sensor", "position", [0.0, 0.0], r"\$\.sensor\.position: expected a list of 3 numbers"),
+        ("sensor", "target", [1e308, 0.0, 0.0], r"\$\.sensor\.target\[0\]: expected a coordinate within 100 m"),
+        ("sensor", "far", 0.05, r"\$\.sensor\.far: expected beyond near \(0\.1\), got 0\.05"),
+        ("sensor", "noise", 1, r"\$\.sensor\.noise: expected true or false, got 1"),
+        ("sensor", "lens", 1, r"\$\.sensor: unknown key 'lens'; expected keys among position, target"),
+        ("container", "depth", 1e308, r"\$\.container\.depth: expected a positive extent of at most 100 m"),
+    ],
+)
+def test_settings_from_json_names_the_field_and_what_was_expected(
+    section: str, key: str, value: object, message: str
+) -> None:
+    data = SimulationSettings().to_dict()
+    data[section][key] = value
+    with pytest.raises(InvalidFile, match=message) as caught:
+        settings_from_json(data)
+    assert "\n" not in str(caught.value)
+
+
+@pytest.mark.parametrize("part", ["container", "pile", "ground_truth", "sensor"])
+def test_settings_from_json_refuses_a_part_that_is_not_an_object(part: str) -> None:
+    data = SimulationSettings().to_dict()
+    data[part] = [1, 2]
+    with pytest.raises(InvalidFile, match=rf"<settings>: \$\.{part}: expected an object, got \[1, 2\]"):
+        settings_from_json(data)
+
+
+def test_settings_from_json_gives_left_out_keys_their_defaults() -> None:
+    settings = settings_from_json({"boxes": [3, 5], "pile": {"friction": 0.8}})
+    assert settings.boxes == (3, 5) and settings.pile.friction == 0.8
+    assert settings.pile.time_step == PileSettings().time_step and settings.sensor == SensorSettings()
+
+
+def test_settings_from_json_turns_a_refused_combination_into_a_path_error() -> None:
+    data = {"sizes": "four", "container": {"depth": 0.2}}
+    with pytest.raises(InvalidScene, match=r"a\.json: \$\.metadata\.settings: boxes of size set 'four' do not fit"):
+        settings_from_json(data, source="a.json", path="$.metadata.settings", error=InvalidScene)

@@ -62,10 +62,10 @@ def _roundtrip_pile(path: Path, number: int, model: Any, samples: int) -> tuple[
     from unstack.reasoner.decision import decide
     from unstack.scene import Scene, load_scene
     from unstack.sim.camera_view import camera_view
-    from unstack.sim.settings import SimulationSettings
+    from unstack.sim.settings import SimulationSettings, scene_settings
 
     scene = load_scene(path)
-    settings = SimulationSettings.from_dict(scene.metadata["settings"])
+    settings = scene_settings(scene) or SimulationSettings()
     view = camera_view(scene)
     ids = sorted(view.masks)
     built = scene_from_depth(

@@ -314,10 +314,10 @@ def container_policies(
 
     def rebuilding(own_masses: bool) -> Callable[[Scene], str]:
         def policy(scene: Scene) -> str:
-            from unstack.sim.settings import SimulationSettings
+            from unstack.sim.belief import belief_settings
             from unstack.sim.unloading import rebuilt_removals
 
-            typical = float(np.mean(SimulationSettings.from_dict(scene.metadata["settings"]).pile.mass_range))
+            typical = float(np.mean(belief_settings(scene).pile.mass_range))
             masses = None if own_masses else {box.id: typical for box in scene.boxes}
             return lookahead(scene, rebuilt_removals(scene, masses=masses))
 
@@ -332,11 +332,10 @@ def container_policies(
         return lookahead(scene, rebuilt_removals(scene, fixed=hidden))
 
     def rebuilt_draws(scene: Scene) -> str:
-        from unstack.sim.belief import BELIEF_WORLDS
-        from unstack.sim.settings import SimulationSettings
+        from unstack.sim.belief import BELIEF_WORLDS, belief_settings
         from unstack.sim.unloading import rebuilt_removals
 
-        low, high = SimulationSettings.from_dict(scene.metadata["settings"]).pile.mass_range
+        low, high = belief_settings(scene).pile.mass_range
         draws = np.random.default_rng(seed)
         moved = {box_id: 0.0 for box_id in scene.detected}
         for _ in range(BELIEF_WORLDS):

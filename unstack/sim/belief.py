@@ -396,14 +396,11 @@ def _faced(blocks: Sequence[BeliefBlock], behind: np.ndarray) -> tuple[list[Beli
 def belief_settings(scene: Scene, settings: Any = None) -> Any:
     """The simulation settings belief worlds of ``scene`` are built with: ``settings`` when
     given, else a simulated scene's own (``metadata.settings``), else the defaults."""
-    from unstack.sim.settings import SimulationSettings
+    from unstack.sim.settings import SimulationSettings, scene_settings
 
     if settings is not None:
         return settings
-    data = scene.metadata.get("settings")
-    if isinstance(data, dict):
-        return SimulationSettings.from_dict(data)
-    return SimulationSettings()
+    return scene_settings(scene) or SimulationSettings()
 
 
 def _disturbed(before: tuple[np.ndarray, np.ndarray], after: tuple[np.ndarray, np.ndarray], truth: Any) -> np.ndarray:

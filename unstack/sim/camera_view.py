@@ -47,12 +47,12 @@ class CameraView:
 
 def scene_sensor(scene: Scene) -> Any:
     """The sensor a simulated scene was scanned with (its viewpoint moved as the data set moved it)."""
-    from unstack.sim.settings import SimulationSettings
+    from unstack.sim.settings import scene_settings
 
-    data = scene.metadata.get("settings")
-    if not isinstance(data, dict):
+    settings = scene_settings(scene)
+    if settings is None:
         raise UnstackError(f"{scene.source}: $.metadata.settings: rendering a camera view needs a simulated scene")
-    sensor = dataclasses.replace(SimulationSettings.from_dict(data).sensor, position_jitter=0.0)
+    sensor = dataclasses.replace(settings.sensor, position_jitter=0.0)
     simulation = scene.metadata.get("simulation", {})
     if "sensor_position" in simulation:
         sensor = dataclasses.replace(
@@ -67,11 +67,11 @@ def camera_view(scene: Scene, *, noise_seed: int | None = None) -> CameraView:
     ``noise_seed``: with the sensor's depth noise on (its ``noise`` setting), the seed of the noise.
     """
     from unstack.sim.sensor import scan_pile, sensor_intrinsics, sensor_pose
-    from unstack.sim.settings import SimulationSettings
+    from unstack.sim.settings import SimulationSettings, scene_settings
     from unstack.sim.world import PhysicsWorld
 
     sensor = scene_sensor(scene)
-    settings = SimulationSettings.from_dict(scene.metadata["settings"])
+    settings = scene_settings(scene) or SimulationSettings()
     with PhysicsWorld(settings, door=False) as world:
         for box in scene.boxes:
             world.add_box(box.size, box.position, box.orientation_xyzw, mass=1.0)

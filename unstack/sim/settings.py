@@ -12,17 +12,22 @@ Examples
 (4, 3)
 >>> SimulationSettings.from_dict(settings.to_dict()) == settings
 True
+
+Settings read from a file are checked field by field, with the file and JSON path in the
+error (:func:`settings_from_json`).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
+import typing
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from unstack.errors import UnstackError
+from unstack.errors import InvalidFile, InvalidScene, UnstackError
 
 __all__ = [
     "ARRANGEMENTS",
@@ -37,6 +42,8 @@ __all__ = [
     "SensorSettings",
     "SimulationSettings",
     "family_settings",
+    "scene_settings",
+    "settings_from_json",
 ]
 
 #: Named box-size sets: full edge lengths in metres. ``paper2`` are the paper's two sizes
@@ -283,19 +290,150 @@ class SimulationSettings:
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> SimulationSettings:
-        """Inverse of :meth:`to_dict`."""
-        return cls(
-            boxes=(int(data["boxes"][0]), int(data["boxes"][1])),
-            sizes=data["sizes"],
-            container=Container(**data["container"]),
-            pile=PileSettings(**_tuples(data["pile"])),
-            ground_truth=GroundTruthSettings(**data["ground_truth"]),
-            sensor=SensorSettings(**_tuples(data["sensor"])),
+        """Inverse of :meth:`to_dict`, every field checked (:func:`settings_from_json`)."""
+        return settings_from_json(data)
+
+
+#: What a settings field (``Class.field``) may hold beyond its type: ``"positive"``, ``"at least
+#: 0"``, ``"at least 1"``, ``(low, high)`` with both ends in, ``"extent"`` and ``"coordinate"``
+#: (within :data:`MAX_EXTENT`), ``"time step"`` (up to :data:`MAX_TIME_STEP`). Bounds that keep
+#: a physics world sane and its run finite: a coarser step lets boxes pass through each other,
+#: a horizon of hours or an image of a billion pixels is a typing slip, not a setting.
+FIELD_LIMITS: dict[str, Any] = {
+    "Container.depth": "extent", "Container.width": "extent", "Container.height": "extent",
+    "PileSettings.wave_size": (1, 1000), "PileSettings.max_tilt_deg": (0.0, 90.0),
+    "PileSettings.mass_range": (0.01, 1000.0), "PileSettings.friction": (0.0, 10.0),
+    "PileSettings.time_step": "time step", "PileSettings.settle_window": (0.001, 10.0),
+    "PileSettings.settle_displacement": "positive", "PileSettings.settle_rotation_deg": "positive",
+    "PileSettings.settle_windows": (1, 100), "PileSettings.settle_max_time": (0.001, 600.0),
+    "PileSettings.max_refills": (0, 100), "PileSettings.fallen_share": (0.0, 1.0),
+    "GroundTruthSettings.horizon": (0.001, 60.0), "GroundTruthSettings.early_exit_after": (0.0, 60.0),
+    "GroundTruthSettings.early_exit_speed": "at least 0",
+    "GroundTruthSettings.displacement_threshold": (0.0001, 1.0),
+    "GroundTruthSettings.rotation_threshold_deg": (0.01, 90.0), "GroundTruthSettings.creep_displacement": "positive",
+    "GroundTruthSettings.creep_rotation_deg": "positive",
+    "SensorSettings.position": "coordinate", "SensorSettings.target": "coordinate",
+    "SensorSettings.vertical_fov_deg": (1.0, 179.0), "SensorSettings.width": (1, 8192),
+    "SensorSettings.height": (1, 8192), "SensorSettings.near": "positive", "SensorSettings.far": "positive",
+    "SensorSettings.min_pixels": "at least 0", "SensorSettings.position_jitter": (0.0, 1.0),
+    "SimulationSettings.boxes": "at least 1",
+}  # fmt: skip
+#: The coarsest physics step a settings file may ask for (seconds; the default is 1/240).
+MAX_TIME_STEP = 0.02
+#: The largest container extent a settings file may give (metres; a 53-foot trailer is 16 m deep).
+MAX_EXTENT = 100.0
+
+
+def _field_value(value: Any, kind: Any, name: str, where: str, fail: Any) -> Any:
+    """One field's value checked against its annotated type and :data:`FIELD_LIMITS`."""
+    if typing.get_origin(kind) is tuple:
+        items = typing.get_args(kind)
+        if not isinstance(value, list | tuple) or len(value) != len(items):
+            fail(where, f"expected a list of {len(items)} numbers, got {value!r:.40}")
+        return tuple(
+            _field_value(item, inner, name, f"{where}[{k}]", fail)
+            for k, (item, inner) in enumerate(zip(value, items, strict=True))
         )
+    if kind is bool or kind is str:
+        if not isinstance(value, kind):
+            fail(where, f"expected {'true or false' if kind is bool else 'a string'}, got {value!r:.40}")
+        return value
+    number = isinstance(value, int | float) and not isinstance(value, bool)
+    if kind is int and not (number and float(value).is_integer()):
+        fail(where, f"expected a whole number, got {value!r:.40}")
+    if not number or not math.isfinite(value):
+        fail(where, f"expected a finite number, got {value!r:.40}")
+    limit = FIELD_LIMITS.get(name)
+    if limit == "extent" and not 0.0 < value <= MAX_EXTENT:
+        fail(where, f"expected a positive extent of at most {MAX_EXTENT:g} m, got {value}")
+    if limit == "coordinate" and abs(value) > MAX_EXTENT:
+        fail(where, f"expected a coordinate within {MAX_EXTENT:g} m of the door, got {value}")
+    if limit == "time step" and not 0.0 < value <= MAX_TIME_STEP:
+        fail(where, f"expected a physics step above 0 and at most {MAX_TIME_STEP} s, got {value}")
+    if limit == "positive" and value <= 0:
+        fail(where, f"expected a positive number, got {value}")
+    if limit in ("at least 0", "at least 1") and value < int(limit[-1]):
+        fail(where, f"expected a number {limit}, got {value}")
+    if isinstance(limit, tuple) and not limit[0] <= value <= limit[1]:
+        fail(where, f"expected a number from {limit[0]:g} to {limit[1]:g}, got {value}")
+    return int(value) if kind is int else float(value)
 
 
-def _tuples(data: dict[str, Any]) -> dict[str, Any]:
-    return {key: tuple(value) if isinstance(value, list) else value for key, value in data.items()}
+def _section(cls: type, data: Any, where: str, fail: Any) -> Any:
+    """A settings dataclass from a JSON object: unknown keys refused, missing ones defaulted."""
+    if not isinstance(data, dict):
+        fail(where, f"expected an object, got {data!r:.40}")
+    kinds = typing.get_type_hints(cls)
+    unknown = sorted(set(data) - set(kinds))
+    if unknown:
+        fail(where, f"unknown key {unknown[0]!r}; expected keys among {', '.join(kinds)}")
+    values = {}
+    for name, value in data.items():
+        kind = kinds[name]
+        inner = f"{where}.{name}"
+        values[name] = (
+            _section(kind, value, inner, fail)
+            if isinstance(kind, type) and dataclasses.is_dataclass(kind)
+            else _field_value(value, kind, f"{cls.__name__}.{name}", inner, fail)
+        )
+    return cls(**values)
+
+
+def settings_from_json(
+    data: Any, *, source: str = "<settings>", path: str = "$", error: type[InvalidFile] = InvalidFile
+) -> SimulationSettings:
+    """Simulation settings read from JSON (:meth:`SimulationSettings.to_dict`), every field checked.
+
+    Keys left out take their defaults; an unknown key, a value of the wrong type, a number
+    that is not finite or out of its range (:data:`FIELD_LIMITS`) and settings that cannot
+    make a pile (:class:`SimulationSettings` refuses them) raise ``error`` with ``source`` and
+    the JSON path of the field below ``path``.
+
+    Examples
+    --------
+    >>> settings_from_json({"pile": {"friction": 0.8}}).pile.friction
+    0.8
+    >>> settings_from_json({"pile": {"time_step": -1}}, source="a.json", path="$.m")
+    Traceback (most recent call last):
+    unstack.errors.InvalidFile: a.json: $.m.pile.time_step: expected a physics step above 0 and at most 0.02 s, got -1
+    """
+
+    def fail(where: str, message: str) -> typing.NoReturn:
+        raise error(source, where, message)
+
+    try:
+        settings: SimulationSettings = _section(SimulationSettings, data, path, fail)
+    except InvalidSettings as refused:
+        fail(path, str(refused))
+    if not settings.sensor.near < settings.sensor.far:
+        fail(f"{path}.sensor.far", f"expected beyond near ({settings.sensor.near}), got {settings.sensor.far}")
+    low, high = settings.pile.mass_range
+    if low > high:
+        fail(f"{path}.pile.mass_range", f"expected [low, high] with low <= high, got [{low}, {high}]")
+    return settings
+
+
+def scene_settings(scene: Any) -> SimulationSettings | None:
+    """The simulation settings a scene carries (``metadata.settings``), checked; None without them.
+
+    Raises
+    ------
+    InvalidScene
+        ``metadata.settings`` is there but not valid settings (file and JSON path named).
+
+    Examples
+    --------
+    >>> import unstack
+    >>> scene_settings(unstack.load("examples/pile5.scene.json")).container.depth
+    2.0
+    >>> scene_settings(unstack.load("examples/leaning.scene.json")) is None
+    True
+    """
+    if "settings" not in scene.metadata:
+        return None
+    return settings_from_json(
+        scene.metadata["settings"], source=scene.source, path="$.metadata.settings", error=InvalidScene
+    )
 
 
 def json_ready(value: Any) -> Any:

@@ -125,12 +125,12 @@ class UnloadRun:
 
 
 def _scene_settings(scene: Scene) -> Any:
-    from unstack.sim.settings import SimulationSettings
+    from unstack.sim.settings import scene_settings
 
-    data = scene.metadata.get("settings")
-    if not isinstance(data, dict):
+    settings = scene_settings(scene)
+    if settings is None:
         raise UnstackError(f"{scene.source}: $.metadata.settings: executing an order needs a simulated scene")
-    return SimulationSettings.from_dict(data)
+    return settings
 
 
 def execute_unloading(scene: Scene, order: Sequence[str]) -> UnloadRun:
