@@ -13,7 +13,7 @@ highest. It is the container maker ``hybrid_faces_free`` of the results page (wh
 the hybrid's pick, the default's whenever some box is below the free cost; when none is, the
 hybrid takes the lowest expected cost and the default the near ties): over the five
 families of 30 fresh piles it moved 0.55 +- 0.26 boxes per pile fewer than highest first with
-every seen box detected, 1.41 +- 0.27 fewer with a detector missing half the boxes, at 0.44 s
+every seen box detected, 1.41 +- 0.27 fewer with a detector missing half the boxes, at 0.40 s
 a pick for 5 detected boxes (benchmarks page).
 
 The scene must be in the container frame of the simulator (x from the door inwards, y across
