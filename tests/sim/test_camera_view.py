@@ -37,3 +37,32 @@ def test_most_boxes_come_back_within_a_centimetre_and_gravity_within_a_fifth_of_
     assert len(built.fitted) >= len(ids) - 2
     errors = [np.linalg.norm(item.box.position - scene.box(item.box.id).position) for item in built.fitted]
     assert np.median(errors) < 0.01
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "message"),
+    [
+        ("sensor_position", "door", r"\$\.metadata\.simulation\.sensor_position: expected 3 numbers"),
+        ("sensor_target", [1.0, float("nan"), 0.9], r"\$\.metadata\.simulation\.sensor_target\[1\]: expected a finite"),
+    ],
+)
+def test_a_bad_sensor_pose_in_the_metadata_names_its_json_path(
+    small_dataset: Path, key: str, value: object, message: str
+) -> None:
+    from unstack.errors import InvalidScene
+    from unstack.scene import Scene
+    from unstack.sim.camera_view import scene_sensor
+
+    scene = load_scene(list_configurations(small_dataset)[0])
+    metadata = {
+        **scene.metadata,
+        "simulation": {
+            **scene.metadata.get("simulation", {}),
+            "sensor_position": [-2.8, 0.0, 1.3],
+            "sensor_target": [1.0, 0.0, 0.9],
+        },
+    }
+    metadata["simulation"][key] = value
+    changed = Scene(scene.boxes, scene.points, scene.detected, metadata=metadata, source=scene.source)
+    with pytest.raises(InvalidScene, match=message):
+        scene_sensor(changed)

@@ -55,9 +55,15 @@ def scene_sensor(scene: Scene) -> Any:
     sensor = dataclasses.replace(settings.sensor, position_jitter=0.0)
     simulation = scene.metadata.get("simulation", {})
     if "sensor_position" in simulation:
-        sensor = dataclasses.replace(
-            sensor, position=tuple(simulation["sensor_position"]), target=tuple(simulation["sensor_target"])
+        from unstack.checks import check_vector
+
+        position, target = (
+            check_vector(simulation.get(key), 3, source=scene.source, path=f"$.metadata.simulation.{key}")
+            for key in ("sensor_position", "sensor_target")
         )
+        x, y, z = (float(value) for value in position)
+        aim_x, aim_y, aim_z = (float(value) for value in target)
+        sensor = dataclasses.replace(sensor, position=(x, y, z), target=(aim_x, aim_y, aim_z))
     return sensor
 
 
