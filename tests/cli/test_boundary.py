@@ -265,3 +265,40 @@ def test_validate_checks_the_settings_of_a_data_set_manifest(tmp_path: Path) -> 
     path = tmp_path / "manifest.json"
     path.write_text(json.dumps(manifest))
     one_line_error(unstack("validate", str(path)), "$.settings.pile.mass_range: expected [low, high] with low <= high")
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "fragment"),
+    [
+        ("--depth", "nan", "Invalid value for '--depth': expected a finite number, got nan"),
+        ("--width", "1e12", "Invalid value for '--width': expected a positive extent of at most 100 m"),
+        ("--horizon", "inf", "Invalid value for '--horizon': expected a finite number, got inf"),
+        ("--horizon", "1e12", "Invalid value for '--horizon': expected a number from 0.001 to 60"),
+        ("--min-pixels", "-1", "Invalid value for '--min-pixels': expected a number at least 0, got -1"),
+        ("--viewpoint-jitter", "nan", "Invalid value for '--viewpoint-jitter': expected a finite number"),
+        ("--resolution", "0x480", "--resolution: expected a number from 1 to 8192, got 0 in '0x480'"),
+    ],
+)
+def test_simulate_refuses_a_setting_out_of_range_before_any_work(
+    tmp_path: Path, option: str, value: str, fragment: str
+) -> None:
+    folder = tmp_path / "piles"
+    one_line_error(unstack("simulate", "--configs", "1", "--out", str(folder), option, value), fragment)
+    assert not folder.exists()
+
+
+@pytest.mark.parametrize(
+    ("command", "fragment"),
+    [
+        (["train", "DATA", "-o", "MODEL", "--offset", "inf"], "feature settings need 0 < offset <= 10 m, got inf"),
+        (["train", "DATA", "-o", "MODEL", "--pose-noise", "nan"], "pose_noise must be a finite number, got nan"),
+        (["evaluate", "general", "DATA", "--pose-noise", "nan"], "pose_noise must be a finite number, got nan"),
+    ],
+)
+def test_learning_commands_refuse_lengths_that_are_not_finite(
+    tmp_path: Path, small_dataset: Path, command: list[str], fragment: str
+) -> None:
+    model = tmp_path / "model.skops"
+    arguments = [str(small_dataset) if part == "DATA" else str(model) if part == "MODEL" else part for part in command]
+    one_line_error(unstack(*arguments), fragment)
+    assert not model.exists()

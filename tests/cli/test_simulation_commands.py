@@ -62,7 +62,7 @@ def test_simulate_a_staged_family_of_boxes_set_down_by_hand(tmp_path: Path) -> N
         (["--configs", "-3"], "configs must be a non-negative count, got -3"),
         (["--jobs", "0"], "jobs must be at least 1, got 0"),
         (["--resolution", "big"], "--resolution: expected WIDTHxHEIGHT in pixels"),
-        (["--width", "0"], "--depth, --width and --horizon must be positive, got 2, 0 and 1"),
+        (["--width", "0"], "Invalid value for '--width': expected a positive extent of at most 100 m, got 0.0"),
         (["--boxes", "9", "--sizes", "four", "--depth", "0.6", "--width", "0.8"], "do not fit a 0.6 x 0.8 x 2.39 m"),
         (["--scheduler", "tcp://127.0.0.1:9"], "dask scheduler tcp://127.0.0.1:9 does not answer within 5 s"),
         (["--scheduler", "nowhere"], "scheduler: expected an address like tcp://HOST:PORT, got 'nowhere'"),

@@ -99,10 +99,27 @@ def test_pair_features_eq_6_and_7(rng: np.random.Generator) -> None:
     assert np.array_equal(xy[7:13], yx[13:19]) and np.array_equal(xy[13:19], yx[7:13])
 
 
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        ({"sigma": 0}, r"need 0 < sigma <= 10 m, got 0"),
+        ({"offset": float("inf")}, r"need 0 < offset <= 10 m, got inf"),
+        ({"offset": float("nan")}, r"need 0 < offset <= 10 m, got nan"),
+        ({"sigma": 1e12}, r"need 0 < sigma <= 10 m, got 1000000000000\.0"),
+        ({"tolerance": 1.0}, r"need 0 < tolerance < 1, got 1\.0"),
+    ],
+)
+def test_feature_lengths_must_be_finite_positive_and_at_most_ten_metres(
+    arguments: dict[str, float], message: str
+) -> None:
+    from unstack.errors import UnstackError
+
+    with pytest.raises(UnstackError, match=message):
+        FeatureSettings(**arguments)  # type: ignore[arg-type]
+
+
 def test_feature_settings_are_checked() -> None:
     from unstack.errors import UnstackError
 
-    with pytest.raises(UnstackError, match="offset > 0, sigma > 0"):
-        FeatureSettings(sigma=0)
     with pytest.raises(UnstackError, match="unknown DBAF method 'fft'"):
         FeatureSettings(dbaf_method="fft")

@@ -10,6 +10,7 @@ from unstack.errors import InvalidFile, InvalidScene
 from unstack.sim.settings import (
     SIZE_SETS,
     Container,
+    GroundTruthSettings,
     InvalidSettings,
     PileSettings,
     SensorSettings,
@@ -40,11 +41,19 @@ def test_round_trip_through_json(sizes: str) -> None:
     [
         ({"sizes": "paper3"}, r"unknown size set 'paper3'; expected one of paper2, four"),
         ({"boxes": (40, 30)}, r"box range 40-30 is reversed"),
-        ({"boxes": (-1, 5)}, r"box counts must be positive, got -1-5"),
-        ({"boxes": (0, 0)}, r"box counts must be positive"),
+        ({"boxes": (-1, 5)}, r"settings\.boxes\[0\]: expected a number at least 1, got -1"),
+        ({"boxes": (0, 0)}, r"settings\.boxes\[0\]: expected a number at least 1, got 0"),
         ({"boxes": (300, 400)}, r"400 boxes of size set 'paper2' do not fit a 2.0 x 2.35 x 2.39 m container"),
         ({"container": Container(depth=0.2)}, r"do not fit a 0.2 m container"),
-        ({"container": Container(depth=-1.0)}, r"container extents must be positive"),
+        ({"container": Container(depth=-1.0)}, r"settings\.container\.depth: expected a positive extent"),
+        (
+            {"container": Container(width=float("nan"))},
+            r"settings\.container\.width: expected a finite number, got nan",
+        ),
+        (
+            {"ground_truth": GroundTruthSettings(horizon=1e6)},
+            r"settings\.ground_truth\.horizon: expected a number from",
+        ),
     ],
 )
 def test_bad_settings_are_one_line_errors(arguments: dict[str, object], message: str) -> None:

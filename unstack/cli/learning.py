@@ -11,11 +11,12 @@ from rich.table import Table
 from rich.text import Text
 
 from unstack.cli.main import STATICS_HELP, data_dir_argument, model_path_option
+from unstack.cli.options import constrained
 from unstack.cli.text import counted
 from unstack.errors import UnstackError
 from unstack.learning.choices import LEARNERS, SPLITS
 from unstack.learning.features import FEATURE_SETS
-from unstack.learning.training_data import ISET_DRAWS
+from unstack.learning.training_data import ISET_DRAWS, dataset_examples
 
 __all__ = ["evaluate", "load_support_model", "metrics_view", "probabilities", "scene_supports", "train"]
 
@@ -116,7 +117,7 @@ def _examples(
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
 @click.option("--vary-clouds/--same-clouds", default=False, show_default=True,
               help="Show each ISet its cloud as another sensor might: sparser, noisier, with holes.")  # fmt: skip
-@click.option("--pose-noise", type=click.FloatRange(0.0, 0.1), default=0.0, show_default=True,
+@click.option("--pose-noise", type=constrained(dataset_examples, "pose_noise"), default=0.0, show_default=True,
               help="Show each ISet its boxes as a detector reports them: errors of this many metres.")  # fmt: skip
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of the ISets, the split and the folds.")  # fmt: skip
@@ -209,7 +210,7 @@ def train(
 @click.option("--isets", type=click.IntRange(min=1), default=3, show_default=True, help="ISets per configuration.")
 @click.option("--isets-from", "draw", type=click.Choice(list(ISET_DRAWS)), default="random",
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
-@click.option("--pose-noise", type=click.FloatRange(0.0, 0.1), default=0.0, show_default=True,
+@click.option("--pose-noise", type=constrained(dataset_examples, "pose_noise"), default=0.0, show_default=True,
               help="Score on boxes as a detector reports them: errors of this many metres.")  # fmt: skip
 @click.option("--seed", type=click.IntRange(min=0), default=1, show_default=True, help="Seed of the ISets.")
 @click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Parallel processes.")

@@ -38,7 +38,7 @@ import click
 from unstack.errors import InvalidArgument
 from unstack.parameters import OneOf, constraints_of
 
-__all__ = ["Checked", "constrained"]
+__all__ = ["Checked", "constrained", "setting"]
 
 
 if TYPE_CHECKING:
@@ -92,3 +92,17 @@ def constrained(function: Callable[..., Any], parameter: str) -> _ParamType:
     if isinstance(constraint, OneOf):
         return click.Choice(list(constraint.choices))
     return Checked(constraint.kind, functools.partial(constraint.check, name=parameter))
+
+
+def setting(field: str, kind: type) -> Checked:
+    """The click type of an option that sets one simulation setting (``Class.field``): the check a
+    settings file's field gets (:func:`unstack.sim.settings.check_setting`).
+
+    Examples
+    --------
+    >>> setting("GroundTruthSettings.horizon", float).convert("2", None, None)
+    2.0
+    """
+    from unstack.sim.settings import check_setting
+
+    return Checked(kind, functools.partial(check_setting, field=field))

@@ -6,8 +6,9 @@ import re
 
 import click
 
-from unstack.errors import UnstackError
-from unstack.sim.settings import FAMILIES, SIZE_SETS
+from unstack.cli.options import setting
+from unstack.errors import InvalidArgument, UnstackError
+from unstack.sim.settings import FAMILIES, SIZE_SETS, check_setting
 
 __all__ = ["parse_box_range", "simulate"]
 
@@ -42,17 +43,19 @@ def parse_box_range(text: str) -> tuple[int, int]:
 @click.option("--out", "out", required=True, type=click.Path(), help="Folder of the data set (created; resumable).")
 @click.option("--jobs", type=int, default=1, show_default=True, help="Worker processes on this machine.")
 @click.option("--scheduler", default=None, help="Address of a dask.distributed scheduler to run the tasks on.")
-@click.option("--depth", type=float, default=None, help="Container section depth along x (m; default: the family's).")
-@click.option("--width", type=float, default=None,
+@click.option("--depth", type=setting("Container.depth", float), default=None,
+              help="Container section depth along x (m; default: the family's).")  # fmt: skip
+@click.option("--width", type=setting("Container.width", float), default=None,
               help="Container section width along y (m); narrower sections stack the boxes higher.")  # fmt: skip
-@click.option("--horizon", type=float, default=1.0, show_default=True, help="Seconds simulated after each removal.")
+@click.option("--horizon", type=setting("GroundTruthSettings.horizon", float), default=1.0, show_default=True,
+              help="Seconds simulated after each removal (0.001 to 60).")  # fmt: skip
 @click.option("--noise/--no-noise", default=False, show_default=True, help="Kinect-like depth noise.")
 @click.option("--resolution", default="640x480", show_default=True, help="Sensor image size WIDTHxHEIGHT.")
-@click.option(
-    "--min-pixels", type=int, default=50, show_default=True, help="Visible pixels that make a box detectable."
-)
-@click.option("--viewpoint-jitter", type=click.FloatRange(0.0, 1.0), default=0.0, show_default=True,
-              help="Move the sensor of each configuration by up to this much per axis (m).")  # fmt: skip
+@click.option("--min-pixels", type=setting("SensorSettings.min_pixels", int), default=50, show_default=True,
+              help="Visible pixels that make a box detectable.")  # fmt: skip
+@click.option("--viewpoint-jitter", type=setting("SensorSettings.position_jitter", float), default=0.0,
+              show_default=True,
+              help="Move the sensor of each configuration by up to this much per axis (m, 0 to 1).")  # fmt: skip
 def simulate(
     configs: int,
     family: str,
@@ -85,16 +88,21 @@ def simulate(
     depth = base.container.depth if depth is None else depth
     width = base.container.width if width is None else width
     match = re.fullmatch(r"(\d+)x(\d+)", resolution.strip())
-    if not match or min(int(match.group(1)), int(match.group(2))) < 1:
+    if not match:
         raise UnstackError(f"--resolution: expected WIDTHxHEIGHT in pixels (for example 640x480), got {resolution!r}")
-    if depth <= 0 or width <= 0 or horizon <= 0:
-        raise UnstackError(f"--depth, --width and --horizon must be positive, got {depth:g}, {width:g} and {horizon:g}")
+    try:
+        pixels = [
+            check_setting(int(text), f"SensorSettings.{side}")
+            for text, side in zip(match.groups(), ("width", "height"), strict=True)
+        ]
+    except InvalidArgument as error:
+        raise UnstackError(f"--resolution: {error} in {resolution!r}") from None
     if seed < 0:
         raise UnstackError(f"--seed must be a non-negative integer, got {seed}")
     sensor = replace(
         SensorSettings(),
-        width=int(match.group(1)),
-        height=int(match.group(2)),
+        width=pixels[0],
+        height=pixels[1],
         noise=noise,
         min_pixels=min_pixels,
         position_jitter=viewpoint_jitter,

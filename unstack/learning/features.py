@@ -77,6 +77,11 @@ FEATURE_SETS = ("paper", "extended", "general")
 KDTREE_MAX_COVER = 0.05
 
 
+#: The longest interest-point offset and DBAF width the features take (metres): ten times the
+#: paper's 1 m and 0.5 m, beyond any container's width.
+MAX_FEATURE_LENGTH = 10.0
+
+
 @dataclass(frozen=True)
 class FeatureSettings:
     """Parameters of the support features (the paper's values by default).
@@ -107,11 +112,11 @@ class FeatureSettings:
     def __post_init__(self) -> None:
         from unstack.errors import UnstackError
 
-        if not (self.offset > 0 and self.sigma > 0 and 0 < self.tolerance < 1):
-            raise UnstackError(
-                f"feature settings need offset > 0, sigma > 0 and 0 < tolerance < 1, got {self.offset}, "
-                f"{self.sigma}, {self.tolerance}"
-            )
+        for name, length in (("offset", self.offset), ("sigma", self.sigma)):
+            if not (math.isfinite(length) and 0 < length <= MAX_FEATURE_LENGTH):
+                raise UnstackError(f"feature settings need 0 < {name} <= {MAX_FEATURE_LENGTH:g} m, got {length}")
+        if not 0 < self.tolerance < 1:
+            raise UnstackError(f"feature settings need 0 < tolerance < 1, got {self.tolerance}")
         if self.dbaf_method not in ("auto", "direct", "kdtree"):
             raise UnstackError(f"unknown DBAF method {self.dbaf_method!r}; expected auto, direct or kdtree")
         if self.feature_set not in FEATURE_SETS:

@@ -28,6 +28,7 @@ import numpy as np
 
 from unstack.errors import UnstackError
 from unstack.learning.features import FeatureSettings, pair_features
+from unstack.parameters import COUNT, DETECTOR_NOISE, ISET_SIZE, validate_params
 from unstack.scene import Scene, load_scene
 from unstack.understanding.detector import detector_poses
 
@@ -149,6 +150,11 @@ def detected_positions(scene: Scene) -> np.ndarray:
     return np.array([scene.boxes[index[box_id]].position for box_id in scene.detected], dtype=np.float64)
 
 
+#: The arguments of :func:`scene_examples` and :func:`dataset_examples` checked at every call.
+EXAMPLE_ARGUMENTS = {"r": ISET_SIZE, "isets": COUNT, "pose_noise": DETECTOR_NOISE}
+
+
+@validate_params(EXAMPLE_ARGUMENTS)
 def scene_examples(
     scene: Scene,
     *,
@@ -239,6 +245,7 @@ def dataset_fingerprint(folder: str | os.PathLike[str]) -> str:
     return digest.hexdigest()
 
 
+@validate_params({**EXAMPLE_ARGUMENTS, "n_jobs": COUNT})
 def dataset_examples(
     folder: str | os.PathLike[str],
     *,

@@ -21,13 +21,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
 import typing
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from unstack.errors import InvalidFile, InvalidScene, UnstackError
+from unstack.errors import InvalidArgument, InvalidFile, InvalidScene, UnstackError
 
 __all__ = [
     "ARRANGEMENTS",
@@ -41,6 +42,7 @@ __all__ = [
     "PileSettings",
     "SensorSettings",
     "SimulationSettings",
+    "check_setting",
     "family_settings",
     "scene_settings",
     "settings_from_json",
@@ -242,9 +244,11 @@ class SimulationSettings:
     sensor: SensorSettings = field(default_factory=SensorSettings)
 
     def __post_init__(self) -> None:
+        def refuse(where: str, message: str) -> typing.NoReturn:
+            raise InvalidSettings(f"{where}: {message}")
+
+        _values(SimulationSettings, json_ready(dataclasses.asdict(self)), "settings", refuse)
         low, high = self.boxes
-        if low < 1 or high < 1:
-            raise InvalidSettings(f"box counts must be positive, got {low}-{high}")
         if low > high:
             raise InvalidSettings(f"box range {low}-{high} is reversed; expected LOW-HIGH with LOW <= HIGH")
         if self.pile.arrangement not in ARRANGEMENTS:
@@ -258,8 +262,6 @@ class SimulationSettings:
         if self.sizes not in SIZE_SETS:
             raise InvalidSettings(f"unknown size set {self.sizes!r}; expected one of {', '.join(SIZE_SETS)}")
         container = self.container
-        if min(container.depth, container.width, container.height) <= 0:
-            raise InvalidSettings(f"container extents must be positive, got {dataclasses.astuple(container)}")
         sizes = self.box_sizes()
         if np.any(sizes.min(axis=1) > min(container.depth, container.width)) or np.any(
             sizes.min(axis=1) > container.height
@@ -294,6 +296,10 @@ class SimulationSettings:
         return settings_from_json(data)
 
 
+#: The settings classes by name, for :func:`check_setting`.
+_PARTS: dict[str, type] = {
+    part.__name__: part for part in (Container, PileSettings, GroundTruthSettings, SensorSettings, SimulationSettings)
+}
 #: What a settings field (``Class.field``) may hold beyond its type: ``"positive"``, ``"at least
 #: 0"``, ``"at least 1"``, ``(low, high)`` with both ends in, ``"extent"`` and ``"coordinate"``
 #: (within :data:`MAX_EXTENT`), ``"time step"`` (up to :data:`MAX_TIME_STEP`). Bounds that keep
@@ -338,7 +344,7 @@ def _field_value(value: Any, kind: Any, name: str, where: str, fail: Any) -> Any
         if not isinstance(value, kind):
             fail(where, f"expected {'true or false' if kind is bool else 'a string'}, got {value!r:.40}")
         return value
-    number = isinstance(value, int | float) and not isinstance(value, bool)
+    number = isinstance(value, numbers.Real) and not isinstance(value, bool | np.bool_)
     if kind is int and not (number and float(value).is_integer()):
         fail(where, f"expected a whole number, got {value!r:.40}")
     if not number or not math.isfinite(value):
@@ -361,6 +367,11 @@ def _field_value(value: Any, kind: Any, name: str, where: str, fail: Any) -> Any
 
 def _section(cls: type, data: Any, where: str, fail: Any) -> Any:
     """A settings dataclass from a JSON object: unknown keys refused, missing ones defaulted."""
+    return cls(**_values(cls, data, where, fail))
+
+
+def _values(cls: type, data: Any, where: str, fail: Any) -> dict[str, Any]:
+    """The checked field values of a settings dataclass given as a JSON object (parts built)."""
     if not isinstance(data, dict):
         fail(where, f"expected an object, got {data!r:.40}")
     kinds = typing.get_type_hints(cls)
@@ -376,7 +387,43 @@ def _section(cls: type, data: Any, where: str, fail: Any) -> Any:
             if isinstance(kind, type) and dataclasses.is_dataclass(kind)
             else _field_value(value, kind, f"{cls.__name__}.{name}", inner, fail)
         )
-    return cls(**values)
+    return values
+
+
+def check_setting(value: Any, field: str) -> Any:
+    """One settings field's value checked as in a settings file (:data:`FIELD_LIMITS`).
+
+    Parameters
+    ----------
+    value : object
+    field : str
+        ``Class.field``, such as ``"GroundTruthSettings.horizon"``.
+
+    Returns
+    -------
+    object
+        The canonical value (``float``, ``int``, a tuple of them, ``bool`` or ``str``).
+
+    Raises
+    ------
+    InvalidArgument
+        What was expected and what was given (the command line shows it for the option).
+
+    Examples
+    --------
+    >>> check_setting(2, "GroundTruthSettings.horizon")
+    2.0
+    >>> check_setting(float("nan"), "Container.depth")
+    Traceback (most recent call last):
+    unstack.errors.InvalidArgument: expected a finite number, got nan
+    """
+    part, name = field.split(".")
+    kind = typing.get_type_hints(_PARTS[part])[name]
+
+    def fail(where: str, message: str) -> typing.NoReturn:
+        raise InvalidArgument(message)
+
+    return _field_value(value, kind, field, name, fail)
 
 
 def settings_from_json(
