@@ -65,6 +65,28 @@ def test_intrinsics_need_positive_pixels(tmp_path: Path) -> None:
         load_intrinsics(tmp_path / "k.json")
 
 
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (
+            {"fx": 1e9},
+            r"\$\.fx: expected a focal length that sees 1 to 170 degrees across 640 px \(28 to 3\.67e\+04 px\)",
+        ),
+        ({"fy": 2.0}, r"\$\.fy: expected a focal length that sees 1 to 170 degrees across 480 px"),
+        ({"cx": 1e308}, r"\$\.cx: expected a principal point inside the image \(0 to 640 px\), got 1e\+308"),
+        ({"cy": 481}, r"\$\.cy: expected a principal point inside the image \(0 to 480 px\), got 481"),
+        ({"width": 10**9}, r"\$\.width: expected at most 16384 pixels, got 1e\+09"),
+    ],
+)
+def test_intrinsics_that_no_depth_camera_has_are_refused(
+    tmp_path: Path, change: dict[str, float], message: str
+) -> None:
+    intrinsics = {"fx": 600.0, "fy": 600.0, "cx": 320.0, "cy": 240.0, "width": 640, "height": 480, **change}
+    (tmp_path / "k.json").write_text(json.dumps(intrinsics))
+    with pytest.raises(InvalidFile, match=message):
+        load_intrinsics(tmp_path / "k.json")
+
+
 def test_a_mask_of_another_size_than_the_depth_image_is_refused(tmp_path: Path) -> None:
     mask = _png(tmp_path / "m.png", np.full((3, 3), 255, dtype=np.uint8))
     with pytest.raises(InvalidFile, match="expected a mask of 5 x 4 pixels like the depth image, got 3 x 3"):

@@ -19,6 +19,7 @@ Examples
 from __future__ import annotations
 
 import json
+import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,6 +35,11 @@ __all__ = ["DEPTH_UNITS", "MAX_DEPTH_M", "Intrinsics", "load_depth", "load_intri
 DEPTH_UNITS = {"mm": 0.001, "m": 1.0}
 #: No depth camera in a container or a cell reads further than this (metres).
 MAX_DEPTH_M = 20.0
+#: The fields of view (degrees, across the image's width and height) a pinhole camera's
+#: intrinsics may give: beyond them a focal length is a typing slip (a depth camera sees 40-90).
+FIELD_OF_VIEW = (1.0, 170.0)
+#: The widest and tallest depth image read (pixels; depth cameras give 1-2 thousand).
+MAX_PIXELS = 16384
 
 
 @dataclass(frozen=True)
@@ -76,6 +82,23 @@ def load_intrinsics(path: str | os.PathLike[str]) -> Intrinsics:
         values[name] = float(value)
     if values["width"] != int(values["width"]) or values["height"] != int(values["height"]):
         raise InvalidFile(source, "$.width", "expected whole numbers of pixels for width and height")
+    for focal, centre, side in (("fx", "cx", "width"), ("fy", "cy", "height")):
+        if values[side] > MAX_PIXELS:
+            raise InvalidFile(source, f"$.{side}", f"expected at most {MAX_PIXELS} pixels, got {values[side]:g}")
+        if values[centre] > values[side]:
+            raise InvalidFile(
+                source,
+                f"$.{centre}",
+                f"expected a principal point inside the image (0 to {values[side]:g} px), got {values[centre]:g}",
+            )
+        low, high = (values[side] / (2.0 * math.tan(math.radians(angle) / 2.0)) for angle in FIELD_OF_VIEW[::-1])
+        if not low <= values[focal] <= high:
+            raise InvalidFile(
+                source,
+                f"$.{focal}",
+                f"expected a focal length that sees {FIELD_OF_VIEW[0]:g} to {FIELD_OF_VIEW[1]:g} degrees across "
+                f"{values[side]:g} px ({low:.3g} to {high:.3g} px), got {values[focal]:g}",
+            )
     return Intrinsics(
         values["fx"], values["fy"], values["cx"], values["cy"], int(values["width"]), int(values["height"])
     )

@@ -9,6 +9,7 @@ residual, the duplicates left out and the masks that could not be fitted.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import click
@@ -57,7 +58,7 @@ def _door(text: str | None) -> list[float] | None:
         values = [float(value) for value in text.split(",")]
     except ValueError:
         values = []
-    if len(values) != 3 or not any(values):
+    if len(values) != 3 or not any(values) or not all(math.isfinite(value) for value in values):
         raise UnstackError(f"--door: expected a direction x,y,z in the pose's frame, got {text!r}")
     return values
 
