@@ -12,8 +12,6 @@ from unstack.sim.settings import (
     Container,
     GroundTruthSettings,
     InvalidSettings,
-    PileSettings,
-    SensorSettings,
     SimulationSettings,
     settings_from_json,
 )
@@ -110,7 +108,8 @@ def test_settings_from_json_refuses_a_part_that_is_not_an_object(part: str) -> N
 def test_settings_from_json_gives_left_out_keys_their_defaults() -> None:
     settings = settings_from_json({"boxes": [3, 5], "pile": {"friction": 0.8}})
     assert settings.boxes == (3, 5) and settings.pile.friction == 0.8
-    assert settings.pile.time_step == PileSettings().time_step and settings.sensor == SensorSettings()
+    defaults = SimulationSettings()
+    assert settings.pile.time_step == defaults.pile.time_step and settings.sensor == defaults.sensor
 
 
 def test_settings_from_json_turns_a_refused_combination_into_a_path_error() -> None:

@@ -72,14 +72,12 @@ FEATURE_NAMES: tuple[str, ...] = (
 )
 #: Feature sets of ``FeatureSettings.feature_set``: Eq. 6 alone, or Eq. 6 and the contact features.
 FEATURE_SETS = ("paper", "extended", "general")
-#: Interest points whose truncation ball covers more than this share of the cloud's
-#: bounding box make ``"auto"`` use the direct sum.
-KDTREE_MAX_COVER = 0.05
-
-
 #: The longest interest-point offset and DBAF width the features take (metres): ten times the
 #: paper's 1 m and 0.5 m, beyond any container's width.
 MAX_FEATURE_LENGTH = 10.0
+#: Interest points whose truncation ball covers more than this share of the cloud's
+#: bounding box make ``"auto"`` use the direct sum.
+KDTREE_MAX_COVER = 0.05
 
 
 @dataclass(frozen=True)

@@ -411,11 +411,8 @@ def check_setting(value: Any, field: str) -> Any:
 
     Examples
     --------
-    >>> check_setting(2, "GroundTruthSettings.horizon")
-    2.0
-    >>> check_setting(float("nan"), "Container.depth")
-    Traceback (most recent call last):
-    unstack.errors.InvalidArgument: expected a finite number, got nan
+    >>> check_setting(2, "GroundTruthSettings.horizon"), check_setting([0, 0.5, 1], "SensorSettings.target")
+    (2.0, (0.0, 0.5, 1.0))
     """
     part, name = field.split(".")
     kind = typing.get_type_hints(_PARTS[part])[name]
