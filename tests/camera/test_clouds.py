@@ -71,6 +71,10 @@ def test_compressed_pcd_is_refused_in_one_line(tmp_path: Path) -> None:
         ([{"id": "a", "center": [0, 0, 0], "size": [1, -1, 1]}], r"\$\[0\]\.size: expected positive edges"),
         ([{"center": [0, 0, 0], "size": [1, 1, 1]}], r"\$\[0\]: expected an object with a non-empty string id"),
         ({"boxes": []}, r"\$\.boxes: expected a non-empty list"),
+        (
+            [{"id": "a", "center": [0, 0, 0], "size": [1, 1, 1], "yaw_deg": 1e308}],
+            r"\$\[0\]\.yaw_deg: expected a yaw within 3600 degrees either way, got 1e\+308",
+        ),
     ],
 )
 def test_bad_detections_name_the_json_path(tmp_path: Path, boxes: object, message: str) -> None:

@@ -87,3 +87,16 @@ def test_a_depth_image_and_detections_make_a_scene(camera_files: list[str], tmp_
     run = unstack("scene", *depth_only, "--detections", str(tmp_path / "boxes.json"), "--out", str(tmp_path / "s.json"))
     assert run.returncode == 0, run.stderr
     assert json.loads((tmp_path / "s.json").read_text())["detected"] == ["a"]
+
+
+def test_a_scene_with_a_box_in_the_floor_is_written_and_warned_about(tmp_path: Path) -> None:
+    rng = np.random.default_rng(0)
+    floor = np.column_stack([rng.uniform(-1, 1, 4000), rng.uniform(-1, 1, 4000), np.zeros(4000)])
+    np.save(tmp_path / "cloud.npy", floor)
+    sunk = [{"id": "sunk", "center": [0, 0, 0.0], "size": [0.4, 0.3, 0.3], "yaw_deg": 0}]
+    (tmp_path / "boxes.json").write_text(json.dumps(sunk))
+    out = tmp_path / "scene.json"
+    run = unstack("scene", "--cloud", str(tmp_path / "cloud.npy"), "--detections", str(tmp_path / "boxes.json"),
+                  "--out", str(out))  # fmt: skip
+    assert run.returncode == 0 and out.exists()
+    assert f"unstack: warning: {out}: box 'sunk' reaches 0.15 m into the floor" in run.stderr

@@ -36,6 +36,8 @@ from unstack.scene import Box, Scene
 
 __all__ = ["load_cloud", "load_detections", "scene_from_cloud"]
 
+#: The largest yaw a detection may give (degrees, either way): ten turns; beyond, a typing slip.
+MAX_YAW_DEG = 3600.0
 _PCD_TYPES = {("F", 4): "<f4", ("F", 8): "<f8", ("I", 1): "<i1", ("I", 2): "<i2", ("I", 4): "<i4",
               ("U", 1): "<u1", ("U", 2): "<u2", ("U", 4): "<u4"}  # fmt: skip
 
@@ -147,6 +149,12 @@ def check_detections(detections: Sequence[Any], *, source: str = "<detections>",
                 raise InvalidFile(source, f"{where}.orientation_xyzw", "expected a quaternion x, y, z, w")
         elif not isinstance(item.get("yaw_deg", 0.0), int | float) or isinstance(item.get("yaw_deg"), bool):
             raise InvalidFile(source, f"{where}.yaw_deg", "expected a number of degrees")
+        elif not abs(item.get("yaw_deg", 0.0)) <= MAX_YAW_DEG:  # NaN too
+            raise InvalidFile(
+                source,
+                f"{where}.yaw_deg",
+                f"expected a yaw within {MAX_YAW_DEG:g} degrees either way, got {item['yaw_deg']}",
+            )
 
 
 def _heading(rotation: np.ndarray, size: np.ndarray) -> tuple[float, np.ndarray]:

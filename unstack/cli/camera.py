@@ -168,4 +168,10 @@ def scene(
         console.print(f"left out {duplicate}: its mask lies mostly inside {kept}'s (a duplicate detection)")
     for box_id, reason in built.unfitted.items():
         console.print(f"left out {box_id}: {reason}")
+    from unstack.cli.main import _warn
+    from unstack.scene import load_scene
+    from unstack.understanding.plausibility import scene_warnings
+
+    for warning in scene_warnings(load_scene(target)):  # what decide and validate will say of it
+        _warn(warning)
     click.echo(f"scene in {target}; decide with: unstack decide {target}")
