@@ -58,6 +58,48 @@ def test_pcd_files_are_read_in_ascii_and_binary(tmp_path: Path, data: str) -> No
     assert load_cloud(tmp_path / "cloud.pcd") == pytest.approx(points.astype("<f4").astype(np.float64), abs=1e-6)
 
 
+def _mangled(text: str, data: str) -> str:
+    """The test cloud's PCD text (5 points) with ``text`` edited: ``KEY=VALUE`` sets a header line."""
+    key, value = text.split("=", 1)
+    lines = data.splitlines()
+    lines = [f"{key} {value}" if line.split()[0] == key else line for line in lines]
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.parametrize(
+    ("change", "rows", "message"),
+    [
+        ("POINTS=7", None, r"the header gives 7 POINTS, the ascii data holds 5 rows"),
+        ("POINTS=-5", None, r"expected a POINTS count of at least 0, got -5"),
+        ("COUNT=1 1 1", None, r"expected one SIZE, TYPE and COUNT \(at least 1\) for each of the 4 FIELDS"),
+        ("TYPE=F F F", None, r"expected one SIZE, TYPE and COUNT"),
+        ("COUNT=1 1 1 0", None, r"expected one SIZE, TYPE and COUNT \(at least 1\)"),
+        (None, ["1 2 3"] * 5, r"expected ascii rows of 4 numbers each, got 3"),
+        (None, ["1 2 x 4"] * 5, r"expected ascii rows of 4 numbers each"),
+    ],
+)
+def test_a_malformed_ascii_pcd_is_one_line(
+    tmp_path: Path, change: str | None, rows: list[str] | None, message: str
+) -> None:
+    _write_pcd(tmp_path / "cloud.pcd", np.zeros((5, 3)), "ascii")
+    text = (tmp_path / "cloud.pcd").read_text()
+    header, body = text.split("DATA ascii\n")
+    header = _mangled(change, header) if change else header
+    body = "\n".join(rows) + "\n" if rows else body
+    (tmp_path / "cloud.pcd").write_text(header + "DATA ascii\n" + body)
+    with pytest.raises(InvalidFile, match=message):
+        load_cloud(tmp_path / "cloud.pcd")
+
+
+@pytest.mark.parametrize("points", [6, 10**12])
+def test_a_binary_pcd_shorter_than_its_header_says_is_one_line(tmp_path: Path, points: int) -> None:
+    _write_pcd(tmp_path / "cloud.pcd", np.zeros((5, 3)), "binary")
+    raw = (tmp_path / "cloud.pcd").read_bytes().replace(b"POINTS 5", f"POINTS {points}".encode())
+    (tmp_path / "cloud.pcd").write_bytes(raw)
+    with pytest.raises(InvalidFile, match=rf"the header gives {points} POINTS, the binary data holds 5"):
+        load_cloud(tmp_path / "cloud.pcd")
+
+
 def test_compressed_pcd_is_refused_in_one_line(tmp_path: Path) -> None:
     _write_pcd(tmp_path / "cloud.pcd", np.zeros((5, 3)), "binary_compressed")
     with pytest.raises(InvalidFile, match="PCD data 'binary_compressed' is not read"):

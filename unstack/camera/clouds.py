@@ -70,9 +70,25 @@ def _load_pcd(file: Path) -> np.ndarray:
         raise InvalidFile(source, "$", "expected a PCD header with FIELDS, SIZE, TYPE, POINTS and DATA") from None
     if not {"x", "y", "z"} <= set(fields):
         raise InvalidFile(source, "$", f"expected the fields x, y and z, got {' '.join(fields)}")
+    if not len(sizes) == len(types) == len(counts) == len(fields) or min(counts) < 1:
+        raise InvalidFile(
+            source, "$", f"expected one SIZE, TYPE and COUNT (at least 1) for each of the {len(fields)} FIELDS"
+        )
+    if points < 0:
+        raise InvalidFile(source, "$", f"expected a POINTS count of at least 0, got {points}")
+    columns = np.cumsum([0, *counts])
     if data == "ascii":
-        table = np.loadtxt(raw[offset:].decode("ascii").splitlines(), ndmin=2)
-        columns = np.cumsum([0, *counts])
+        rows = [line for line in raw[offset:].decode("ascii", errors="replace").splitlines() if line.strip()]
+        if len(rows) != points:
+            raise InvalidFile(source, "$", f"the header gives {points} POINTS, the ascii data holds {len(rows)} rows")
+        if points == 0:
+            return np.zeros((0, 3))
+        try:
+            table = np.loadtxt(rows, ndmin=2)
+        except ValueError:
+            raise InvalidFile(source, "$", f"expected ascii rows of {columns[-1]} numbers each") from None
+        if table.shape[1] != columns[-1]:
+            raise InvalidFile(source, "$", f"expected ascii rows of {columns[-1]} numbers each, got {table.shape[1]}")
         picked = [table[:, columns[fields.index(name)]] for name in ("x", "y", "z")]
         return np.column_stack(picked)
     if data != "binary":
@@ -82,6 +98,9 @@ def _load_pcd(file: Path) -> np.ndarray:
                           for name, kind, size, count in zip(fields, types, sizes, counts, strict=True)])  # fmt: skip
     except KeyError:
         raise InvalidFile(source, "$", "expected PCD fields of types F, I or U of 1-8 bytes") from None
+    held = (len(raw) - offset) // dtype.itemsize
+    if held < points:
+        raise InvalidFile(source, "$", f"the header gives {points} POINTS, the binary data holds {held}")
     records = np.frombuffer(raw, dtype=dtype, count=points, offset=offset)
     return np.column_stack([records[name].astype(np.float64) for name in ("x", "y", "z")])
 
@@ -89,7 +108,7 @@ def _load_pcd(file: Path) -> np.ndarray:
 def load_cloud(path: str | os.PathLike[str]) -> np.ndarray:
     """A point cloud as (N, 3) float64 metres from ``.npy``, ``.ply`` or ``.pcd``; non-finite points dropped."""
     from unstack.checks import check_points
-    from unstack.scene import load_points
+    from unstack.scene import MAX_CLOUD_FILE_BYTES, MAX_POINTS, load_points
 
     file = Path(path)
     if file.suffix.lower() != ".pcd":
@@ -97,7 +116,16 @@ def load_cloud(path: str | os.PathLike[str]) -> np.ndarray:
         return cloud
     if not file.is_file():
         raise InvalidFile(str(file), "$", "the point cloud file does not exist")
+    size = file.stat().st_size
+    if size > MAX_CLOUD_FILE_BYTES:
+        raise InvalidFile(
+            str(file),
+            "$",
+            f"expected a point cloud file of at most {MAX_CLOUD_FILE_BYTES // 2**20} MiB, got {size / 2**20:,.1f} MiB",
+        )
     cloud = _load_pcd(file)
+    if len(cloud) > MAX_POINTS:
+        raise InvalidFile(str(file), "$", f"expected at most {MAX_POINTS:,} points, got {len(cloud):,}")
     return check_points(cloud[np.all(np.isfinite(cloud), axis=1)], source=str(file), path="$")
 
 
