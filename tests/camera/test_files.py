@@ -23,6 +23,11 @@ def test_a_16_bit_png_in_millimetres_reads_as_metres(tmp_path: Path) -> None:
     assert depth.dtype == np.float64 and depth[0, 0] == pytest.approx(1.25)
 
 
+def test_an_8_bit_png_is_refused_as_a_depth_image(tmp_path: Path) -> None:
+    with pytest.raises(InvalidFile, match="expected a 16-bit PNG of depths, got an 8-bit image"):
+        load_depth(_png(tmp_path / "d.png", np.full((4, 5), 200, dtype=np.uint8)))
+
+
 def test_metres_declared_as_millimetres_are_refused(tmp_path: Path) -> None:
     with pytest.raises(InvalidFile, match="declared in mm but every reading is at most 20 mm: are the values metres"):
         load_depth(_png(tmp_path / "d.png", np.full((4, 5), 2, dtype=np.uint16)))

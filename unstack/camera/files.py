@@ -169,6 +169,10 @@ def load_depth(path: str | os.PathLike[str], *, units: str | None = None) -> np.
         raise InvalidFile(source, "$", f"cannot read the depth image: {error}") from None
     if raw.ndim != 2 or not (np.issubdtype(raw.dtype, np.integer) or np.issubdtype(raw.dtype, np.floating)):
         raise InvalidFile(source, "$", f"expected a single-channel depth image, got shape {raw.shape} of {raw.dtype}")
+    if suffix == ".png" and raw.dtype.itemsize < 2:
+        raise InvalidFile(
+            source, "$", "expected a 16-bit PNG of depths, got an 8-bit image (at most 255 mm: a picture, not depth)"
+        )
     declared = units or ("m" if np.issubdtype(raw.dtype, np.floating) else "mm")
     if declared not in DEPTH_UNITS:
         raise InvalidFile(source, "$", f"unknown depth units {declared!r}; expected one of {', '.join(DEPTH_UNITS)}")
