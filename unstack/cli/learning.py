@@ -118,7 +118,7 @@ def _examples(
 @click.option("--vary-clouds/--same-clouds", default=False, show_default=True,
               help="Show each ISet its cloud as another sensor might: sparser, noisier, with holes.")  # fmt: skip
 @click.option("--pose-noise", type=constrained(dataset_examples, "pose_noise"), default=0.0, show_default=True,
-              help="Show each ISet its boxes as a detector reports them: errors of this many metres.")  # fmt: skip
+              help="Show each ISet its boxes as a detector reports them: errors of this many m (0-0.1).")  # fmt: skip
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of the ISets, the split and the folds.")  # fmt: skip
 @click.option("--split-by", type=click.Choice(list(SPLITS)), default="pairs", show_default=True,
@@ -211,7 +211,7 @@ def train(
 @click.option("--isets-from", "draw", type=click.Choice(list(ISET_DRAWS)), default="random",
               show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
 @click.option("--pose-noise", type=constrained(dataset_examples, "pose_noise"), default=0.0, show_default=True,
-              help="Score on boxes as a detector reports them: errors of this many metres.")  # fmt: skip
+              help="Score on boxes as a detector reports them: errors of this many metres (0 to 0.1).")  # fmt: skip
 @click.option("--seed", type=click.IntRange(min=0), default=1, show_default=True, help="Seed of the ISets.")
 @click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Parallel processes.")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
