@@ -48,7 +48,7 @@ def parse_box_range(text: str) -> tuple[int, int]:
 @click.option("--width", type=setting("Container.width", float), default=None,
               help="Container section width along y (m); narrower sections stack the boxes higher.")  # fmt: skip
 @click.option("--horizon", type=setting("GroundTruthSettings.horizon", float), default=1.0, show_default=True,
-              help="Seconds simulated after each removal (0.001 to 60).")  # fmt: skip
+              help="Seconds simulated after each removal (0.001 to 10).")  # fmt: skip
 @click.option("--noise/--no-noise", default=False, show_default=True, help="Kinect-like depth noise.")
 @click.option("--resolution", default="640x480", show_default=True, help="Sensor image size WIDTHxHEIGHT.")
 @click.option("--min-pixels", type=setting("SensorSettings.min_pixels", int), default=50, show_default=True,
