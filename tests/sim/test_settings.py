@@ -12,6 +12,7 @@ from unstack.sim.settings import (
     Container,
     GroundTruthSettings,
     InvalidSettings,
+    PileSettings,
     SimulationSettings,
     settings_from_json,
 )
@@ -51,6 +52,10 @@ def test_round_trip_through_json(sizes: str) -> None:
         (
             {"ground_truth": GroundTruthSettings(horizon=1e6)},
             r"settings\.ground_truth\.horizon: expected a number from",
+        ),
+        (
+            {"pile": PileSettings(mass_range=(15.0, 5.0))},
+            r"settings\.pile\.mass_range: expected \[low, high\] with low <= high, got \[15\.0, 5\.0\]",
         ),
     ],
 )

@@ -248,6 +248,7 @@ class SimulationSettings:
             raise InvalidSettings(f"{where}: {message}")
 
         _values(SimulationSettings, json_ready(dataclasses.asdict(self)), "settings", refuse)
+        _check_pairs(self.pile, self.sensor, "settings", refuse)
         low, high = self.boxes
         if low > high:
             raise InvalidSettings(f"box range {low}-{high} is reversed; expected LOW-HIGH with LOW <= HIGH")
@@ -367,13 +368,9 @@ def _field_value(value: Any, kind: Any, name: str, where: str, fail: Any) -> Any
     return int(value) if kind is int else float(value)
 
 
-def _section(cls: type, data: Any, where: str, fail: Any) -> Any:
-    """A settings dataclass from a JSON object: unknown keys refused, missing ones defaulted."""
-    return cls(**_values(cls, data, where, fail))
-
-
 def _values(cls: type, data: Any, where: str, fail: Any) -> dict[str, Any]:
-    """The checked field values of a settings dataclass given as a JSON object (parts built)."""
+    """The checked field values of a settings dataclass given as a JSON object: unknown keys
+    refused, missing ones left to their defaults, parts (nested settings) built."""
     if not isinstance(data, dict):
         fail(where, f"expected an object, got {data!r:.40}")
     kinds = typing.get_type_hints(cls)
@@ -385,11 +382,20 @@ def _values(cls: type, data: Any, where: str, fail: Any) -> dict[str, Any]:
         kind = kinds[name]
         inner = f"{where}.{name}"
         values[name] = (
-            _section(kind, value, inner, fail)
+            kind(**_values(kind, value, inner, fail))
             if isinstance(kind, type) and dataclasses.is_dataclass(kind)
             else _field_value(value, kind, f"{cls.__name__}.{name}", inner, fail)
         )
     return values
+
+
+def _check_pairs(pile: PileSettings, sensor: SensorSettings, where: str, fail: Any) -> None:
+    """The settings whose limits depend on another field: the mass range's order, far beyond near."""
+    if not sensor.near < sensor.far:
+        fail(f"{where}.sensor.far", f"expected beyond near ({sensor.near}), got {sensor.far}")
+    low, high = pile.mass_range
+    if low > high:
+        fail(f"{where}.pile.mass_range", f"expected [low, high] with low <= high, got [{low}, {high}]")
 
 
 def check_setting(value: Any, field: str) -> Any:
@@ -447,16 +453,12 @@ def settings_from_json(
     def fail(where: str, message: str) -> typing.NoReturn:
         raise error(source, where, message)
 
+    values = _values(SimulationSettings, data, path, fail)
+    _check_pairs(values.get("pile", PileSettings()), values.get("sensor", SensorSettings()), path, fail)
     try:
-        settings: SimulationSettings = _section(SimulationSettings, data, path, fail)
+        return SimulationSettings(**values)
     except InvalidSettings as refused:
         fail(path, str(refused))
-    if not settings.sensor.near < settings.sensor.far:
-        fail(f"{path}.sensor.far", f"expected beyond near ({settings.sensor.near}), got {settings.sensor.far}")
-    low, high = settings.pile.mass_range
-    if low > high:
-        fail(f"{path}.pile.mass_range", f"expected [low, high] with low <= high, got [{low}, {high}]")
-    return settings
 
 
 def scene_settings(scene: Any) -> SimulationSettings | None:
