@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from unstack.errors import InvalidArgument
 from unstack.experiments.disturbance_training import pick_scores, train_disturbance
 from unstack.experiments.pick_causes import CAUSES, cause_table, moved_causes
 from unstack.experiments.pick_responses import (
@@ -72,6 +74,27 @@ def test_the_collection_resumes_without_work(small_dataset: Path, states: Path) 
     summaries = collect_pick_responses([small_dataset], states, piles=2, seed=1, max_picks=3)
     assert [summary["states"] for summary in summaries] == [3, 3]
     assert sorted(path.stat().st_mtime_ns for path in states.glob("*/*/step-*.npz")) == before
+
+
+def test_a_decision_maker_as_behaviour_takes_every_pick(small_dataset: Path, tmp_path: Path) -> None:
+    """With ``behaviour="highest"`` every saved state is followed by the removal of the box
+    that maker picks there: the next state no longer holds it."""
+    from unstack.experiments.container import container_policies
+
+    highest = container_policies(None, seed=1, makers=["highest"])["highest"]
+    summaries = collect_pick_responses([small_dataset], tmp_path, piles=1, seed=1, max_picks=3, behaviour="highest")
+    assert summaries[0]["behaviour"] == "highest" and summaries[0]["states"] == 3
+    loaded = [scene for _, scene in load_states(tmp_path)]
+    for scene, after in itertools.pairwise(loaded):
+        taken = highest(scene)
+        assert taken in scene.box_ids and taken not in after.box_ids
+        assert len(after.box_ids) == len(scene.box_ids) - 1
+
+
+def test_an_unknown_behaviour_is_refused(small_dataset: Path, tmp_path: Path) -> None:
+    with pytest.raises(InvalidArgument, match="unknown behaviour 'tallest'; expected one of mixed, unstack"):
+        collect_pick_responses([small_dataset], tmp_path, behaviour="tallest")
+    assert not any(tmp_path.iterdir())
 
 
 def test_each_state_gives_a_row_per_candidate_in_both_views(records: list[dict[str, object]]) -> None:

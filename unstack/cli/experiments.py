@@ -637,25 +637,35 @@ def belief_calibration_command(
 @click.option("--piles", type=RESPONSES("piles"), default=None, help="The first N piles of each data set.")
 @click.option("--max-picks", type=RESPONSES("max_picks"), default=None, help="Stop each pile after this many picks.")
 @click.option("--seed", type=RESPONSES("seed"), default=0, show_default=True)
+@click.option("--behaviour", type=RESPONSES("behaviour"), default="mixed", show_default=True,
+              help="What takes the picks: mixed (the probe's best, the highest or a random box, drawn) or a "
+              "decision maker of `unstack experiment container` (the states it reaches itself, as DAgger "
+              "collects them).")  # fmt: skip
+@model_path_option
+@click.option("--disturbance", "disturbance_path", type=click.Path(dir_okay=False, exists=True), default=None,
+              help="Disturbance model file of a moves maker taking the picks (default: the shipped one).")  # fmt: skip
 @click.option("--jobs", type=RESPONSES("n_jobs"), default=1, show_default=True, help="Piles run in parallel.")
 @click.option("--scheduler", default=None,
               help="Address of a dask.distributed scheduler (tcp://HOST:PORT): piles run on its workers.")  # fmt: skip
 def pick_responses(
-    data_dirs: tuple[str, ...], out: str, piles: int | None, max_picks: int | None, seed: int, jobs: int,
-    scheduler: str | None,
+    data_dirs: tuple[str, ...], out: str, piles: int | None, max_picks: int | None, seed: int, behaviour: str,
+    model_path: str | None, disturbance_path: str | None, jobs: int, scheduler: str | None,
 ) -> None:  # fmt: skip
     """Empty piles with a physics probe of every candidate before each pick; save every state.
 
     The training data of the disturbance model: each state holds the boxes, the cloud, the
     reachable candidates and what each candidate's removal moves (tried in the engine and
-    undone). Which candidate is then taken is drawn: the probe's best, the highest, a random one.
+    undone). Which candidate is then taken: by default drawn (the probe's best, the highest, a
+    random one); with --behaviour, a decision maker's pick.
     """
+    from unstack.cli.main import load_model_option
     from unstack.sim.dataset import scheduler_client
 
+    model = None if behaviour == "mixed" else load_model_option(model_path)[0]
     with scheduler_client(scheduler) as client, progress_bar("piles") as report:
         summaries = collect_pick_responses(
-            list(data_dirs), out, piles=piles, seed=seed, max_picks=max_picks, n_jobs=jobs, client=client,
-            progress=report,
+            list(data_dirs), out, piles=piles, seed=seed, max_picks=max_picks, behaviour=behaviour, model=model,
+            disturbance=disturbance_path, n_jobs=jobs, client=client, progress=report,
         )  # fmt: skip
     states = sum(summary["states"] for summary in summaries)
     click.echo(f"{len(summaries)} piles, {states} states in {out}")

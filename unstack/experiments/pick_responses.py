@@ -9,10 +9,13 @@ more than 2 cm. A state is saved whole -- the boxes with their poses, the point 
 candidates and every candidate's outcome -- so that the robot's-view features
 (:mod:`unstack.learning.pick_features`) can be computed again without the engine.
 
-Which candidate is then taken (the behaviour) is drawn per step, seeded: the one the probe
-says moves least (ties to the box resting highest) with probability
+Which candidate is then taken (the behaviour) is, by default (``"mixed"``), drawn per step,
+seeded: the one the probe says moves least (ties to the box resting highest) with probability
 :data:`BEHAVIOUR_SHARES` ``["lookahead"]``, the highest box, or a random one -- so the states
-cover both calm piles and piles a poorer policy leaves behind.
+cover both calm piles and piles a poorer policy leaves behind. A closed-loop decision maker
+named as the behaviour (:data:`~unstack.experiments.container.CONTAINER_MAKERS`) takes every
+pick instead: the states are those that policy itself reaches, as DAgger collects them for a
+policy learned from states another behaviour reached.
 
 Examples
 --------
@@ -33,10 +36,11 @@ from typing import Any
 import numpy as np
 
 from unstack.experiments.dispatch import run_unordered
-from unstack.parameters import COUNT, OPTIONAL_COUNT, SEED, validate_params
+from unstack.parameters import COUNT, OPTIONAL_COUNT, SEED, OneOf, validate_params
 from unstack.scene import Scene
 
 __all__ = [
+    "BEHAVIOURS",
     "BEHAVIOUR_SHARES",
     "STATE_FORMAT",
     "VIEWS",
@@ -51,6 +55,17 @@ __all__ = [
 STATE_FORMAT = "unstack.pick-state/1"
 #: Shares of the behaviours that choose the pick taken after the probe (they sum to 1).
 BEHAVIOUR_SHARES = {"lookahead": 0.5, "highest": 0.3, "random": 0.2}
+
+
+def _behaviours() -> tuple[str, ...]:
+    from unstack.experiments.container import CONTAINER_MAKERS, ORACLE_MAKERS
+
+    return ("mixed", *(maker for maker in CONTAINER_MAKERS if maker not in ORACLE_MAKERS))
+
+
+#: What may take the picks of a collection: ``"mixed"`` (:func:`behaviour_pick`'s draw) or a
+#: closed-loop decision maker that reads only what the robot sees (no oracle).
+BEHAVIOURS = _behaviours()
 
 
 def behaviour_pick(moved: Mapping[str, int], resting: Mapping[str, float], draw: float, order: int = 0) -> str:
@@ -112,8 +127,30 @@ def load_states(folder: str | os.PathLike[str]) -> Iterator[tuple[dict[str, Any]
         yield _load_state(path)
 
 
-def _collect_pile(path: Path, number: int, out: Path, seed: int, max_picks: int | None) -> tuple[int, dict[str, Any]]:
-    """Empty one pile with the probe, saving every state; the run's summary comes back."""
+def _maker(behaviour: str, model: Any, disturbance: Any, seed: int) -> Callable[..., str] | None:
+    """The decision maker that takes every pick, or None for the ``"mixed"`` draw."""
+    if behaviour == "mixed":
+        return None
+    from unstack.experiments.container import PROBING_MAKERS, container_policies
+    from unstack.learning.model_file import default_model_path, load_model
+
+    if model is None:
+        model = load_model(default_model_path())
+    maker = container_policies(model, seed=seed, makers=[behaviour], disturbance=disturbance)[behaviour]
+    if behaviour in PROBING_MAKERS:
+        return maker
+    return lambda current, _outcomes: maker(current)
+
+
+#: The ``behaviour`` of :func:`_collect_pile` when the picks are drawn.
+_MIXED = ("mixed", None, None)
+
+
+def _collect_pile(
+    path: Path, number: int, out: Path, seed: int, max_picks: int | None, behaviour: tuple[str, Any, Any] = _MIXED
+) -> tuple[int, dict[str, Any]]:
+    """Empty one pile with the probe, saving every state; the run's summary comes back.
+    ``behaviour``: its name, the support model and the disturbance model of a decision maker."""
     from unstack.atomic import atomic_write_bytes, atomic_write_text
     from unstack.geometry import bounding_boxes
     from unstack.scene import load_scene
@@ -124,6 +161,7 @@ def _collect_pile(path: Path, number: int, out: Path, seed: int, max_picks: int 
     folder.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(number,)))
     steps = [0]
+    maker = _maker(*behaviour, seed)
 
     def policy(current: Scene, outcomes: Mapping[str, Any]) -> str:
         import io
@@ -132,6 +170,8 @@ def _collect_pile(path: Path, number: int, out: Path, seed: int, max_picks: int 
         np.savez_compressed(buffer, **_state_payload(current, outcomes, path.stem, steps[0]))
         atomic_write_bytes(folder / f"step-{steps[0]:03d}.npz", buffer.getvalue())
         steps[0] += 1
+        if maker is not None:
+            return maker(current, outcomes)
         bounds = bounding_boxes([current.box(box_id) for box_id in current.detected])
         resting = {box_id: float(bounds[k, 2]) for k, box_id in enumerate(current.detected)}
         moved = {box_id: outcome.boxes_moved for box_id, outcome in outcomes.items()}
@@ -140,11 +180,21 @@ def _collect_pile(path: Path, number: int, out: Path, seed: int, max_picks: int 
     run = unload_container(scene, policy, seed=seed + number, max_picks=max_picks, probe=True)
     summary = {"scene": path.name, "boxes": len(scene.boxes), "states": steps[0], "boxes_moved": run.boxes_moved,
                "stopped": run.stopped}  # fmt: skip
+    if maker is not None:
+        summary["behaviour"] = behaviour[0]
     atomic_write_text(folder / "done.json", json.dumps(summary) + "\n")
     return number, summary
 
 
-@validate_params({"piles": OPTIONAL_COUNT, "seed": SEED, "max_picks": OPTIONAL_COUNT, "n_jobs": COUNT})
+@validate_params(
+    {
+        "piles": OPTIONAL_COUNT,
+        "seed": SEED,
+        "max_picks": OPTIONAL_COUNT,
+        "n_jobs": COUNT,
+        "behaviour": OneOf(BEHAVIOURS),
+    }
+)
 def collect_pick_responses(
     data_dirs: list[str | os.PathLike[str]],
     out: str | os.PathLike[str],
@@ -152,6 +202,9 @@ def collect_pick_responses(
     piles: int | None = None,
     seed: int = 0,
     max_picks: int | None = None,
+    behaviour: str = "mixed",
+    model: Any = None,
+    disturbance: Any = None,
     n_jobs: int = 1,
     client: Any = None,
     progress: Callable[[int, int], None] | None = None,
@@ -169,13 +222,20 @@ def collect_pick_responses(
         Seeds the scans and the behaviour, pile by pile.
     max_picks : int, optional
         Stop each pile after this many picks.
+    behaviour : str
+        What takes the picks (:data:`BEHAVIOURS`): ``"mixed"``, the seeded draw of
+        :func:`behaviour_pick`, or a closed-loop decision maker (the states it reaches itself).
+    model, disturbance
+        The support model and the disturbance model (a file or a fitted model; None: the
+        shipped one) of a decision maker taking the picks; ``"mixed"`` reads neither.
     n_jobs, client
         Piles in parallel processes, or on a dask.distributed cluster.
 
     Returns
     -------
     list of dict
-        Per pile: scene, boxes, states saved, boxes moved by the behaviour, why it stopped.
+        Per pile: scene, boxes, states saved, boxes moved by the behaviour, why it stopped
+        (and the behaviour, when a decision maker took the picks).
     """
     from unstack.dataset_folders import require_configurations
 
@@ -193,7 +253,7 @@ def collect_pick_responses(
         if done.is_file():
             summaries[number] = json.loads(done.read_text())
         else:
-            tasks.append((path, number, pile_folder, seed, max_picks))
+            tasks.append((path, number, pile_folder, seed, max_picks, (behaviour, model, disturbance)))
     if progress is not None:
         progress(len(files) - len(tasks), len(files))
     for number, summary in run_unordered(_collect_pile, tasks, n_jobs=n_jobs, client=client):
