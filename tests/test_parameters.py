@@ -122,3 +122,15 @@ def test_a_cli_option_refuses_what_the_library_refuses_in_the_same_words() -> No
 def test_an_option_for_a_parameter_without_a_constraint_is_a_programming_error() -> None:
     with pytest.raises(TypeError, match="declares no constraint on 'model'"):
         constrained(container_experiment, "model")
+
+
+def test_a_long_choice_is_one_word_in_the_help_and_its_names_are_in_the_error() -> None:
+    from unstack.cli.options import CHOICES_LISTED
+    from unstack.experiments.pick_responses import BEHAVIOURS, collect_pick_responses
+
+    assert len(BEHAVIOURS) > CHOICES_LISTED
+    option_type = constrained(collect_pick_responses, "behaviour")
+    assert option_type.name == "behaviour" and option_type.convert("highest", None, None) == "highest"
+    with pytest.raises(click.BadParameter, match="unknown behaviour 'tallest'; expected one of mixed, unstack, "):
+        option_type.convert("tallest", None, None)
+    assert isinstance(constrained(container_experiment, "reach"), click.Choice)  # a short one lists its names

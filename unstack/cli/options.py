@@ -47,25 +47,33 @@ else:
     _ParamType = click.ParamType  # not subscriptable before click 8.2
 
 
+#: A choice among more than this many names shows as one word in ``--help`` (the names are in
+#: the error a wrong one gets), not as a list that buries the other options.
+CHOICES_LISTED = 12
+_READERS: dict[type, Any] = {int: click.INT, float: click.FLOAT, str: click.STRING}
+
+
 class Checked(_ParamType):
-    """An option of type ``kind`` (int or float) that must pass ``check(value)``.
+    """An option of type ``kind`` (int, float or str) that must pass ``check(value)``.
 
     Parameters
     ----------
     kind : type
-        ``int`` or ``float``: what the text is read as.
+        ``int``, ``float`` or ``str``: what the text is read as.
     check : callable
         The library's check: returns the canonical value or raises
         :class:`~unstack.errors.InvalidArgument`.
+    name : str, optional
+        What ``--help`` calls the value (default: integer, number or text).
     """
 
-    def __init__(self, kind: type, check: Callable[[Any], Any]) -> None:
+    def __init__(self, kind: type, check: Callable[[Any], Any], name: str | None = None) -> None:
         self.kind = kind
         self.check = check
-        self.name = "integer" if kind is int else "number"
+        self.name = name or {int: "integer", float: "number"}.get(kind, "text")
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
-        read = (click.INT if self.kind is int else click.FLOAT).convert(value, param, ctx)
+        read = _READERS[self.kind].convert(value, param, ctx)
         try:
             return self.check(read)
         except InvalidArgument as error:
@@ -75,8 +83,9 @@ class Checked(_ParamType):
 def constrained(function: Callable[..., Any], parameter: str) -> _ParamType:
     """The click type of an option feeding ``parameter`` of ``function``: its declared constraint.
 
-    A choice becomes :class:`click.Choice` (the choices show in ``--help``); a range, a
-    :class:`Checked` number running the constraint's check.
+    A choice becomes :class:`click.Choice` (the choices show in ``--help``), or, beyond
+    :data:`CHOICES_LISTED` choices, a :class:`Checked` name; a range, a :class:`Checked`
+    number running the constraint's check.
 
     Parameters
     ----------
@@ -89,6 +98,8 @@ def constrained(function: Callable[..., Any], parameter: str) -> _ParamType:
     if parameter not in constraints:
         raise TypeError(f"{function.__qualname__} declares no constraint on {parameter!r}")
     constraint = constraints[parameter]
+    if isinstance(constraint, OneOf) and len(constraint.choices) > CHOICES_LISTED:
+        return Checked(str, functools.partial(constraint.check, name=parameter), name=parameter)
     if isinstance(constraint, OneOf):
         return click.Choice(list(constraint.choices))
     return Checked(constraint.kind, functools.partial(constraint.check, name=parameter))
