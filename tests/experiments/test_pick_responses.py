@@ -46,6 +46,14 @@ def test_every_state_is_saved_with_every_candidates_outcome(states: Path) -> Non
         assert all(set(moved) <= set(header["ids"]) - {box} for box, moved in header["moved"].items())
 
 
+def test_one_piles_folder_gives_its_own_states_in_order(states: Path) -> None:
+    folder = sorted(path.parent for path in states.glob("*/*/done.json"))[1]
+    headers = [header for header, _ in load_states(folder)]
+    assert [header["step"] for header in headers] == [0, 1, 2] and {header["pile"] for header in headers} == {
+        folder.name
+    }
+
+
 def test_the_probed_outcome_is_what_the_pick_then_does(small_dataset: Path) -> None:
     """The chosen candidate's probed outcome is the step the run then records, and a replay of
     the order without probes moves the same boxes (restoring a saved state keeps the poses

@@ -122,8 +122,10 @@ def _load_state(path: Path) -> tuple[dict[str, Any], Scene]:
 
 
 def load_states(folder: str | os.PathLike[str]) -> Iterator[tuple[dict[str, Any], Scene]]:
-    """Every saved state of a collection (``DATA-SET/PILE/step-NNN.npz``), as ``(header, scene)``."""
-    for path in sorted(Path(folder).glob("*/*/step-*.npz")):
+    """Every saved state of a collection (``DATA-SET/PILE/step-NNN.npz``), or of one pile's
+    folder in it, in order, as ``(header, scene)``."""
+    paths = sorted(Path(folder).glob("step-*.npz")) or sorted(Path(folder).glob("*/*/step-*.npz"))
+    for path in paths:
         yield _load_state(path)
 
 
