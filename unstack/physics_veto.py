@@ -48,7 +48,14 @@ from unstack.scene import Scene
 if TYPE_CHECKING:
     from unstack.reasoner.decision import Decision
 
-__all__ = ["PHYSICS_FILL", "PHYSICS_VETO", "PHYSICS_WORLDS", "physics_veto", "world_settings"]
+__all__ = [
+    "PHYSICS_FILL",
+    "PHYSICS_VETO",
+    "PHYSICS_WORLDS",
+    "expected_moves_in_view",
+    "physics_veto",
+    "world_settings",
+]
 
 #: Belief worlds the pick (and, when it is vetoed, each alternative) is tried in.
 PHYSICS_WORLDS = 4
@@ -72,6 +79,29 @@ def _expected_moved(
         world_scene, boxes, worlds=worlds, fill=PHYSICS_FILL, seed=seed, settings=settings, net=net
     )
     return {box_id: float(outcome.expected_moved) for box_id, outcome in outcomes.items()}
+
+
+def expected_moves_in_view(
+    scene: Scene, boxes: list[str], *, seed: int = 0, worlds: int = PHYSICS_WORLDS
+) -> dict[str, float]:
+    """The boxes each of ``boxes`` is expected to move in the veto's belief worlds of a closed
+    loop's scene (built from its boxes in view, :func:`unstack.sim.unloading.in_view_scene`),
+    one box at a time as a caller tries them (the maker ``hybrid_faces_walk``).
+
+    Examples
+    --------
+    >>> import unstack
+    >>> scene = unstack.load("examples/pile5.scene.json")
+    >>> moved = expected_moves_in_view(scene, ["b13"], seed=0)
+    >>> list(moved), moved["b13"] >= 0.0
+    (['b13'], True)
+    """
+    from unstack.sim.unloading import in_view_scene
+
+    given = in_view_scene(scene)
+    settings = world_settings(given)
+    built, _ = _inside_container(given, settings)
+    return _expected_moved(built, boxes, seed, settings, worlds)
 
 
 def world_settings(scene: Scene) -> Any:

@@ -90,6 +90,8 @@ def test_the_hybrid_takes_the_highest_box_the_model_does_not_believe_loaded() ->
         "hybrid_faces_free_gated",
         "hybrid_moves_free",
         "hybrid_moves_free_1",
+        "hybrid_moves_walk",
+        "hybrid_faces_walk",
     ],
 )
 def test_the_hybrid_vetoes_start_from_the_hybrids_pick_not_the_highest_box(maker: str) -> None:

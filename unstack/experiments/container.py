@@ -136,6 +136,13 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
 ``hybrid_moves_free_1``
     the same, vetoed at :data:`~unstack.physics_veto.PHYSICS_VETO` expected boxes (as the
     physics veto), not :data:`~unstack.moves.MOVES_VETO`.
+``hybrid_moves_walk``
+    down the boxes the reasoner believes hold nothing up, highest first, the first that the
+    disturbance model does not expect to move :data:`~unstack.physics_veto.PHYSICS_VETO` boxes
+    or more: the default's pick unless vetoed, then the next highest not vetoed.
+``hybrid_faces_walk``
+    the same walk with the faces belief's physics as the veto (as ``hybrid_faces_free``, which
+    takes the belief's fewest among every such box once the hybrid's pick is vetoed).
 
 Metrics per pile and per maker: boxes moved more than 2 cm, boxes fallen (dropped more than
 0.2 m or tipped more than 45 degrees), the share of picks that move nothing, and paired
@@ -189,7 +196,7 @@ CONTAINER_MAKERS = (
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
     "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any",
     "hybrid_faces_free_8", "hybrid_faces_free_sure", "hybrid_moves_free", "unstack_strict", "hybrid_moves_free_1",
-    "hybrid_faces_free_net", "hybrid_faces_free_gated",
+    "hybrid_faces_free_net", "hybrid_faces_free_gated", "hybrid_moves_walk", "hybrid_faces_walk",
 )  # fmt: skip
 #: Diagnostic oracles that read every box of the pile, seen or not (never a robot's policy);
 #: run only when named.
@@ -202,7 +209,7 @@ TRIED_MAKERS = (
     "belief_sampled", "belief_sampled_veto", "belief_scaled_veto",
     "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any",
     "hybrid_faces_free_8", "hybrid_faces_free_sure", "hybrid_moves_free", "unstack_strict", "hybrid_moves_free_1",
-    "hybrid_faces_free_net", "hybrid_faces_free_gated",
+    "hybrid_faces_free_net", "hybrid_faces_free_gated", "hybrid_moves_walk", "hybrid_faces_walk",
 )  # fmt: skip
 #: The makers run when none are named.
 DEFAULT_CONTAINER_MAKERS = tuple(
@@ -217,7 +224,9 @@ STRICT_FREE_COST = 0.2
 #: ``python benchmarks/veto_features.py report``).
 GATE_MOVES = 0.086
 #: Makers that read the disturbance model (:mod:`unstack.moves`).
-MOVES_MAKERS = ("moves", "moves_veto", "hybrid_moves_free", "hybrid_moves_free_1", "hybrid_faces_free_gated")
+MOVES_MAKERS = (
+    "moves", "moves_veto", "hybrid_moves_free", "hybrid_moves_free_1", "hybrid_faces_free_gated", "hybrid_moves_walk",
+)  # fmt: skip
 #: Makers whose policy is told what every candidate's removal does in the engine (the true pile).
 PROBING_MAKERS = ("lookahead",)
 #: Recorded sweeps per sampled group in each decision: 512 when a sweep re-inserted every box,
@@ -449,6 +458,26 @@ def container_policies(
 
         return policy
 
+    def hybrid_faces_walk(scene: Scene) -> str:
+        """Down the boxes the reasoner believes hold nothing up, the hybrid's pick first and
+        then highest first, the first the faces belief does not expect to move
+        :data:`~unstack.physics_veto.PHYSICS_VETO` boxes or more; if every one is vetoed, the
+        belief's fewest (``hybrid_faces_free`` tries every such box once its pick is vetoed)."""
+        from unstack.height_veto import FREE_COST, hybrid_choice
+        from unstack.physics_veto import expected_moves_in_view
+
+        reasoned = decision(scene, "load")
+        pick = hybrid_choice(scene, reasoned)
+        costs = expected_costs(reasoned)
+        free = [box_id for box_id in scene.detected if costs[box_id] < FREE_COST and box_id != pick]
+        order = [pick, *sorted(free, key=lambda box_id: (height(scene, box_id), box_id), reverse=True)]
+        tried: dict[str, float] = {}
+        for box_id in order:
+            tried.update(expected_moves_in_view(scene, [box_id], seed=seed))
+            if tried[box_id] < PHYSICS_VETO:
+                return box_id
+        return fewest(scene, {box_id: tried.get(box_id, np.inf) for box_id in scene.detected})
+
     def hybrid_faces_free_gated(scene: Scene) -> str:
         """``hybrid_faces_free`` where the disturbance model expects the hybrid's pick to move
         :data:`GATE_MOVES` boxes or more; elsewhere the hybrid's pick, without the physics."""
@@ -476,26 +505,45 @@ def container_policies(
             return pick
         return str(vetoed.choice)
 
+    def predicted_moves(scene: Scene) -> tuple[str, dict[str, float], list[str]]:
+        """The default's pick, the disturbance model's expected moves of every candidate, and
+        the boxes the reasoner believes hold nothing up (every box if none)."""
+        from unstack.height_veto import FREE_COST, free_highest
+        from unstack.learning.pick_features import pick_features
+        from unstack.pipeline import scene_support_probabilities
+        from unstack.reasoner.decision import decide
+
+        supports = scene_support_probabilities(scene, model)
+        reasoned = decide(supports, cost="load", samples=samples, seed=seed)
+        pick = str(free_highest(reasoned, scene).choice)
+        features = pick_features(scene, supports, reasoned.marginals, reasoned.expected_costs)
+        predicted = disturbance_model().expected_moves(features)
+        expected = dict(zip(supports.objects, (float(moved) for moved in predicted), strict=True))
+        costs = expected_costs(reasoned)
+        free = [box_id for box_id in scene.detected if costs[box_id] < FREE_COST] or list(scene.detected)
+        return pick, expected, free
+
     def moves_free(veto_at: float) -> Callable[[Scene], str]:
         def policy(scene: Scene) -> str:
             """The default's pick unless the disturbance model expects its removal to move
             ``veto_at`` boxes or more; then the fewest expected moves among the boxes the
             reasoner believes hold nothing up, ties to the box resting highest."""
-            from unstack.height_veto import FREE_COST, free_highest
-            from unstack.learning.pick_features import pick_features
-            from unstack.pipeline import scene_support_probabilities
-            from unstack.reasoner.decision import decide
-
-            supports = scene_support_probabilities(scene, model)
-            reasoned = decide(supports, cost="load", samples=samples, seed=seed)
-            pick = str(free_highest(reasoned, scene).choice)
-            features = pick_features(scene, supports, reasoned.marginals, reasoned.expected_costs)
-            predicted = disturbance_model().expected_moves(features)
-            expected = dict(zip(supports.objects, (float(moved) for moved in predicted), strict=True))
+            pick, expected, free = predicted_moves(scene)
             if expected[pick] < veto_at:
                 return pick
-            costs = expected_costs(reasoned)
-            free = [box_id for box_id in scene.detected if costs[box_id] < FREE_COST] or list(scene.detected)
+            return fewest(scene, {box_id: expected[box_id] if box_id in free else np.inf for box_id in scene.detected})
+
+        return policy
+
+    def moves_walk(veto_at: float) -> Callable[[Scene], str]:
+        def policy(scene: Scene) -> str:
+            """The highest of the boxes the reasoner believes hold nothing up that the
+            disturbance model does not expect to move ``veto_at`` boxes or more (the default's
+            pick when it is not vetoed); if every one is vetoed, the fewest expected moves."""
+            _, expected, free = predicted_moves(scene)
+            for box_id in sorted(free, key=lambda box_id: (height(scene, box_id), box_id), reverse=True):
+                if expected[box_id] < veto_at:
+                    return box_id
             return fewest(scene, {box_id: expected[box_id] if box_id in free else np.inf for box_id in scene.detected})
 
         return policy
@@ -582,6 +630,8 @@ def container_policies(
         "hybrid_faces_free_sure": hybrid_faces_free_sure,
         "hybrid_moves_free": moves_free(MOVES_VETO),
         "hybrid_moves_free_1": moves_free(PHYSICS_VETO),
+        "hybrid_moves_walk": moves_walk(PHYSICS_VETO),
+        "hybrid_faces_walk": hybrid_faces_walk,
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:
