@@ -32,9 +32,12 @@ from typing import Any
 import numpy as np
 
 
-def behaviour_of(states: Path, pile: str) -> str:
-    """``mixed`` or the decision maker that emptied ``pile`` (``DATA-SET/PILE``)."""
-    return str(json.loads((states / pile / "done.json").read_text()).get("behaviour", "mixed"))
+def behaviours(states: Path) -> dict[str, str]:
+    """``mixed`` or the decision maker that emptied each pile (``DATA-SET/PILE``) of ``states``."""
+    return {
+        f"{done.parent.parent.name}/{done.parent.name}": str(json.loads(done.read_text()).get("behaviour", "mixed"))
+        for done in states.glob("*/*/done.json")
+    }
 
 
 def physical_pile(pile: str) -> str:
@@ -49,9 +52,10 @@ def shipped_calibration(records: list[dict[str, Any]], states: Path) -> dict[str
     from unstack.learning.disturbance import calibration, load_disturbance_model
 
     shipped = load_disturbance_model()
+    behaviour = behaviours(states)
     kinds: dict[str, tuple[list[np.ndarray], list[np.ndarray]]] = {}
     for record in records:
-        key = f"{behaviour_of(states, record['pile'])}/{record['view']}"
+        key = f"{behaviour[record['pile']]}/{record['view']}"
         predicted, actual = kinds.setdefault(key, ([], []))
         predicted.append(shipped.expected_moves(np.asarray(record["features"])))
         actual.append(np.asarray(record["moved"]))

@@ -31,6 +31,7 @@ import numpy as np
 def pile_rows(folder: Path) -> tuple[str, np.ndarray]:
     """Per state followed by a pick: boxes moved by the default's pick, by the pick taken,
     whether the two differ, and the fewest any candidate moves."""
+    from unstack.experiments.container import CONTAINER_SAMPLES
     from unstack.experiments.pick_responses import load_states
     from unstack.height_veto import free_highest
     from unstack.learning.model_file import default_model_path, load_model
@@ -45,7 +46,7 @@ def pile_rows(folder: Path) -> tuple[str, np.ndarray]:
         if len(gone) != 1:  # a box lost below the floor with the pick: the pick is not known
             continue
         taken = gone.pop()
-        decision = decide(scene_support_probabilities(scene, model), cost="load", samples=1536, seed=0)
+        decision = decide(scene_support_probabilities(scene, model), cost="load", samples=CONTAINER_SAMPLES, seed=0)
         default = str(free_highest(decision, scene).choice)
         moved = {box_id: len(boxes) for box_id, boxes in header["moved"].items()}
         rows.append((moved[default], moved[taken], float(default != taken), min(moved.values())))
