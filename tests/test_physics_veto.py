@@ -82,6 +82,21 @@ def test_a_lower_veto_vetoes_whatever_the_default_veto_does_and_is_recorded(smal
     Draft202012Validator(load_schema("unstack.decision/1")).validate(netted.to_dict())
 
 
+def test_the_veto_in_worlds_of_hidden_cartons_is_recorded_and_an_unknown_fill_refused(small_dataset: Path) -> None:
+    scene = unstack.load(small_dataset / "config-0005.json")
+    default = unstack.decide(scene, seed=0)
+    cartons = physics_veto(default, scene, seed=0, fill="cartons")
+    assert cartons.physics_veto is not None and cartons.physics_veto["fill"] == "cartons"
+    assert cartons.physics_veto["tried"][0]["box"] == default.choice
+    assert cartons.to_dict() == physics_veto(default, scene, seed=0, fill="cartons").to_dict()
+    Draft202012Validator(load_schema("unstack.decision/1")).validate(cartons.to_dict())
+    for fill in ("cloud", "boxes"):
+        with pytest.raises(
+            InvalidArgument, match=f"unknown belief fill '{fill}' for the physics veto; expected one of"
+        ):
+            physics_veto(default, scene, fill=fill)
+
+
 def test_the_same_seed_gives_the_same_worlds_and_choice(small_dataset: Path) -> None:
     scene = unstack.load(small_dataset / "config-0005.json")
     first, second = (unstack.decide(scene, seed=3, physics_veto=True).to_dict() for _ in range(2))

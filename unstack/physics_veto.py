@@ -71,13 +71,17 @@ WALL_SLACK = 0.02
 
 
 def _expected_moved(
-    world_scene: Scene, boxes: list[str], seed: int, settings: Any, worlds: int, net: bool = False
+    world_scene: Scene,
+    boxes: list[str],
+    seed: int,
+    settings: Any,
+    worlds: int,
+    net: bool = False,
+    fill: str = PHYSICS_FILL,
 ) -> dict[str, float]:
     from unstack.sim.belief import belief_removals
 
-    outcomes = belief_removals(
-        world_scene, boxes, worlds=worlds, fill=PHYSICS_FILL, seed=seed, settings=settings, net=net
-    )
+    outcomes = belief_removals(world_scene, boxes, worlds=worlds, fill=fill, seed=seed, settings=settings, net=net)
     return {box_id: float(outcome.expected_moved) for box_id, outcome in outcomes.items()}
 
 
@@ -187,6 +191,7 @@ def physics_veto(
     veto_at: float = PHYSICS_VETO,
     worlds: int = PHYSICS_WORLDS,
     net: bool = False,
+    fill: str = PHYSICS_FILL,
 ) -> Decision:
     """The decision with its pick vetoed where physics on the belief expects it to move boxes.
 
@@ -213,6 +218,10 @@ def physics_veto(
         Count, in each world, only the boxes that stay still there with nothing taken (measured
         no better than counting every box: the results page, maker ``hybrid_faces_free_net``);
         recorded as ``physics_veto["net"]``.
+    fill : {"faces", "cartons", "scaled", "sampled", "occlusion"}
+        What the belief worlds put where the sensor sees no box (:data:`unstack.sim.belief.FILLS`;
+        default :data:`PHYSICS_FILL`; ``"cartons"``, whole hidden cartons drawn into the unseen
+        space, is the maker ``hybrid_cartons_free`` of the results page).
 
     Returns
     -------
@@ -252,6 +261,11 @@ def physics_veto(
         raise InvalidArgument(f"worlds must be a positive integer, got {worlds!r}")
     if not isinstance(net, bool):
         raise InvalidArgument(f"net must be True or False, got {net!r}")
+    from unstack.sim.belief import FILLS
+
+    if fill not in FILLS or fill == "cloud":
+        known = ", ".join(name for name in FILLS if name != "cloud")
+        raise InvalidArgument(f"unknown belief fill {fill!r} for the physics veto; expected one of {known}")
     missing = [box_id for box_id in decision.objects if box_id not in scene.detected]
     if missing:
         raise InvalidArgument(f"{scene.source}: the decision's boxes {missing} are not detected boxes of the scene")
@@ -259,21 +273,21 @@ def physics_veto(
     settings = world_settings(given)
     built, slid = _inside_container(given, settings)
     pick = decision.choice
-    expected = _expected_moved(built, [pick], seed, settings, worlds, net)
+    expected = _expected_moved(built, [pick], seed, settings, worlds, net, fill)
     vetoed = expected[pick] >= veto_at
     if vetoed:
         costs = dict(zip(decision.objects, (float(cost) for cost in decision.expected_costs), strict=True))
         others = [box_id for box_id in decision.objects if box_id != pick and costs[box_id] < free_cost]
         if others:
-            expected.update(_expected_moved(built, others, seed, settings, worlds, net))
-    record = _record(expected, pick, vetoed, veto_at, worlds)
+            expected.update(_expected_moved(built, others, seed, settings, worlds, net, fill))
+    record = _record(expected, pick, vetoed, veto_at, worlds, fill)
     if net:
         record["net"] = True
     warnings = decision.warnings
     if vetoed:  # a world that does not come to rest moves boxes whatever is taken
         from unstack.sim.belief import restless_boxes
 
-        restless = restless_boxes(built, seed=seed, settings=settings, fill=PHYSICS_FILL)
+        restless = restless_boxes(built, seed=seed, settings=settings, fill=fill)
         if restless:
             record["restless"] = list(restless)
             warnings = (*warnings, f"physics veto: with nothing taken, {', '.join(restless)} move in the belief "
@@ -295,10 +309,12 @@ def physics_veto(
     )  # fmt: skip
 
 
-def _record(expected: Mapping[str, float], pick: str, vetoed: bool, veto_at: float, worlds: int) -> dict[str, Any]:
+def _record(
+    expected: Mapping[str, float], pick: str, vetoed: bool, veto_at: float, worlds: int, fill: str = PHYSICS_FILL
+) -> dict[str, Any]:
     """The ``physics_veto`` object of ``unstack.decision/1``."""
     return {
-        "fill": PHYSICS_FILL,
+        "fill": fill,
         "worlds": worlds,
         "veto_at": veto_at,
         "vetoed": vetoed,

@@ -143,6 +143,10 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
 ``hybrid_faces_walk``
     the same walk with the faces belief's physics as the veto (as ``hybrid_faces_free``, which
     takes the belief's fewest among every such box once the hybrid's pick is vetoed).
+``hybrid_cartons_free``
+    ``hybrid_faces_free`` with whole hidden cartons drawn into the unseen space of each belief
+    world instead of runs of it kept one by one (``fill="cartons"``,
+    :func:`unstack.understanding.hidden_cartons.draw_hidden_cartons`).
 
 Metrics per pile and per maker: boxes moved more than 2 cm, boxes fallen (dropped more than
 0.2 m or tipped more than 45 degrees), the share of picks that move nothing, and paired
@@ -207,6 +211,7 @@ TRIED_MAKERS = (
     "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any",
     "hybrid_faces_free_8", "hybrid_faces_free_sure", "hybrid_moves_free", "unstack_strict", "hybrid_moves_free_1",
     "hybrid_faces_free_net", "hybrid_faces_free_gated", "hybrid_moves_walk", "hybrid_faces_walk",
+    "hybrid_cartons_free",
 )  # fmt: skip
 #: Every decision maker.
 CONTAINER_MAKERS = (*DEFAULT_CONTAINER_MAKERS, *ORACLE_MAKERS, *TRIED_MAKERS)
@@ -427,6 +432,7 @@ def container_policies(
         worlds: int = PHYSICS_WORLDS,
         net: bool = False,
         reasoned: Any = None,
+        fill: str = "faces",
     ) -> tuple[str, Any]:
         """The hybrid's pick, and the decision with it vetoed where the faces belief expects its
         removal to move ``veto_at`` boxes: then that belief's fewest among the boxes the
@@ -443,13 +449,15 @@ def container_policies(
         pick = hybrid_choice(scene, reasoned)
         vetoed = physics_veto(
             dataclasses.replace(reasoned, choice=pick), scene, seed=seed, world_scene=in_view_scene(scene),
-            veto_at=veto_at, worlds=worlds, net=net,
+            veto_at=veto_at, worlds=worlds, net=net, fill=fill,
         )  # fmt: skip
         return pick, vetoed
 
-    def faces_free(veto_at: float, worlds: int = PHYSICS_WORLDS, net: bool = False) -> Callable[[Scene], str]:
+    def faces_free(
+        veto_at: float, worlds: int = PHYSICS_WORLDS, net: bool = False, fill: str = "faces"
+    ) -> Callable[[Scene], str]:
         def policy(scene: Scene) -> str:
-            return str(faces_vetoed(scene, veto_at, worlds, net)[1].choice)
+            return str(faces_vetoed(scene, veto_at, worlds, net, fill=fill)[1].choice)
 
         return policy
 
@@ -627,6 +635,7 @@ def container_policies(
         "hybrid_moves_free_1": moves_free(PHYSICS_VETO),
         "hybrid_moves_walk": moves_walk(PHYSICS_VETO),
         "hybrid_faces_walk": hybrid_faces_walk,
+        "hybrid_cartons_free": faces_free(PHYSICS_VETO, fill="cartons"),
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:

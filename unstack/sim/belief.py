@@ -53,6 +53,13 @@ sensor's side is solid in every world (:func:`behind_seen_faces`). With a detect
 half the boxes, 58-76 % of that space lies inside a hidden box on 8 development piles of each
 family, against 16-35 % of the rest (``benchmarks/occlusion_truth.py --misses 0.5``).
 
+With ``fill="cartons"`` the faces fill's solid fronts stay, and instead of runs kept one by one
+each world draws whole hidden cartons into the unseen space (:func:`carton_blocks`,
+:func:`unstack.understanding.hidden_cartons.draw_hidden_cartons`: the sizes of the boxes in
+view, each resting on something, up to the ``scaled`` share): a truer hypothesis of where hidden
+boxes stand (``benchmarks/carton_truth.py``), measured no better as the physics veto's belief
+(results page, maker ``hybrid_cartons_free``).
+
 The world settles for :data:`~unstack.sim.unloading.RESETTLE_SECONDS`; then each candidate's
 removal is tried as the look-ahead tries it (the same horizon, thresholds and parking, the
 state restored after each try), counting the detected boxes and the hidden-load bodies that
@@ -98,7 +105,10 @@ __all__ = [
     "belief_choice",
     "belief_removals",
     "belief_settings",
+    "carton_blocks",
     "choose_by_expected_moves",
+    "container_interior",
+    "drawn_worlds",
     "occlusion_blocks",
     "restless_boxes",
     "scaled_occupancy",
@@ -124,8 +134,9 @@ HOLD_ROUNDS = 3
 #: and hidden loads (:func:`belief_blocks`), all the space the sensor cannot see next to the
 #: boxes it sees (:func:`occlusion_blocks`), or that space sampled: each run of it kept with a
 #: fixed chance (:data:`OCCUPANCY`) or one scaled by its volume (:func:`scaled_occupancy`), the
-#: space behind surfaces no detected box explains solid (:func:`behind_seen_faces`).
-FILLS = ("cloud", "occlusion", "sampled", "scaled", "faces")
+#: space behind surfaces no detected box explains solid (:func:`behind_seen_faces`), or that
+#: space solid and whole hidden cartons drawn into the rest (:func:`carton_blocks`).
+FILLS = ("cloud", "occlusion", "sampled", "scaled", "faces", "cartons")
 #: Chance that a run of space the sensor cannot see is kept solid in a world of the
 #: ``sampled`` fill: about the share of that space hidden boxes fill on the first scan of the
 #: simulated piles (2-23 % by family; ``benchmarks/occlusion_truth.py``).
@@ -288,6 +299,19 @@ def seen_boxes(scene: Scene) -> list[str]:
     ]
 
 
+def container_interior(settings: Any) -> list[list[float]]:
+    """The lowest and highest corner of the inside of ``settings``' container (the door at x = 0).
+
+    Examples
+    --------
+    >>> from unstack.sim.settings import SimulationSettings
+    >>> container_interior(SimulationSettings())
+    [[0.0, -1.175, 0.0], [2.0, 1.175, 2.39]]
+    """
+    container = settings.container
+    return [[0.0, -container.width / 2.0, 0.0], [container.depth, container.width / 2.0, container.height]]
+
+
 def occlusion_blocks(scene: Scene, settings: Any = None) -> list[BeliefBlock]:
     """The space the sensor cannot see next to the scene's detected boxes, as fixed blocks.
 
@@ -309,13 +333,11 @@ def occlusion_blocks(scene: Scene, settings: Any = None) -> list[BeliefBlock]:
     from unstack.understanding.occlusion import occluded_space
 
     simulation = belief_settings(scene, settings)
-    container = simulation.container
-    interior = [[0.0, -container.width / 2.0, 0.0], [container.depth, container.width / 2.0, container.height]]
     space = occluded_space(
         scene.points,
         [scene.box(box_id) for box_id in scene.detected],
         viewpoint=simulation.sensor.position,
-        interior=interior,
+        interior=container_interior(simulation),
     )
     return [BeliefBlock(size, center, None) for size, center in zip(space.sizes, space.centers, strict=True)]
 
@@ -391,6 +413,50 @@ def _faced(blocks: Sequence[BeliefBlock], behind: np.ndarray) -> tuple[list[Beli
             BeliefBlock(np.array([end - cut, *block.size[1:]]), np.array([(cut + end) / 2, *block.center[1:]]), None)
         )
     return fronts, rests
+
+
+def carton_blocks(
+    scene: Scene,
+    settings: Any,
+    share: float,
+    rng: np.random.Generator,
+    solid: Sequence[BeliefBlock] = (),
+    worlds: int = 1,
+) -> list[list[BeliefBlock]]:
+    """Hypotheses of whole hidden cartons next to the scene's detected boxes, as fixed blocks, one per world.
+
+    :func:`unstack.understanding.hidden_cartons.draw_hidden_cartons` from the scene's cloud,
+    its detected boxes, the sensor's position and the container's inside (of ``settings``),
+    covering ``share`` of the unseen space near them, around the blocks ``solid`` already
+    placed (the ``cartons`` fill: the faces fill's solid fronts, and these drawn anew in every world).
+
+    Examples
+    --------
+    >>> from unstack.scene import Box, Scene
+    >>> from unstack.understanding.clouds import surface_cloud
+    >>> front = Box("front", [0.4, 0.4, 0.4], [0.6, 0.0, 0.2])
+    >>> behind = Box("behind", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2])
+    >>> scene = Scene([front, behind], surface_cloud([front, behind], spacing=0.005, seed=0), ["front"])
+    >>> [blocks] = carton_blocks(scene, belief_settings(scene), 1.0, np.random.default_rng(0))
+    >>> len(blocks) > 0 and all(block.resting_on is None for block in blocks)
+    True
+    """
+    from unstack.understanding.hidden_cartons import CARTON_REACH, draw_hidden_cartons
+    from unstack.understanding.occlusion import occlusion_grid
+
+    interior = container_interior(settings)
+    obstacles = np.array([[*(b.center - b.size / 2), *(b.center + b.size / 2)] for b in solid]).reshape(-1, 6)
+    boxes = [scene.box(box_id) for box_id in scene.detected]
+    grid = occlusion_grid(
+        scene.points, boxes, viewpoint=settings.sensor.position, interior=interior, reach=CARTON_REACH
+    )
+    hypotheses = []
+    for _ in range(worlds):
+        cartons = draw_hidden_cartons(grid, boxes, interior=interior, share=share, rng=rng, obstacles=obstacles)
+        hypotheses.append(
+            [BeliefBlock(size, center, None) for size, center in zip(cartons.sizes, cartons.centers, strict=True)]
+        )
+    return hypotheses
 
 
 def belief_settings(scene: Scene, settings: Any = None) -> Any:
@@ -585,16 +651,29 @@ def _try_removals(
     return outcomes
 
 
-def _drawn_worlds(
+def drawn_worlds(
     scene: Scene, simulation: Any, fill: str, occupancy: float, worlds: int, rng: np.random.Generator
 ) -> list[list[BeliefBlock]]:
-    """The blocks of each world of a fill that draws the unseen space kept (``sampled``,
-    ``scaled``, ``faces``)."""
+    """The fixed blocks of each belief world of a fill that draws the unseen space (``sampled``,
+    ``scaled``, ``faces``, ``cartons``): what :func:`belief_removals` builds its worlds of.
+
+    Examples
+    --------
+    >>> from unstack.understanding.clouds import surface_cloud
+    >>> front = Box("front", [0.4, 0.4, 0.4], [0.6, 0.0, 0.2])
+    >>> behind = Box("behind", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2])
+    >>> scene = Scene([front, behind], surface_cloud([front, behind], spacing=0.005, seed=0), ["front"])
+    >>> worlds = drawn_worlds(scene, belief_settings(scene), "cartons", OCCUPANCY, 2, np.random.default_rng(0))
+    >>> len(worlds), all(block.resting_on is None for blocks in worlds for block in blocks)
+    (2, True)
+    """
     from unstack.understanding.occlusion import THINNEST  # the rest of a block split at a face may be thinner
 
     space = occlusion_blocks(scene, simulation)
     kept_share = occupancy if fill == "sampled" else scaled_occupancy(space)
-    solid, drawn = _faced(space, behind_seen_faces(scene, space)) if fill == "faces" else ([], space)
+    solid, drawn = _faced(space, behind_seen_faces(scene, space)) if fill in ("faces", "cartons") else ([], space)
+    if fill == "cartons":
+        return [solid + cartons for cartons in carton_blocks(scene, simulation, kept_share, rng, solid, worlds)]
     return [
         solid + [block for block in drawn if rng.random() < kept_share and block.size[0] > THINNEST]
         for _ in range(worlds)
@@ -615,7 +694,7 @@ def restless_boxes(
     ----------
     scene, seed, settings, occupancy
         As in :func:`belief_removals`.
-    fill : {"occlusion", "sampled", "scaled", "faces"}
+    fill : {"occlusion", "sampled", "scaled", "faces", "cartons"}
         A fill without the cloud fill's rounds of holding what falls.
 
     Returns
@@ -640,7 +719,7 @@ def restless_boxes(
     if fill == "occlusion":
         blocks = occlusion_blocks(scene, simulation)
     else:
-        blocks = _drawn_worlds(scene, simulation, fill, occupancy, 1, np.random.default_rng(seed))[0]
+        blocks = drawn_worlds(scene, simulation, fill, occupancy, 1, np.random.default_rng(seed))[0]
     low_mass, high_mass = simulation.pile.mass_range
     masses = {box_id: (low_mass + high_mass) / 2.0 for box_id in scene.detected}
     with PhysicsWorld(simulation, door=False) as world:
@@ -682,13 +761,13 @@ def belief_removals(
     settings : SimulationSettings, optional
         Container, friction, time step, masses and the removal thresholds; default: the
         scene's own (``metadata.settings`` of a simulated scene), else the defaults.
-    fill : {"cloud", "occlusion", "sampled", "scaled", "faces"}
+    fill : {"cloud", "occlusion", "sampled", "scaled", "faces", "cartons"}
         What stands where no detected box is (:data:`FILLS`, the module docstring); with
-        ``"sampled"``, ``"scaled"`` or ``"faces"`` the worlds differ in the unseen space kept,
+        ``"sampled"``, ``"scaled"``, ``"faces"`` or ``"cartons"`` the worlds differ in the unseen space kept,
         not in masses or poses.
     occupancy : float
         With ``fill="sampled"``: the chance that a run of unseen space is kept solid
-        (:data:`OCCUPANCY`); ``"scaled"`` and ``"faces"`` take :func:`scaled_occupancy` instead.
+        (:data:`OCCUPANCY`); ``"scaled"``, ``"faces"`` and ``"cartons"`` take :func:`scaled_occupancy` instead.
     net : bool
         Count, in each world, only the boxes that stay still there when nothing is taken (a
         world that does not come to rest moves some boxes whatever is taken).
@@ -711,10 +790,10 @@ def belief_removals(
         raise UnstackError(f"occupancy must lie between 0 and 1, got {occupancy}")
     simulation = belief_settings(scene, settings)
     rng = np.random.default_rng(seed)
-    if fill in ("sampled", "scaled", "faces"):
+    if fill in ("sampled", "scaled", "faces", "cartons"):
         runs = [
             _try_removals(scene, blocks, tried, simulation, None, 0, net)
-            for blocks in _drawn_worlds(scene, simulation, fill, occupancy, worlds, rng)
+            for blocks in drawn_worlds(scene, simulation, fill, occupancy, worlds, rng)
         ]
     else:
         blocks = belief_blocks(scene) if fill == "cloud" else occlusion_blocks(scene, simulation)

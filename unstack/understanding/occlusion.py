@@ -47,7 +47,16 @@ import numpy as np
 
 from unstack.scene import Box
 
-__all__ = ["CELL", "CLEARANCE", "DIRECTION_BIN", "REACH", "OccludedBlocks", "occluded_space"]
+__all__ = [
+    "CELL",
+    "CLEARANCE",
+    "DIRECTION_BIN",
+    "REACH",
+    "OccludedBlocks",
+    "OcclusionGrid",
+    "occluded_space",
+    "occlusion_grid",
+]
 
 #: Edge of the cells the container's interior is cut into (metres).
 CELL = 0.06
@@ -104,6 +113,76 @@ def _clipped(low: np.ndarray, high: np.ndarray, bounds: np.ndarray) -> tuple[np.
     return low, high
 
 
+@dataclass(frozen=True)
+class OcclusionGrid:
+    """The cells near some boxes and which of them the sensor cannot see.
+
+    Attributes
+    ----------
+    axes : tuple of numpy.ndarray
+        The cells' centre coordinates along x, y and z (metres).
+    occluded : numpy.ndarray of bool, shape (len(axes[0]), len(axes[1]), len(axes[2]))
+        Behind the visible surface and outside every box.
+    distance : numpy.ndarray of float, the same shape
+        How far each cell's centre lies outside the nearest box's bounds (metres, 0 inside).
+    """
+
+    axes: tuple[np.ndarray, np.ndarray, np.ndarray]
+    occluded: np.ndarray
+    distance: np.ndarray
+
+
+def occlusion_grid(
+    points: Any, boxes: Sequence[Box], *, viewpoint: Any, interior: Any, cell: float = CELL, reach: float = REACH
+) -> OcclusionGrid | None:
+    """The cells within ``reach`` of ``boxes`` and which the sensor cannot see (the module
+    docstring; :func:`occluded_space` joins them into blocks); None when there are none.
+
+    Parameters
+    ----------
+    points, boxes, viewpoint, interior, cell
+        As in :func:`occluded_space`.
+    reach : float
+        Only cells within this distance of a box's bounds are considered (metres).
+
+    Examples
+    --------
+    >>> from unstack.understanding.clouds import surface_cloud
+    >>> front = Box("front", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2])
+    >>> cloud = surface_cloud([front], viewpoint=[-2.0, 0.0, 0.3], spacing=0.005, seed=0)
+    >>> grid = occlusion_grid(cloud, [front], viewpoint=[-2.0, 0.0, 0.3], interior=[[0, -1, 0], [2, 1, 2]])
+    >>> bool(grid.occluded.any()), grid.occluded.shape == grid.distance.shape
+    (True, True)
+    """
+    from unstack.geometry import bounding_boxes
+
+    cloud = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    origin = np.asarray(viewpoint, dtype=np.float64)
+    inside_low, inside_high = np.asarray(interior, dtype=np.float64)
+    if len(cloud) == 0 or not boxes:
+        return None
+    keys, surface = _visible_surface(cloud, origin)
+    bounds = bounding_boxes(list(boxes))
+    low = np.maximum(bounds[:, :3].min(axis=0) - reach, inside_low)
+    high = np.minimum(bounds[:, 3:].max(axis=0) + reach, inside_high)
+    axes = tuple(np.arange(start + cell / 2, stop, cell) for start, stop in zip(low, high, strict=True))
+    if any(len(axis) == 0 for axis in axes):
+        return None
+    centres = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    distance = np.full(len(centres), np.inf)
+    inside = np.zeros(len(centres), dtype=bool)
+    for bound in bounds:
+        outside = np.maximum(np.maximum(bound[:3] - centres, centres - bound[3:]), 0.0)
+        distance = np.minimum(distance, np.max(outside, axis=1))
+        inside |= np.all((centres > bound[:3]) & (centres < bound[3:]), axis=1)
+    near = distance < reach
+    cell_keys, cell_ranges = _direction_keys(centres - origin)
+    slot = np.minimum(np.searchsorted(keys, cell_keys), len(keys) - 1)
+    behind = (keys[slot] == cell_keys) & (cell_ranges > surface[slot] + 0.75 * cell)
+    shape = tuple(len(axis) for axis in axes)
+    return OcclusionGrid(axes, (near & ~inside & behind).reshape(shape), distance.reshape(shape))  # type: ignore[arg-type]
+
+
 def occluded_space(
     points: Any, boxes: Sequence[Box], *, viewpoint: Any, interior: Any, cell: float = CELL
 ) -> OccludedBlocks:
@@ -128,31 +207,13 @@ def occluded_space(
     """
     from unstack.geometry import bounding_boxes
 
-    cloud = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    origin = np.asarray(viewpoint, dtype=np.float64)
-    inside_low, inside_high = np.asarray(interior, dtype=np.float64)
     empty = OccludedBlocks(np.zeros((0, 3)), np.zeros((0, 3)))
-    if len(cloud) == 0 or not boxes:
+    grid = occlusion_grid(points, boxes, viewpoint=viewpoint, interior=interior, cell=cell)
+    if grid is None:
         return empty
-    keys, surface = _visible_surface(cloud, origin)
     bounds = bounding_boxes(list(boxes))
-    low = np.maximum(bounds[:, :3].min(axis=0) - REACH, inside_low)
-    high = np.minimum(bounds[:, 3:].max(axis=0) + REACH, inside_high)
-    axes = [np.arange(start + cell / 2, stop, cell) for start, stop in zip(low, high, strict=True)]
-    if any(len(axis) == 0 for axis in axes):
-        return empty
-    centres = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    near = np.zeros(len(centres), dtype=bool)
-    inside = np.zeros(len(centres), dtype=bool)
-    for bound in bounds:
-        near |= np.all((centres > bound[:3] - REACH) & (centres < bound[3:] + REACH), axis=1)
-        inside |= np.all((centres > bound[:3]) & (centres < bound[3:]), axis=1)
-    cell_keys, cell_ranges = _direction_keys(centres - origin)
-    slot = np.minimum(np.searchsorted(keys, cell_keys), len(keys) - 1)
-    behind = (keys[slot] == cell_keys) & (cell_ranges > surface[slot] + 0.75 * cell)
-    occluded = (near & ~inside & behind).reshape(tuple(len(axis) for axis in axes))
-    grid = np.array([len(axis) for axis in axes])
-    padded = np.zeros((grid[0] + 2, grid[1], grid[2]), dtype=bool)
+    axes, occluded = grid.axes, grid.occluded
+    padded = np.zeros((occluded.shape[0] + 2, *occluded.shape[1:]), dtype=bool)
     padded[1:-1] = occluded
     starts = np.argwhere(padded[1:-1] & ~padded[:-2])  # (depth index, j, k) of each run's first cell
     stops = np.argwhere(~padded[2:] & padded[1:-1])  # ... and of its last; both in (j, k, depth) order below
