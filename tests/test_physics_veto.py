@@ -97,6 +97,20 @@ def test_the_veto_in_worlds_of_hidden_cartons_is_recorded_and_an_unknown_fill_re
             physics_veto(default, scene, fill=fill)
 
 
+def test_worlds_that_draw_masses_are_recorded_reproducible_and_try_the_same_pick(small_dataset: Path) -> None:
+    scene = unstack.load(small_dataset / "config-0005.json")
+    default = unstack.decide(scene, seed=0)
+    typical = physics_veto(default, scene, seed=0)
+    drawn = physics_veto(default, scene, seed=0, draw_masses=True)
+    assert drawn.physics_veto is not None and drawn.physics_veto["masses_drawn"] is True
+    assert typical.physics_veto is not None and "masses_drawn" not in typical.physics_veto
+    assert drawn.physics_veto["tried"][0]["box"] == typical.physics_veto["tried"][0]["box"] == default.choice
+    assert drawn.to_dict() == physics_veto(default, scene, seed=0, draw_masses=True).to_dict()
+    Draft202012Validator(load_schema("unstack.decision/1")).validate(drawn.to_dict())
+    with pytest.raises(InvalidArgument, match="draw_masses must be True or False, got 1"):
+        physics_veto(default, scene, draw_masses=1)  # type: ignore[arg-type]
+
+
 def test_the_same_seed_gives_the_same_worlds_and_choice(small_dataset: Path) -> None:
     scene = unstack.load(small_dataset / "config-0005.json")
     first, second = (unstack.decide(scene, seed=3, physics_veto=True).to_dict() for _ in range(2))

@@ -78,10 +78,13 @@ def _expected_moved(
     worlds: int,
     net: bool = False,
     fill: str = PHYSICS_FILL,
+    draw_masses: bool = False,
 ) -> dict[str, float]:
     from unstack.sim.belief import belief_removals
 
-    outcomes = belief_removals(world_scene, boxes, worlds=worlds, fill=fill, seed=seed, settings=settings, net=net)
+    outcomes = belief_removals(
+        world_scene, boxes, worlds=worlds, fill=fill, seed=seed, settings=settings, net=net, draw_masses=draw_masses
+    )
     return {box_id: float(outcome.expected_moved) for box_id, outcome in outcomes.items()}
 
 
@@ -192,6 +195,7 @@ def physics_veto(
     worlds: int = PHYSICS_WORLDS,
     net: bool = False,
     fill: str = PHYSICS_FILL,
+    draw_masses: bool = False,
 ) -> Decision:
     """The decision with its pick vetoed where physics on the belief expects it to move boxes.
 
@@ -222,6 +226,10 @@ def physics_veto(
         What the belief worlds put where the sensor sees no box (:data:`unstack.sim.belief.FILLS`;
         default :data:`PHYSICS_FILL`; ``"cartons"``, whole hidden cartons drawn into the unseen
         space, is the maker ``hybrid_cartons_free`` of the results page).
+    draw_masses : bool
+        Draw each belief world's masses from the settings' range instead of the typical mass
+        in every world (the maker ``hybrid_faces_free_masses``); recorded as
+        ``physics_veto["masses_drawn"]``.
 
     Returns
     -------
@@ -261,6 +269,8 @@ def physics_veto(
         raise InvalidArgument(f"worlds must be a positive integer, got {worlds!r}")
     if not isinstance(net, bool):
         raise InvalidArgument(f"net must be True or False, got {net!r}")
+    if not isinstance(draw_masses, bool):
+        raise InvalidArgument(f"draw_masses must be True or False, got {draw_masses!r}")
     from unstack.sim.belief import FILLS
 
     if fill not in FILLS or fill == "cloud":
@@ -273,16 +283,18 @@ def physics_veto(
     settings = world_settings(given)
     built, slid = _inside_container(given, settings)
     pick = decision.choice
-    expected = _expected_moved(built, [pick], seed, settings, worlds, net, fill)
+    expected = _expected_moved(built, [pick], seed, settings, worlds, net, fill, draw_masses)
     vetoed = expected[pick] >= veto_at
     if vetoed:
         costs = dict(zip(decision.objects, (float(cost) for cost in decision.expected_costs), strict=True))
         others = [box_id for box_id in decision.objects if box_id != pick and costs[box_id] < free_cost]
         if others:
-            expected.update(_expected_moved(built, others, seed, settings, worlds, net, fill))
+            expected.update(_expected_moved(built, others, seed, settings, worlds, net, fill, draw_masses))
     record = _record(expected, pick, vetoed, veto_at, worlds, fill)
     if net:
         record["net"] = True
+    if draw_masses:
+        record["masses_drawn"] = True
     warnings = decision.warnings
     if vetoed:  # a world that does not come to rest moves boxes whatever is taken
         from unstack.sim.belief import restless_boxes

@@ -15,7 +15,9 @@ from unstack.sim.belief import (
     belief_blocks,
     belief_choice,
     belief_removals,
+    belief_settings,
     choose_by_expected_moves,
+    drawn_worlds,
     occlusion_blocks,
     restless_boxes,
     scaled_occupancy,
@@ -194,6 +196,27 @@ def test_with_every_box_detected_the_faces_fill_is_the_scaled_fill(column: list[
     assert faces == scaled
 
 
+@pytest.mark.slow  # physics
+def test_with_hidden_cartons_the_first_world_rests_and_taking_the_top_box_moves_nothing(hidden_step: list[Box]) -> None:
+    scene = _seen_from_the_door(hidden_step, ["front", "up"])
+    worlds = drawn_worlds(scene, belief_settings(scene), "cartons", 0.2, 3, np.random.default_rng(0))
+    assert all(block.resting_on is None for blocks in worlds for block in blocks)
+    assert restless_boxes(scene, fill="cartons") == ()
+    outcomes = belief_removals(scene, worlds=3, fill="cartons", seed=0)
+    assert outcomes == belief_removals(scene, worlds=3, fill="cartons", seed=0)
+    assert outcomes["up"].expected_moved == 0.0  # the top of the pile moves nothing when taken
+
+
+@pytest.mark.slow  # physics
+def test_drawn_masses_keep_the_drawn_space_and_what_needs_no_mass_to_move(column: list[Box]) -> None:
+    scene = _seen_from_the_door(column, [box.id for box in column])
+    typical = belief_removals(scene, worlds=3, fill="faces", seed=2)
+    drawn = belief_removals(scene, worlds=3, fill="faces", seed=2, draw_masses=True)
+    assert drawn == belief_removals(scene, worlds=3, fill="faces", seed=2, draw_masses=True)
+    for box_id in ("bottom", "top"):  # a column falls, and its top moves nothing, whatever the masses
+        assert drawn[box_id].expected_moved == typical[box_id].expected_moved
+
+
 def test_an_occupancy_outside_zero_to_one_is_refused(column: list[Box]) -> None:
     with pytest.raises(UnstackError, match=r"occupancy must lie between 0 and 1, got 1\.5"):
         belief_removals(_scene(column, ["bottom"]), fill="sampled", occupancy=1.5)
@@ -201,7 +224,8 @@ def test_an_occupancy_outside_zero_to_one_is_refused(column: list[Box]) -> None:
 
 def test_an_unknown_fill_is_refused(column: list[Box]) -> None:
     with pytest.raises(
-        UnstackError, match="unknown belief fill 'air'; expected one of cloud, occlusion, sampled, scaled, faces"
+        UnstackError,
+        match="unknown belief fill 'air'; expected one of cloud, occlusion, sampled, scaled, faces, cartons",
     ):
         belief_removals(_scene(column, ["bottom"]), fill="air")
 

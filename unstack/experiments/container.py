@@ -147,6 +147,9 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     ``hybrid_faces_free`` with whole hidden cartons drawn into the unseen space of each belief
     world instead of runs of it kept one by one (``fill="cartons"``,
     :func:`unstack.understanding.hidden_cartons.draw_hidden_cartons`).
+``hybrid_faces_free_masses``
+    ``hybrid_faces_free`` with each belief world's masses drawn from the settings' range
+    (``draw_masses=True``), not the typical mass in every world.
 
 Metrics per pile and per maker: boxes moved more than 2 cm, boxes fallen (dropped more than
 0.2 m or tipped more than 45 degrees), the share of picks that move nothing, and paired
@@ -211,7 +214,7 @@ TRIED_MAKERS = (
     "belief_faces_veto", "hybrid_faces_veto", "hybrid_faces_free", "hybrid_faces_free_any",
     "hybrid_faces_free_8", "hybrid_faces_free_sure", "hybrid_moves_free", "unstack_strict", "hybrid_moves_free_1",
     "hybrid_faces_free_net", "hybrid_faces_free_gated", "hybrid_moves_walk", "hybrid_faces_walk",
-    "hybrid_cartons_free",
+    "hybrid_cartons_free", "hybrid_faces_free_masses",
 )  # fmt: skip
 #: Every decision maker.
 CONTAINER_MAKERS = (*DEFAULT_CONTAINER_MAKERS, *ORACLE_MAKERS, *TRIED_MAKERS)
@@ -433,6 +436,7 @@ def container_policies(
         net: bool = False,
         reasoned: Any = None,
         fill: str = "faces",
+        draw_masses: bool = False,
     ) -> tuple[str, Any]:
         """The hybrid's pick, and the decision with it vetoed where the faces belief expects its
         removal to move ``veto_at`` boxes: then that belief's fewest among the boxes the
@@ -449,15 +453,15 @@ def container_policies(
         pick = hybrid_choice(scene, reasoned)
         vetoed = physics_veto(
             dataclasses.replace(reasoned, choice=pick), scene, seed=seed, world_scene=in_view_scene(scene),
-            veto_at=veto_at, worlds=worlds, net=net, fill=fill,
+            veto_at=veto_at, worlds=worlds, net=net, fill=fill, draw_masses=draw_masses,
         )  # fmt: skip
         return pick, vetoed
 
     def faces_free(
-        veto_at: float, worlds: int = PHYSICS_WORLDS, net: bool = False, fill: str = "faces"
+        veto_at: float, worlds: int = PHYSICS_WORLDS, net: bool = False, fill: str = "faces", draw_masses: bool = False
     ) -> Callable[[Scene], str]:
         def policy(scene: Scene) -> str:
-            return str(faces_vetoed(scene, veto_at, worlds, net, fill=fill)[1].choice)
+            return str(faces_vetoed(scene, veto_at, worlds, net, fill=fill, draw_masses=draw_masses)[1].choice)
 
         return policy
 
@@ -636,6 +640,7 @@ def container_policies(
         "hybrid_moves_walk": moves_walk(PHYSICS_VETO),
         "hybrid_faces_walk": hybrid_faces_walk,
         "hybrid_cartons_free": faces_free(PHYSICS_VETO, fill="cartons"),
+        "hybrid_faces_free_masses": faces_free(PHYSICS_VETO, draw_masses=True),
     }
     unknown = [maker for maker in makers if maker not in every]
     if unknown:

@@ -742,6 +742,7 @@ def belief_removals(
     fill: str = "cloud",
     occupancy: float = OCCUPANCY,
     net: bool = False,
+    draw_masses: bool = False,
 ) -> dict[str, BeliefOutcome]:
     """What removing each candidate moves in the belief worlds built from ``scene``.
 
@@ -771,6 +772,10 @@ def belief_removals(
     net : bool
         Count, in each world, only the boxes that stay still there when nothing is taken (a
         world that does not come to rest moves some boxes whatever is taken).
+    draw_masses : bool
+        With a fill that draws the unseen space: draw each world's masses of the detected boxes
+        too, uniformly from the settings' range (seeded apart from the space's draws, which stay
+        as they are), instead of the typical mass in every world.
 
     Returns
     -------
@@ -791,8 +796,9 @@ def belief_removals(
     simulation = belief_settings(scene, settings)
     rng = np.random.default_rng(seed)
     if fill in ("sampled", "scaled", "faces", "cartons"):
+        mass_rng = np.random.default_rng((seed, 1)) if draw_masses else None
         runs = [
-            _try_removals(scene, blocks, tried, simulation, None, 0, net)
+            _try_removals(scene, blocks, tried, simulation, mass_rng, 0, net)
             for blocks in drawn_worlds(scene, simulation, fill, occupancy, worlds, rng)
         ]
     else:
