@@ -48,7 +48,7 @@ import numpy as np
 from unstack.scene import Box
 from unstack.understanding.occlusion import OccludedBlocks, OcclusionGrid
 
-__all__ = ["ATTEMPTS", "CARTON_REACH", "SEEN_SLACK", "carton_extents", "draw_hidden_cartons"]
+__all__ = ["ATTEMPTS", "CARTON_REACH", "GAP", "MIN_HEIGHT", "SEEN_SLACK", "carton_extents", "draw_hidden_cartons"]
 
 #: Hidden cartons stand within this distance of a box in view (metres).
 CARTON_REACH = 0.6
@@ -102,11 +102,11 @@ def _fitted(low: np.ndarray, high: np.ndarray, taken: np.ndarray) -> tuple[np.nd
     the shorter way, or cut down under what stands over it (to no less than :data:`MIN_HEIGHT` of
     itself), twice at most; None where it still enters something."""
     height = high[2] - low[2]
-    for _ in range(3):
+    for attempt in range(3):
         hit = _overlapping(low, high, taken)
         if len(hit) == 0:
             return low, high
-        if _ == 2:
+        if attempt == 2:
             return None
         for row in taken[hit]:
             depth = np.minimum(high, row[3:]) - np.maximum(low, row[:3])
