@@ -110,6 +110,7 @@ __all__ = [
     "container_interior",
     "drawn_worlds",
     "occlusion_blocks",
+    "removals_in_world",
     "restless_boxes",
     "scaled_occupancy",
     "seen_boxes",
@@ -572,7 +573,7 @@ def _falling(world: Any, bodies: dict[str, int], truth: Any) -> set[str]:
     return {names[k] for k in np.flatnonzero(_disturbed(start, world.poses(every), truth))}
 
 
-def _try_removals(
+def removals_in_world(
     scene: Scene,
     blocks: list[BeliefBlock],
     tried: list[str],
@@ -583,9 +584,19 @@ def _try_removals(
 ) -> dict[str, tuple[str, ...]]:
     """One belief world: build, support or hold what it cannot hold, try each removal and undo it.
 
-    ``rng`` None: every detected box of the typical mass; else masses drawn uniformly from the
+    The detected boxes of ``scene`` (free to move) and ``blocks`` (fixed, or a detected box's
+    hidden load) in a world of ``simulation``'s settings; ``hold_rounds`` rounds of supporting,
+    then holding, a detected box that falls with nothing taken (the ``cloud`` fill's). ``rng``
+    None: every detected box of the typical mass; else masses drawn uniformly from the
     settings' range. ``net``: the bodies that move in this world with nothing taken (over the
-    same horizon) are not counted for any candidate. Returns what moved per candidate.
+    same horizon) are not counted for any candidate. Returns what moved per candidate of ``tried``.
+
+    Examples
+    --------
+    >>> column = [Box("low", [0.4, 0.4, 0.3], [1.0, 0.0, 0.15]), Box("top", [0.4, 0.4, 0.3], [1.0, 0.0, 0.45])]
+    >>> scene = Scene(column, np.zeros((0, 3)), ["low", "top"])
+    >>> removals_in_world(scene, [], ["low", "top"], belief_settings(scene), None, 0)
+    {'low': ('top',), 'top': ()}
     """
     from unstack.sim.ground_truth import PARKING, run_horizon
     from unstack.sim.unloading import RESETTLE_SECONDS
@@ -798,14 +809,14 @@ def belief_removals(
     if fill in ("sampled", "scaled", "faces", "cartons"):
         mass_rng = np.random.default_rng((seed, 1)) if draw_masses else None
         runs = [
-            _try_removals(scene, blocks, tried, simulation, mass_rng, 0, net)
+            removals_in_world(scene, blocks, tried, simulation, mass_rng, 0, net)
             for blocks in drawn_worlds(scene, simulation, fill, occupancy, worlds, rng)
         ]
     else:
         blocks = belief_blocks(scene) if fill == "cloud" else occlusion_blocks(scene, simulation)
         hold_rounds = HOLD_ROUNDS if fill == "cloud" else 0
         runs = [
-            _try_removals(scene, blocks, tried, simulation, None if world == 0 else rng, hold_rounds, net)
+            removals_in_world(scene, blocks, tried, simulation, None if world == 0 else rng, hold_rounds, net)
             for world in range(worlds)
         ]
     return {
