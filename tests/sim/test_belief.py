@@ -217,6 +217,14 @@ def test_drawn_masses_keep_the_drawn_space_and_what_needs_no_mass_to_move(column
         assert drawn[box_id].expected_moved == typical[box_id].expected_moved
 
 
+@pytest.mark.parametrize("fill", ["cloud", "occlusion"])
+def test_drawn_masses_are_refused_with_a_fill_whose_worlds_draw_masses_already(column: list[Box], fill: str) -> None:
+    with pytest.raises(
+        UnstackError, match=f"draw_masses is for the fills that draw the unseen space .* the {fill} fill"
+    ):
+        belief_removals(_scene(column, ["bottom"]), fill=fill, draw_masses=True)
+
+
 def test_an_occupancy_outside_zero_to_one_is_refused(column: list[Box]) -> None:
     with pytest.raises(UnstackError, match=r"occupancy must lie between 0 and 1, got 1\.5"):
         belief_removals(_scene(column, ["bottom"]), fill="sampled", occupancy=1.5)

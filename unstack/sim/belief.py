@@ -776,7 +776,7 @@ def belief_removals(
     fill : {"cloud", "occlusion", "sampled", "scaled", "faces", "cartons"}
         What stands where no detected box is (:data:`FILLS`, the module docstring); with
         ``"sampled"``, ``"scaled"``, ``"faces"`` or ``"cartons"`` the worlds differ in the unseen space kept,
-        not in masses or poses.
+        not in poses, nor in masses unless ``draw_masses``.
     occupancy : float
         With ``fill="sampled"``: the chance that a run of unseen space is kept solid
         (:data:`OCCUPANCY`); ``"scaled"``, ``"faces"`` and ``"cartons"`` take :func:`scaled_occupancy` instead.
@@ -786,7 +786,8 @@ def belief_removals(
     draw_masses : bool
         With a fill that draws the unseen space: draw each world's masses of the detected boxes
         too, uniformly from the settings' range (seeded apart from the space's draws, which stay
-        as they are), instead of the typical mass in every world.
+        as they are), instead of the typical mass in every world. Refused with the ``cloud`` and
+        ``occlusion`` fills, whose worlds after the first draw masses already.
 
     Returns
     -------
@@ -804,6 +805,11 @@ def belief_removals(
         raise UnstackError(f"unknown belief fill {fill!r}; expected one of {', '.join(FILLS)}")
     if not 0.0 <= occupancy <= 1.0:
         raise UnstackError(f"occupancy must lie between 0 and 1, got {occupancy}")
+    if draw_masses and fill in ("cloud", "occlusion"):
+        raise UnstackError(
+            f"draw_masses is for the fills that draw the unseen space (sampled, scaled, faces, cartons); the {fill} "
+            "fill's worlds after the first draw masses already"
+        )
     simulation = belief_settings(scene, settings)
     rng = np.random.default_rng(seed)
     if fill in ("sampled", "scaled", "faces", "cartons"):
