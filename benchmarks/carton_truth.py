@@ -22,6 +22,7 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
+from occlusion_truth import block_samples
 
 from unstack.dataset_folders import require_configurations
 from unstack.geometry import points_in_box
@@ -42,13 +43,7 @@ def _inside_any(points: np.ndarray, boxes: list) -> np.ndarray:  # type: ignore[
 
 
 def _block_points(blocks: list, step: float) -> np.ndarray:  # type: ignore[type-arg]
-    parts = []
-    for block in blocks:
-        axes = [
-            np.arange(c - s / 2 + step / 2, c + s / 2, step) if s > step else np.array([c])
-            for c, s in zip(block.center, block.size, strict=True)
-        ]
-        parts.append(np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3))
+    parts = [block_samples(block.center, block.size, step) for block in blocks]
     return np.concatenate(parts) if parts else np.zeros((0, 3))
 
 

@@ -184,7 +184,7 @@ def draw_hidden_cartons(
     taken = np.concatenate(placed)
     inside_low, inside_high = np.asarray(interior, dtype=np.float64)
     covered = np.zeros_like(grid.occluded)
-    cell = float(grid.axes[0][1] - grid.axes[0][0]) if len(grid.axes[0]) > 1 else 0.06
+    cell = grid.cell
     unseen_cells = np.argwhere(grid.occluded)
     band_covered = 0.0
     sizes, centers = [], []

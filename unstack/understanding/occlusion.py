@@ -125,11 +125,14 @@ class OcclusionGrid:
         Behind the visible surface and outside every box.
     distance : numpy.ndarray of float, the same shape
         How far each cell's centre lies outside the nearest box's bounds (metres, 0 inside).
+    cell : float
+        Edge of the cells (metres).
     """
 
     axes: tuple[np.ndarray, np.ndarray, np.ndarray]
     occluded: np.ndarray
     distance: np.ndarray
+    cell: float
 
 
 def occlusion_grid(
@@ -180,7 +183,8 @@ def occlusion_grid(
     slot = np.minimum(np.searchsorted(keys, cell_keys), len(keys) - 1)
     behind = (keys[slot] == cell_keys) & (cell_ranges > surface[slot] + 0.75 * cell)
     shape = tuple(len(axis) for axis in axes)
-    return OcclusionGrid(axes, (near & ~inside & behind).reshape(shape), distance.reshape(shape))  # type: ignore[arg-type]
+    occluded = (near & ~inside & behind).reshape(shape)
+    return OcclusionGrid(axes, occluded, distance.reshape(shape), cell)  # type: ignore[arg-type]
 
 
 def occluded_space(
