@@ -65,6 +65,9 @@ SIZE_TIE = 0.02
 class FittedBox:
     """A box fitted to one mask, with how well it fits.
 
+    Returned by :func:`fit_box`; :func:`boxes_from_masks` keeps one per mask it does not drop
+    as a duplicate, and the fit measures below are what the camera input reports per box.
+
     Attributes
     ----------
     box : Box

@@ -33,6 +33,9 @@ ORIGIN_X = 1.3
 class CanonicalCase:
     """One canonical scene with what a right decision must respect.
 
+    Drawn by :func:`build_case`; the generalisation suite checks a decision's first pick
+    against ``pickable`` and its expected costs against ``holds``.
+
     Attributes
     ----------
     kind : str

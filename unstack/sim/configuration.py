@@ -47,6 +47,9 @@ MAX_PILES = 4
 class SimulatedConfiguration:
     """A finished configuration.
 
+    Returned by :func:`simulate_configuration` for one seed and index: a pile that settled
+    without creeping, its removal responses, and the scan of it.
+
     Attributes
     ----------
     index : int

@@ -115,6 +115,9 @@ TIP_SUPPORT_PROBABILITY = 0.65
 class TipSupport:
     """A detected box that cannot stand without another detected box, and that box.
 
+    Found by :func:`tip_supports`; :func:`raise_tip_supports` lifts ``P(supporter supports
+    held)`` to at least :data:`TIP_SUPPORT_PROBABILITY` for each one.
+
     Attributes
     ----------
     held : str
