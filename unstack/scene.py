@@ -36,6 +36,7 @@ from unstack.checks import (
     check_vector,
 )
 from unstack.errors import InvalidScene
+from unstack.frozen import set_frozen_fields
 from unstack.geometry import overlapping_pairs
 from unstack.jsonio import Document, read_document, validate_document
 
@@ -118,29 +119,20 @@ class Box:
     ) -> None:
         if not isinstance(id, str) or not id:
             raise InvalidScene(source, f"{path}.id", f"expected a non-empty string id, got {id!r}")
-        object.__setattr__(self, "id", id)
-        object.__setattr__(
+        set_frozen_fields(  # checked in this order: the first error found is the one raised
             self,
-            "size",
-            _check_edges(
+            id=id,
+            size=_check_edges(
                 check_vector(size, 3, positive=True, source=source, path=f"{path}.size"), source, f"{path}.size"
             ),
-        )
-        object.__setattr__(
-            self,
-            "position",
-            _check_coordinates(
+            position=_check_coordinates(
                 check_vector(position, 3, source=source, path=f"{path}.position"), source, f"{path}.position"
             ),
+            orientation_xyzw=check_quaternion_xyzw(orientation_xyzw, source=source, path=f"{path}.orientation_xyzw"),
+            mass=None
+            if mass is None
+            else float(check_vector([mass], 1, positive=True, source=source, path=f"{path}.mass")[0]),
         )
-        object.__setattr__(
-            self,
-            "orientation_xyzw",
-            check_quaternion_xyzw(orientation_xyzw, source=source, path=f"{path}.orientation_xyzw"),
-        )
-        if mass is not None:
-            mass = float(check_vector([mass], 1, positive=True, source=source, path=f"{path}.mass")[0])
-        object.__setattr__(self, "mass", mass)
 
     def to_dict(self) -> dict[str, Any]:
         """The box as a JSON object of ``unstack.scene/1``."""
@@ -302,12 +294,15 @@ class Scene:
         cloud = _check_coordinates(check_points(points, source=source, path=points_path), source, points_path)
         cloud.setflags(write=False)
         _refuse_overlaps(boxes, source)
-        object.__setattr__(self, "boxes", boxes)
-        object.__setattr__(self, "points", cloud)
-        object.__setattr__(self, "detected", detected_ids)
-        object.__setattr__(self, "ground_truth", truth)
-        object.__setattr__(self, "metadata", dict(metadata or {}))
-        object.__setattr__(self, "source", source)
+        set_frozen_fields(
+            self,
+            boxes=boxes,
+            points=cloud,
+            detected=detected_ids,
+            ground_truth=truth,
+            metadata=dict(metadata or {}),
+            source=source,
+        )
 
     @property
     def box_ids(self) -> tuple[str, ...]:

@@ -24,6 +24,7 @@ import numpy as np
 from unstack.atomic import atomic_write_text
 from unstack.checks import check_ids, check_probability_matrix, check_vector
 from unstack.errors import InvalidSupports
+from unstack.frozen import set_frozen_fields
 from unstack.jsonio import Document, read_document, validate_document
 
 __all__ = ["SUPPORTS_FORMAT", "Supports", "load_supports"]
@@ -107,13 +108,16 @@ class Supports:
         if heights is not None:
             height_vector = check_vector(heights, len(ids), source=source, path="$.heights", error=InvalidSupports)
             height_vector.setflags(write=False)
-        object.__setattr__(self, "hidden_load", load_vector)
-        object.__setattr__(self, "heights", height_vector)
-        object.__setattr__(self, "objects", ids)
-        object.__setattr__(self, "probabilities", matrix)
-        object.__setattr__(self, "masses", mass_vector)
-        object.__setattr__(self, "metadata", dict(metadata or {}))
-        object.__setattr__(self, "source", source)
+        set_frozen_fields(
+            self,
+            hidden_load=load_vector,
+            heights=height_vector,
+            objects=ids,
+            probabilities=matrix,
+            masses=mass_vector,
+            metadata=dict(metadata or {}),
+            source=source,
+        )
 
     @property
     def n_objects(self) -> int:

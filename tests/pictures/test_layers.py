@@ -13,6 +13,7 @@ ALLOWED = {
     "geometry",
     "plotting",
     "atomic",
+    "frozen",
     "errors",
     "checks",
     "jsonio",

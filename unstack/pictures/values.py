@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from unstack.errors import InvalidArgument, InvalidFile
+from unstack.frozen import set_frozen_fields
 
 __all__ = ["DecisionValues", "check_threshold", "read_decision_values"]
 
@@ -108,17 +109,17 @@ class DecisionValues:
         plan = tuple(order or ())
         if any(box not in known for box in plan) or len(set(plan)) != len(plan):
             raise InvalidArgument(f"{source}: the order must list distinct boxes of the decision")
-        for name, value in (
-            ("objects", ids),
-            ("expected_costs", costs),
-            ("expected_cost_errors", errors),
-            ("choice", choice),
-            ("order", plan),
-            ("probabilities", matrix),
-            ("cost_name", cost_name),
-            ("source", source),
-        ):
-            object.__setattr__(self, name, value)
+        set_frozen_fields(
+            self,
+            objects=ids,
+            expected_costs=costs,
+            expected_cost_errors=errors,
+            choice=choice,
+            order=plan,
+            probabilities=matrix,
+            cost_name=cost_name,
+            source=source,
+        )
 
     @classmethod
     def from_decision(cls, decision: Any, *, order: Sequence[str] | None = None, source: str = "<decision>") -> Any:
