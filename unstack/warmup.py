@@ -57,7 +57,7 @@ def _features() -> None:
     points = np.random.default_rng(0).uniform(0.0, 1.0, (64, 3))
     gaussian_sums(points, points[:4].copy(), 2.0)
     columns = column_index(points, 0.25)
-    counts_in_boxes(*columns, 0.25, np.zeros((2, 3)), np.ones((2, 3)))
+    counts_in_boxes(columns, np.zeros((2, 3)), np.ones((2, 3)))
 
 
 #: What :func:`warm_up` compiles, in order: ``(name, function)``.

@@ -8,21 +8,40 @@ points one by one. Counts are exact (no point is dropped or counted twice).
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
 from unstack.threads import run_in_ranges
 
 
-def column_index(points: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Points sorted by (column, z), the first row of each column, the grid origin and its shape."""
+class PointColumns(NamedTuple):
+    """A cloud bucketed into square columns of the xy plane (:func:`column_index`)."""
+
+    points: np.ndarray
+    """The points sorted by (column, z)."""
+    starts: np.ndarray
+    """The first row of each column (and one past the last)."""
+    origin: np.ndarray
+    """The grid's lowest corner in x and y."""
+    shape: np.ndarray
+    """Columns along x and y."""
+    cell: float
+    """A column's side (metres)."""
+
+
+def column_index(points: np.ndarray, cell: float) -> PointColumns:
+    """The points bucketed into columns of side ``cell``."""
     origin = points[:, :2].min(axis=0)
     cells = np.floor((points[:, :2] - origin) / cell).astype(np.int64)
     shape = cells.max(axis=0) + 1
     column = cells[:, 0] * shape[1] + cells[:, 1]
     order = np.lexsort((points[:, 2], column))
     starts = np.searchsorted(column[order], np.arange(shape[0] * shape[1] + 1))
-    return np.ascontiguousarray(points[order]), starts.astype(np.int64), origin, shape.astype(np.int64)
+    return PointColumns(
+        np.ascontiguousarray(points[order]), starts.astype(np.int64), origin, shape.astype(np.int64), cell
+    )
 
 
 @njit(cache=True, nogil=True)
@@ -75,22 +94,14 @@ def _counts_in_boxes(
         top[q] = highest
 
 
-def counts_in_boxes(
-    points: np.ndarray,
-    starts: np.ndarray,
-    origin: np.ndarray,
-    shape: np.ndarray,
-    cell: float,
-    low: np.ndarray,
-    high: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray]:
+def counts_in_boxes(columns: PointColumns, low: np.ndarray, high: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The compiled counts of every query box, the boxes shared out over
     :func:`unstack.threads.thread_count` threads (each box counted whole by one thread)."""
     boxes = low.shape[0]
     counts = np.zeros(boxes, dtype=np.int64)
     top = np.full(boxes, -np.inf)
     run_in_ranges(
-        lambda first, last: _counts_in_boxes(points, starts, origin, shape, cell, low, high, first, last, counts, top),
+        lambda first, last: _counts_in_boxes(*columns, low, high, first, last, counts, top),
         boxes,
     )
     return counts, top

@@ -144,7 +144,7 @@ def contact_features(boxes: Sequence[Box], points: np.ndarray, pairs: Sequence[t
 
         low, high = _cloud_queries(bounds, x, y, pair_box)
         columns = column_index(points, GRID_CELL)
-        counts, highest = counts_in_boxes(*columns, GRID_CELL, low, high)
+        counts, highest = counts_in_boxes(columns, low, high)
         shares = counts / len(points)
         n_boxes, n_pairs = len(bounds), len(index)
         above_share = shares[:n_boxes]
