@@ -84,6 +84,10 @@ KDTREE_MAX_COVER = 0.05
 class FeatureSettings:
     """Parameters of the support features (the paper's values by default).
 
+    Read by :func:`pair_features` and :func:`feature_names`; a trained model carries the
+    settings it was trained with (:class:`~unstack.learning.model_file.SupportModel`), so new
+    scenes are described as its training scenes were.
+
     Attributes
     ----------
     offset : float

@@ -169,6 +169,9 @@ SEEN_MARGIN = 0.005
 class BeliefBlock:
     """Unseen material put into the belief world: a fixed block or a detected box's hidden load.
 
+    Made by the fills (:func:`belief_blocks`, :func:`occlusion_blocks`, :func:`carton_blocks`,
+    :func:`unseen_supports`) and placed in the engine by :func:`removals_in_world`.
+
     Attributes
     ----------
     size, center : numpy.ndarray, shape (3,)

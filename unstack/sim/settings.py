@@ -157,6 +157,9 @@ ROTATION_THRESHOLD_DEG = 5.0
 class GroundTruthSettings:
     """Support by removal: X supports Y when taking X away makes Y move.
 
+    The ``ground_truth`` of :class:`SimulationSettings`; the same thresholds say which boxes a
+    pick moved in the unloading experiments and in physics on the belief.
+
     Attributes
     ----------
     horizon : float
