@@ -93,6 +93,9 @@ LAYER_TOLERANCE = 0.05
 class Decision:
     """Which box to unload first, and why.
 
+    Returned by :func:`decide` (and :func:`unstack.decide` on a scene); :meth:`to_dict` is the
+    ``unstack.decision/1`` document that ``unstack decide --json`` prints.
+
     Attributes
     ----------
     objects : tuple of str

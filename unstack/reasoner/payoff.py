@@ -34,6 +34,9 @@ PAYOFF_FORMAT = "unstack.payoff/1"
 class PayoffMatrix:
     """Table II for one scene.
 
+    Built by :func:`payoff_matrix` from the worlds the SAT listing finds; ``unstack worlds``
+    prints it, and :meth:`to_dict` is its ``unstack.payoff/1`` document.
+
     Attributes
     ----------
     worlds : WorldSet
