@@ -19,10 +19,9 @@ Usage::
 
 from __future__ import annotations
 
-import argparse
-
 import numpy as np
 from occlusion_truth import block_samples
+from script_arguments import data_sets_parser, print_markdown_head
 
 from unstack.dataset_folders import require_configurations
 from unstack.geometry import points_in_box
@@ -83,14 +82,13 @@ def truth(data: str, piles: int, worlds: int, step: float) -> dict[str, tuple[fl
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("data", nargs="+", help="data set folders of unstack simulate")
-    parser.add_argument("--piles", type=int, default=10)
+    parser = data_sets_parser(__doc__.splitlines()[0], piles=10)
     parser.add_argument("--worlds", type=int, default=4)
     parser.add_argument("--step", type=float, default=0.03)
     args = parser.parse_args()
-    print("| data | fill | precision (drawn solid inside a hidden box) | recall (hidden space covered) |")
-    print("|---|---|---:|---:|")
+    print_markdown_head(
+        "data", "fill", "precision (drawn solid inside a hidden box)", "recall (hidden space covered)", numbers_from=2
+    )
     for data in args.data:
         for fill, (precision, recall) in truth(data, args.piles, args.worlds, args.step).items():
             print(f"| {data} | {fill} | {precision:.3f} | {recall:.3f} |", flush=True)

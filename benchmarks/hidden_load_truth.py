@@ -14,9 +14,8 @@ Usage::
 
 from __future__ import annotations
 
-import argparse
-
 import numpy as np
+from script_arguments import data_sets_parser, print_markdown_head
 
 from unstack.dataset_folders import require_configurations
 from unstack.scene import load_scene
@@ -49,14 +48,11 @@ def score(data: str, piles: int, isets: int, r: int) -> dict[str, float]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("data", nargs="+", help="simulated data sets (unstack simulate)")
-    parser.add_argument("--piles", type=int, default=10)
+    parser = data_sets_parser(__doc__.splitlines()[0], piles=10)
     parser.add_argument("--isets", type=int, default=3)
     parser.add_argument("--r", type=int, default=5)
     args = parser.parse_args()
-    print("| data set | boxes (loaded) | correlation | loaded found | false alarms |")
-    print("|---|---|---|---|---|")
+    print_markdown_head("data set", "boxes (loaded)", "correlation", "loaded found", "false alarms")
     for data in args.data:
         row = score(data, args.piles, args.isets, args.r)
         print(

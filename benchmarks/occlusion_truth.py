@@ -22,10 +22,10 @@ Usage::
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 
 import numpy as np
+from script_arguments import data_sets_parser
 
 from unstack.dataset_folders import require_configurations
 from unstack.geometry import bounding_boxes, points_in_box
@@ -92,9 +92,7 @@ def occupancy(data: str, piles: int, step: float, misses: float = 0.0, seed: int
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("data", nargs="+", help="simulated data sets (unstack simulate)")
-    parser.add_argument("--piles", type=int, default=8)
+    parser = data_sets_parser(__doc__.splitlines()[0], piles=8)
     parser.add_argument("--step", type=float, default=0.03, help="grid step of the samples (m)")
     parser.add_argument("--misses", type=float, default=0.0, help="chance a detected box is dropped")
     parser.add_argument("--seed", type=int, default=0, help="seeds the misses")

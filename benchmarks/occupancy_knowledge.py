@@ -19,10 +19,10 @@ Usage::
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 
 import numpy as np
+from script_arguments import data_sets_parser
 
 from unstack.dataset_folders import require_configurations
 from unstack.geometry import bounding_boxes
@@ -72,9 +72,7 @@ def pile_states(path: str, worlds: int, seed: int) -> list[dict[str, int]]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("data", help="a data set folder of unstack simulate")
-    parser.add_argument("--piles", type=int, default=3)
+    parser = data_sets_parser(__doc__.splitlines()[0], piles=3, several=False)
     parser.add_argument("--worlds", type=int, default=2)
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
