@@ -36,7 +36,21 @@ MAX_SCENE_POINTS = 200_000
 
 @dataclass(frozen=True)
 class CameraScene:
-    """The scene built from camera files, and how it was built."""
+    """The scene built from camera files, and how it was built.
+
+    Attributes
+    ----------
+    scene : Scene
+        The fitted boxes (all detected) and the cloud, in the gravity frame.
+    frame : GravityFrame
+        The transform from the camera's frame (z up, the floor at z = 0).
+    fitted : tuple of FittedBox
+        Every box kept, with how well it fits.
+    duplicates : dict of str to str
+        A mask left out as a duplicate -> the larger mask it lies in.
+    unfitted : dict of str to str
+        A mask no box was kept for -> why.
+    """
 
     scene: Scene
     frame: GravityFrame

@@ -44,7 +44,19 @@ PLAN_SAMPLES = 2048
 
 @dataclass(frozen=True)
 class PlanStep:
-    """One pick of a plan: the chosen box, its expected cost, and the full decision."""
+    """One pick of a plan: the chosen box, its expected cost, and the full decision.
+
+    Attributes
+    ----------
+    choice : str
+        The box taken at this step.
+    expected_cost : float
+        Its expected cost among the boxes still in place.
+    remaining : tuple of str
+        The boxes in place when the step was decided (``choice`` among them).
+    decision : Decision
+        The whole decision on them.
+    """
 
     choice: str
     expected_cost: float
