@@ -54,6 +54,8 @@ Cost: every set operation of the word arrays touches ``words`` words, so a sweep
 
 from __future__ import annotations
 
+import inspect
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -92,17 +94,36 @@ def _uniform(rng: np.ndarray, chain: int) -> float:
 
 # --- set operations ---------------------------------------------------------------------------
 # Each: a stub (never called from Python), the version of each layout (``*_one_word``,
-# ``*_words``) and the overload that picks one from ``work`` or the relation (one word: ``work``
-# an integer, a relation of rank 1). A set is an int64 (the mask, or the row of ``work``);
-# ``relation[i]`` is the set of box ``i`` (an int64 of an ``(n,)`` array, or row ``i`` of an
-# ``(n, words)`` array). numba requires a version's parameters to be those of its overload,
-# annotations included.
+# ``*_words``) and a :func:`_by_layout` line naming the argument whose layout picks one from
+# (one word: ``work`` an integer, a relation of rank 1). A set is an int64 (the mask, or the
+# row of ``work``); ``relation[i]`` is the set of box ``i`` (an int64 of an ``(n,)`` array, or
+# row ``i`` of an ``(n, words)`` array). The two versions take the same parameters, annotations
+# included.
 
 
 def _one_word(value: Any) -> bool:
     """Whether ``work`` or a relation (a numba type) is of the one-word layout: ``work`` an
     integer (no rows: a set is its own bit mask), a relation of rank 1."""
     return isinstance(value, types.Integer) or bool(value.ndim == 1)
+
+
+def _by_layout(
+    operation: Callable[..., Any], one_word: Callable[..., Any], words: Callable[..., Any], decided_by: str
+) -> None:
+    """Compile ``operation`` in a kernel as ``one_word`` or ``words``, by the layout of its
+    argument ``decided_by`` (``work`` or a relation).
+
+    numba calls the overload with the argument types and requires its signature to be the
+    versions' own, so the overload takes theirs.
+    """
+    parameters = inspect.signature(one_word)
+    position = list(parameters.parameters).index(decided_by)
+
+    def layout(*argument_types: Any) -> Any:
+        return one_word if _one_word(argument_types[position]) else words
+
+    layout.__signature__ = parameters  # type: ignore[attr-defined]
+    overload(operation)(layout)
 
 
 def _work(successors: np.ndarray, tries: int) -> Any:
@@ -119,9 +140,7 @@ def _work_words(successors: Any, tries: Any) -> Any:
     return np.zeros((_CANDIDATES + 2 * (tries + 1), successors.shape[1]), dtype=np.int64)
 
 
-@overload(_work)
-def _work_layout(successors: Any, tries: Any) -> Any:
-    return _work_one_word if _one_word(successors) else _work_words
+_by_layout(_work, _work_one_word, _work_words, "successors")
 
 
 def _set(work: Any, row: int) -> int:
@@ -137,9 +156,7 @@ def _set_words(work: Any, row: Any) -> Any:
     return row
 
 
-@overload(_set)
-def _set_layout(work: Any, row: Any) -> Any:
-    return _set_one_word if _one_word(work) else _set_words
+_by_layout(_set, _set_one_word, _set_words, "work")
 
 
 def _emptied(work: Any, row: int) -> int:
@@ -157,9 +174,7 @@ def _emptied_words(work: Any, row: Any) -> Any:
     return row
 
 
-@overload(_emptied)
-def _emptied_layout(work: Any, row: Any) -> Any:
-    return _emptied_one_word if _one_word(work) else _emptied_words
+_by_layout(_emptied, _emptied_one_word, _emptied_words, "work")
 
 
 def _copied(work: Any, row: int, relation: np.ndarray, x: int) -> int:
@@ -177,9 +192,7 @@ def _copied_words(work: Any, row: Any, relation: Any, x: Any) -> Any:
     return row
 
 
-@overload(_copied)
-def _copied_layout(work: Any, row: Any, relation: Any, x: Any) -> Any:
-    return _copied_one_word if _one_word(work) else _copied_words
+_by_layout(_copied, _copied_one_word, _copied_words, "work")
 
 
 def _set_row(relation: np.ndarray, x: int, work: Any, members: int) -> None:
@@ -196,9 +209,7 @@ def _set_row_words(relation: Any, x: Any, work: Any, members: Any) -> Any:
         relation[x, w] = work[members, w]
 
 
-@overload(_set_row)
-def _set_row_layout(relation: Any, x: Any, work: Any, members: Any) -> Any:
-    return _set_row_one_word if _one_word(work) else _set_row_words
+_by_layout(_set_row, _set_row_one_word, _set_row_words, "work")
 
 
 def _is_empty(work: Any, members: int) -> bool:
@@ -217,9 +228,7 @@ def _is_empty_words(work: Any, members: Any) -> Any:
     return True
 
 
-@overload(_is_empty)
-def _is_empty_layout(work: Any, members: Any) -> Any:
-    return _is_empty_one_word if _one_word(work) else _is_empty_words
+_by_layout(_is_empty, _is_empty_one_word, _is_empty_words, "work")
 
 
 def _has(work: Any, members: int, k: int) -> bool:
@@ -235,9 +244,7 @@ def _has_words(work: Any, members: Any, k: Any) -> Any:
     return ((work[members, k >> 6] >> (k & 63)) & 1) != 0
 
 
-@overload(_has)
-def _has_layout(work: Any, members: Any, k: Any) -> Any:
-    return _has_one_word if _one_word(work) else _has_words
+_by_layout(_has, _has_one_word, _has_words, "work")
 
 
 def _with(work: Any, members: int, k: int) -> int:
@@ -254,9 +261,7 @@ def _with_words(work: Any, members: Any, k: Any) -> Any:
     return members
 
 
-@overload(_with)
-def _with_layout(work: Any, members: Any, k: Any) -> Any:
-    return _with_one_word if _one_word(work) else _with_words
+_by_layout(_with, _with_one_word, _with_words, "work")
 
 
 def _row_meets(work: Any, relation: np.ndarray, k: int, members: int) -> bool:
@@ -275,9 +280,7 @@ def _row_meets_words(work: Any, relation: Any, k: Any, members: Any) -> Any:
     return False
 
 
-@overload(_row_meets)
-def _row_meets_layout(work: Any, relation: Any, k: Any, members: Any) -> Any:
-    return _row_meets_one_word if _one_word(work) else _row_meets_words
+_by_layout(_row_meets, _row_meets_one_word, _row_meets_words, "work")
 
 
 def _within_row(work: Any, members: int, relation: np.ndarray, k: int, constrained: bool) -> bool:
@@ -304,9 +307,7 @@ def _within_row_words(work: Any, members: Any, relation: Any, k: Any, constraine
     return True
 
 
-@overload(_within_row)
-def _within_row_layout(work: Any, members: Any, relation: Any, k: Any, constrained: Any) -> Any:
-    return _within_row_one_word if _one_word(work) else _within_row_words
+_by_layout(_within_row, _within_row_one_word, _within_row_words, "work")
 
 
 def _linked(work: Any, successors: np.ndarray, predecessors: np.ndarray, u: int, members: int) -> bool:
@@ -325,9 +326,7 @@ def _linked_words(work: Any, successors: Any, predecessors: Any, u: Any, members
     return False
 
 
-@overload(_linked)
-def _linked_layout(work: Any, successors: Any, predecessors: Any, u: Any, members: Any) -> Any:
-    return _linked_one_word if _one_word(work) else _linked_words
+_by_layout(_linked, _linked_one_word, _linked_words, "work")
 
 
 def _constraints(
@@ -388,9 +387,7 @@ def _constraints_words(work: Any, successors: Any, predecessors: Any, members: A
     return forbidden, forced
 
 
-@overload(_constraints)
-def _constraints_layout(work: Any, successors: Any, predecessors: Any, members: Any, size: Any, inside: Any) -> Any:
-    return _constraints_one_word if _one_word(work) else _constraints_words
+_by_layout(_constraints, _constraints_one_word, _constraints_words, "work")
 
 
 def _in_row(relation: np.ndarray, i: int, j: int) -> bool:
@@ -406,9 +403,7 @@ def _in_row_words(relation: Any, i: Any, j: Any) -> Any:
     return ((relation[i, j >> 6] >> (j & 63)) & 1) != 0
 
 
-@overload(_in_row)
-def _in_row_layout(relation: Any, i: Any, j: Any) -> Any:
-    return _in_row_one_word if _one_word(relation) else _in_row_words
+_by_layout(_in_row, _in_row_one_word, _in_row_words, "relation")
 
 
 def _put(relation: np.ndarray, i: int, j: int, member: bool) -> None:
@@ -431,9 +426,7 @@ def _put_words(relation: Any, i: Any, j: Any, member: Any) -> Any:
         relation[i, j >> 6] &= ~bit
 
 
-@overload(_put)
-def _put_layout(relation: Any, i: Any, j: Any, member: Any) -> Any:
-    return _put_one_word if _one_word(relation) else _put_words
+_by_layout(_put, _put_one_word, _put_words, "relation")
 
 
 def _pair_is_free(i: int, j: int, successors: np.ndarray, predecessors: np.ndarray) -> bool:
@@ -484,9 +477,7 @@ def _pair_is_free_words(i: Any, j: Any, successors: Any, predecessors: Any) -> A
     return True
 
 
-@overload(_pair_is_free)
-def _pair_is_free_layout(i: Any, j: Any, successors: Any, predecessors: Any) -> Any:
-    return _pair_is_free_one_word if _one_word(successors) else _pair_is_free_words
+_by_layout(_pair_is_free, _pair_is_free_one_word, _pair_is_free_words, "successors")
 
 
 # --- the kernels, written once -------------------------------------------------------------
