@@ -10,7 +10,7 @@ from rich.console import Console
 from rich.table import Table
 
 from unstack.cli.learning import FEATURES_HELP, ISETS_FROM_HELP
-from unstack.cli.main import SAMPLES, SECONDS, STATICS_HELP, data_dir_argument, model_path_option
+from unstack.cli.main import SAMPLES, SECONDS, STATICS_HELP, data_dir_argument, model_path_option, out_folder_option
 from unstack.cli.options import Checked, constrained
 from unstack.cli.progress import progress_bar
 from unstack.cli.text import number_table
@@ -74,7 +74,7 @@ def _results_in(paths: list[Path]) -> str:
 
 
 @experiment.command()
-@click.option("--out", required=True, type=click.Path(), help="Folder for table1.json.")
+@out_folder_option("Folder for table1.json.")
 @click.option("--max-n", type=Checked(int, functools.partial(TABLE_SIZE.check, name="max_n")), default=6,
               show_default=True, help="Largest n (7 takes seconds, 8 minutes).")  # fmt: skip
 @click.option("--full", is_flag=True, help="The paper's size: n = 3..7 (overrides --max-n).")
@@ -104,7 +104,7 @@ def table1(out: str, max_n: int, full: bool) -> None:
 
 @experiment.command(short_help="Fig. 5a: the validation confusion matrix of the SVM, beside the paper's.")
 @data_dir_argument
-@click.option("--out", required=True, type=click.Path(), help="Folder for fig5a.json.")
+@out_folder_option("Folder for fig5a.json.")
 @click.option("--r", "r", type=FIG5A("r"), default=5, show_default=True,
               help="Boxes per ISet.")  # fmt: skip
 @click.option("--isets", type=FIG5A("isets"), default=1, show_default=True,
@@ -182,7 +182,7 @@ def fig5a(
 
 @experiment.command(short_help="Fig. 4 and beyond: MSE(cost), first pick right, disturbance per decision maker.")
 @data_dir_argument
-@click.option("--out", required=True, type=click.Path(), help="Folder for decisions.json and fig4.png.")
+@out_folder_option("Folder for decisions.json and fig4.png.")
 @model_path_option
 @click.option("--r", "r", type=DECISIONS("r"), default=5, show_default=True,
               help="Boxes per ISet.")  # fmt: skip
@@ -257,7 +257,7 @@ def decisions(
 
 @experiment.command()
 @data_dir_argument
-@click.option("--out", required=True, type=click.Path(), help="Folder for real7.json.")
+@out_folder_option("Folder for real7.json.")
 @click.option("--model", "model_path", default=None, help="Model trained on piles of the same four sizes.")
 @click.option("--piles", type=REAL7("piles"), default=None, help="Use only the first N piles.")
 def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) -> None:
@@ -288,7 +288,7 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
 
 @experiment.command()
 @data_dir_argument
-@click.option("--out", required=True, type=click.Path(), help="Folder for unloading.json and unloading.png.")
+@out_folder_option("Folder for unloading.json and unloading.png.")
 @model_path_option
 @click.option("--configs", type=UNLOAD("configs"), default=4, show_default=True, help="Piles (the first N).")
 @click.option("--samples", type=SAMPLES, default=UNLOAD_SAMPLES, show_default=True,
@@ -369,7 +369,7 @@ def unload(
 
 @experiment.command()
 @data_dir_argument
-@click.option("--out", required=True, type=click.Path(), help="Folder for container.json.")
+@out_folder_option("Folder for container.json.")
 @model_path_option
 @click.option("--piles", type=CONTAINER("piles"), default=2, show_default=True, help="Piles (the first N).")
 @click.option("--makers", default=",".join(DEFAULT_CONTAINER_MAKERS), show_default=True,
@@ -466,7 +466,7 @@ def container(
 
 
 @experiment.command()
-@click.option("--out", required=True, type=click.Path(), help="Folder for generalisation.json and the pictures.")
+@out_folder_option("Folder for generalisation.json and the pictures.")
 @model_path_option
 @click.option("--seeds", type=click.IntRange(min=1), default=3, show_default=True, help="Scenes drawn per kind.")
 @click.option("--first-seed", type=click.IntRange(min=0), default=0, show_default=True,
@@ -531,7 +531,7 @@ def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int
 
 @experiment.command("camera-roundtrip")
 @data_dir_argument
-@click.option("--out", required=True, type=click.Path(), help="Folder for camera-roundtrip.json.")
+@out_folder_option("Folder for camera-roundtrip.json.")
 @model_path_option
 @click.option("--piles", type=ROUNDTRIP("piles"), default=2, show_default=True, help="Piles (the first N).")
 @click.option("--jobs", type=ROUNDTRIP("n_jobs"), default=1, show_default=True, help="Piles run in parallel.")
@@ -578,7 +578,7 @@ def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, pi
 
 @experiment.command("belief-calibration")
 @data_dir_argument
-@click.option("--out", required=True, type=click.Path(), help="Folder for belief-calibration.json.")
+@out_folder_option("Folder for belief-calibration.json.")
 @click.option("--piles", type=CALIBRATION("piles"), default=2, show_default=True, help="Piles (the first N).")
 @click.option("--detector-misses", type=CALIBRATION("detector_misses"), default=0.0, show_default=True,
               help="Share of the seen boxes the detector misses at each scan.")  # fmt: skip
@@ -633,7 +633,7 @@ def belief_calibration_command(
 
 @experiment.command("pick-responses")
 @click.argument("data_dirs", nargs=-1, required=True, type=click.Path(file_okay=False))
-@click.option("--out", required=True, type=click.Path(), help="Folder of the collected states (resumable).")
+@out_folder_option("Folder of the collected states (resumable).")
 @click.option("--piles", type=RESPONSES("piles"), default=None, help="The first N piles of each data set.")
 @click.option("--max-picks", type=RESPONSES("max_picks"), default=None, help="Stop each pile after this many picks.")
 @click.option("--seed", type=RESPONSES("seed"), default=0, show_default=True)
@@ -673,7 +673,7 @@ def pick_responses(
 
 @experiment.command("train-disturbance")
 @click.argument("states", type=click.Path(file_okay=False, exists=True))
-@click.option("--out", required=True, type=click.Path(), help="Folder for disturbance.skops and disturbance.json.")
+@out_folder_option("Folder for disturbance.skops and disturbance.json.")
 @model_path_option
 @click.option("--folds", type=TRAINING("folds"), default=5, show_default=True,
               help="Grouped folds (piles held out together) of the held-out figures.")  # fmt: skip

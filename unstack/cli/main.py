@@ -40,6 +40,13 @@ model_path_option = click.option("--model", "model_path", default=None, help=MOD
 model_option = click.option("--model", "model", default=None, help=MODEL_HELP)
 #: The folder of a simulated data set (``unstack simulate --out``).
 data_dir_argument = click.argument("data_dir", type=click.Path(file_okay=False))
+
+
+def out_folder_option(help_text: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """``--out``, the folder an experiment writes its results into; ``help_text`` names them."""
+    return click.option("--out", required=True, type=click.Path(), help=help_text)
+
+
 STATICS_HELP = (
     "For a scene: a box that cannot stand without another (leaning on it, or across a gap on it) makes that "
     "one its supporter (P raised to at least 0.65, with a warning); --no-statics keeps the model's probabilities."
