@@ -15,9 +15,6 @@ from unstack.jsonio import load_schema
 from unstack.moves import pick_reasons
 from unstack.supports import Supports
 
-pytestmark = pytest.mark.slow  # the support model and the disturbance model load
-
-
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
@@ -26,6 +23,7 @@ def decision() -> unstack.Decision:
     return unstack.decide(unstack.load(EXAMPLES / "pile5.scene.json"), cost="moves", seed=0)
 
 
+@pytest.mark.slow  # the support model and the disturbance model load
 def test_the_choice_has_the_fewest_expected_moves_up_to_the_near_tie_margin(decision: unstack.Decision) -> None:
     from unstack.moves import MOVES_NEAR_TIE_MARGIN
 
@@ -34,6 +32,7 @@ def test_the_choice_has_the_fewest_expected_moves_up_to_the_near_tie_margin(deci
     assert moves[decision.choice] <= min(moves.values()) + MOVES_NEAR_TIE_MARGIN
 
 
+@pytest.mark.slow  # the support model and the disturbance model load
 def test_every_box_has_its_reasons(decision: unstack.Decision) -> None:
     assert [reason["box"] for reason in decision.reasons] == list(decision.objects)
     for reason, moves in zip(decision.reasons, decision.expected_costs, strict=True):
@@ -41,12 +40,14 @@ def test_every_box_has_its_reasons(decision: unstack.Decision) -> None:
         assert all(p >= 0.2 for _, p in reason["holds_up"])
 
 
+@pytest.mark.slow  # the support model and the disturbance model load
 def test_the_json_names_the_cost_and_validates(decision: unstack.Decision) -> None:
     document = json.loads(json.dumps(decision.to_dict()))
     jsonschema.validate(document, load_schema("unstack.decision/1"))
     assert document["cost"] == "moves" and "choice_probability" not in document and document["reasons"]
 
 
+@pytest.mark.slow  # the support model and the disturbance model load
 def test_the_same_seed_gives_the_same_decision(decision: unstack.Decision, examples: Path) -> None:
     again = unstack.decide(unstack.load(examples / "pile5.scene.json"), cost="moves", seed=0)
     assert again.to_dict() == decision.to_dict()
@@ -57,6 +58,7 @@ def test_supports_alone_cannot_be_decided_on_moves() -> None:
         unstack.decide(Supports(["a", "b"], [[0, 0.2], [0.7, 0]]), cost="moves")
 
 
+@pytest.mark.slow  # the support model and the disturbance model load
 def test_a_disturbance_model_without_the_moves_cost_is_refused(examples: Path) -> None:
     with pytest.raises(InvalidArgument, match="used by the moves cost only"):
         unstack.decide(unstack.load(examples / "pile5.scene.json"), disturbance="model.skops")

@@ -17,8 +17,6 @@ import pytest
 import unstack
 from unstack.threads import even_ranges, map_on_threads
 
-pytestmark = pytest.mark.slow  # runs decisions in four threads
-
 
 def _dense(n: int, seed: int) -> unstack.Supports:
     rng = np.random.default_rng(seed)
@@ -44,6 +42,7 @@ def _summary(decision: unstack.Decision) -> tuple[str, list[float], list[float]]
     return decision.choice, decision.expected_costs.tolist(), [] if errors is None else errors.tolist()
 
 
+@pytest.mark.slow  # runs decisions in four threads
 def test_four_threads_give_the_serial_answers(examples: Path) -> None:
     jobs = _jobs(examples)
     serial = [_summary(unstack.decide(subject, **options)) for subject, options in jobs]
@@ -70,6 +69,7 @@ print(digest.hexdigest())
 """
 
 
+@pytest.mark.slow  # runs decisions in four threads
 def test_the_numbers_do_not_depend_on_the_number_of_threads(examples: Path) -> None:
     import os
     import subprocess
@@ -83,6 +83,7 @@ def test_the_numbers_do_not_depend_on_the_number_of_threads(examples: Path) -> N
     assert len(digests) == 1
 
 
+@pytest.mark.slow  # runs decisions in four threads
 def test_a_decision_starts_no_threading_layer_and_leaves_multiprocessing_alone(examples: Path) -> None:
     import subprocess
     import sys

@@ -14,8 +14,6 @@ from unstack.learning.model_file import default_model_path, load_model
 from unstack.scene import Box, Scene
 from unstack.understanding.clouds import surface_cloud
 
-pytestmark = pytest.mark.slow  # physics runs of every decision maker
-
 
 @pytest.fixture(scope="module")
 def result(small_dataset: Path) -> dict[str, object]:
@@ -23,6 +21,7 @@ def result(small_dataset: Path) -> dict[str, object]:
     return container_experiment(small_dataset, model, piles=1, max_picks=1, samples=64, seed=2, makers=CONTAINER_MAKERS)
 
 
+@pytest.mark.slow  # physics runs of every decision maker
 def test_every_maker_picks_from_the_same_pile_up_to_the_pick_limit(result: dict[str, object]) -> None:
     assert result["makers"] == list(CONTAINER_MAKERS)
     runs = result["runs"][0]["runs"]  # type: ignore[index]
@@ -36,17 +35,20 @@ def test_every_maker_picks_from_the_same_pile_up_to_the_pick_limit(result: dict[
     assert set(result["against_unstack"]) == set(CONTAINER_MAKERS) - {"unstack"}  # type: ignore[arg-type]
 
 
+@pytest.mark.slow  # physics runs of every decision maker
 def test_the_lookahead_first_pick_moves_no_more_than_any_other_makers(result: dict[str, object]) -> None:
     runs = result["runs"][0]["runs"]  # type: ignore[index]
     first = {maker: runs[maker]["steps"][0]["boxes_moved"] for maker in CONTAINER_MAKERS}
     assert first["lookahead"] == min(first.values()), first
 
 
+@pytest.mark.slow  # physics runs of every decision maker
 def test_an_unknown_maker_is_refused_before_any_work(small_dataset: Path) -> None:
     with pytest.raises(UnstackError, match=r"unknown decision makers \['tallest'\]"):
         container_experiment(small_dataset, load_model(default_model_path()), makers=("unstack", "tallest"))
 
 
+@pytest.mark.slow  # physics runs of every decision maker
 def test_the_cli_writes_the_results_and_resumes(small_dataset: Path, tmp_path: Path) -> None:
     arguments = ["experiment", "container", str(small_dataset), "--out", str(tmp_path), "--piles", "1",
                  "--makers", "unstack,highest", "--max-picks", "1", "--samples", "64"]  # fmt: skip
@@ -71,6 +73,7 @@ def _tall_loaded_and_short_free() -> Scene:
     return Scene(boxes, surface_cloud(boxes, viewpoint=[-2.0, 0.0, 1.5], seed=0), ["loaded", "free"])
 
 
+@pytest.mark.slow  # physics runs of every decision maker
 def test_the_hybrid_takes_the_highest_box_the_model_does_not_believe_loaded() -> None:
     policies = container_policies(load_model(default_model_path()), seed=0, makers=("hybrid", "highest"))
     scene = _tall_loaded_and_short_free()
@@ -78,6 +81,7 @@ def test_the_hybrid_takes_the_highest_box_the_model_does_not_believe_loaded() ->
     assert policies["hybrid"](scene) == "free"
 
 
+@pytest.mark.slow  # physics runs of every decision maker
 @pytest.mark.parametrize(
     "maker",
     [
@@ -99,6 +103,7 @@ def test_the_hybrid_vetoes_start_from_the_hybrids_pick_not_the_highest_box(maker
     assert policies[maker](_tall_loaded_and_short_free()) == "free"  # its removal moves nothing
 
 
+@pytest.mark.slow  # physics runs of every decision maker
 def test_the_strict_default_takes_the_highest_box_below_the_strict_free_cost(small_dataset: Path) -> None:
     from unstack.experiments.container import CONTAINER_SAMPLES, STRICT_FREE_COST
     from unstack.pipeline import scene_support_probabilities
@@ -119,6 +124,7 @@ def test_the_strict_default_takes_the_highest_box_below_the_strict_free_cost(sma
             assert pick == decision.choice
 
 
+@pytest.mark.slow  # physics runs of every decision maker
 def test_unstack_gives_near_ties_to_the_box_resting_highest_and_min_cost_keeps_eq13() -> None:
     boxes = [
         Box("a_low", [0.4, 0.4, 0.3], [1.2, -0.35, 0.151]),
@@ -131,11 +137,13 @@ def test_unstack_gives_near_ties_to_the_box_resting_highest_and_min_cost_keeps_e
     assert policies["min_cost"](scene) == "a_low"  # Eq. 13: the lower expected cost (or the smaller id)
 
 
+@pytest.mark.slow  # physics runs of every decision maker
 def test_unstack_never_takes_a_box_under_load() -> None:
     policies = container_policies(load_model(default_model_path()), seed=0, makers=("unstack",))
     assert policies["unstack"](_tall_loaded_and_short_free()) == "free"
 
 
+@pytest.mark.slow  # physics runs of every decision maker
 def test_containers_run_on_a_dask_cluster_with_the_same_results(small_dataset: Path) -> None:
     from distributed import Client, LocalCluster
 
@@ -150,6 +158,7 @@ def test_containers_run_on_a_dask_cluster_with_the_same_results(small_dataset: P
     assert remote["runs"] == local["runs"]
 
 
+@pytest.mark.slow  # physics runs of every decision maker
 def test_an_unreachable_scheduler_is_one_line(small_dataset: Path, tmp_path: Path) -> None:
     result = unstack("experiment", "container", str(small_dataset), "--out", str(tmp_path), "--scheduler", "nonsense")
     assert_one_line_error(result, "tcp://HOST:PORT")

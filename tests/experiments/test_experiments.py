@@ -19,8 +19,6 @@ from unstack.experiments.decisions import (
 from unstack.experiments.table1 import OEIS_A000798, PAPER_TABLE_I, table1
 from unstack.learning.model_file import default_model_path, load_model
 
-pytestmark = pytest.mark.slow  # runs experiments on a simulated data set
-
 
 def test_table1_reproduces_the_paper() -> None:
     for row in table1(sizes=(3, 4, 5, 6), sat_max=5):
@@ -46,6 +44,7 @@ def test_random_scores_are_exact_expectations() -> None:
     assert chosen["first_pick_right"][0] == 0.0 and chosen["moved"][0] == 0
 
 
+@pytest.mark.slow  # runs experiments on a simulated data set
 def test_decisions_on_simulated_piles(small_dataset: Path) -> None:
     result = evaluate_decisions(small_dataset, load_model(default_model_path()), r=4, isets=12, seed=2)
     assert result["isets"] == 12
@@ -62,6 +61,7 @@ def test_decisions_on_simulated_piles(small_dataset: Path) -> None:
     assert again["summary"] == result["summary"]
 
 
+@pytest.mark.slow  # runs experiments on a simulated data set
 def test_per_iset_records_pair_two_models_on_the_same_isets(small_dataset: Path) -> None:
     from unstack.api import load_model
     from unstack.experiments.decisions import paired_between_runs
@@ -97,6 +97,7 @@ def test_runs_on_the_same_folder_spelt_differently_pair(spelling: str) -> None:
         paired_between_runs(run, {**other, "data": "piles2"})
 
 
+@pytest.mark.slow  # runs experiments on a simulated data set
 def test_experiment_commands(small_dataset: Path, tmp_path: Path) -> None:
     result = unstack("experiment", "table1", "--out", str(tmp_path), "--max-n", "5")
     assert result.returncode == 0, result.stderr
@@ -126,6 +127,7 @@ def test_experiment_commands(small_dataset: Path, tmp_path: Path) -> None:
     )
 
 
+@pytest.mark.slow  # runs experiments on a simulated data set
 @pytest.mark.parametrize(
     ("arguments", "message"),
     [
@@ -145,6 +147,7 @@ def test_experiment_bad_input(arguments: list[str], message: str, tmp_path: Path
     assert_one_line_error(result, message, nothing_written_in=tmp_path)
 
 
+@pytest.mark.slow  # runs experiments on a simulated data set
 @pytest.mark.parametrize(("split", "features"), [("pairs", "paper"), ("configuration", "extended")])
 def test_fig5a_on_simulated_piles(small_dataset: Path, tmp_path: Path, split: str, features: str) -> None:
     result = unstack("experiment", "fig5a", str(small_dataset), "--out", str(tmp_path), "--r", "4", "--isets", "3",
@@ -162,6 +165,7 @@ def test_fig5a_on_simulated_piles(small_dataset: Path, tmp_path: Path, split: st
     assert (tmp_path / "fig5a.png").read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.slow  # runs experiments on a simulated data set
 def test_real7_scores_every_iset(small_dataset: Path) -> None:
     from itertools import combinations
 
@@ -177,6 +181,7 @@ def test_real7_scores_every_iset(small_dataset: Path) -> None:
     assert result["worst_mse"]["random"] >= 0
 
 
+@pytest.mark.slow  # runs experiments on a simulated data set
 def test_real7_command(small_dataset: Path, tmp_path: Path) -> None:
     result = unstack("experiment", "real7", str(small_dataset), "--out", str(tmp_path), "--piles", "1")
     assert result.returncode == 0, result.stderr
@@ -184,6 +189,7 @@ def test_real7_command(small_dataset: Path, tmp_path: Path) -> None:
     assert set(json.loads((tmp_path / "real7.json").read_text())["by_r"]) == {"3", "4", "5"}
 
 
+@pytest.mark.slow  # runs experiments on a simulated data set
 def test_unload_command_executes_every_order(small_dataset: Path, tmp_path: Path) -> None:
     result = unstack("experiment", "unload", str(small_dataset), "--out", str(tmp_path), "--configs", "2",
                      "--time-limit", "0.1", "--closed-loop", "--no-statics", "--jobs", "2")  # fmt: skip
@@ -216,6 +222,7 @@ def test_recall_threshold_is_the_largest_reaching_the_recall(recall: float, expe
     assert np.mean(probability[truth == 1] >= threshold) >= recall
 
 
+@pytest.mark.slow  # runs experiments on a simulated data set
 def test_unloading_resumes_from_its_checkpoints(
     small_dataset: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -239,6 +246,7 @@ def test_unloading_resumes_from_its_checkpoints(
         unloading_experiment(small_dataset, model, configs=1, samples=64, statics=False, checkpoints=tmp_path)
 
 
+@pytest.mark.slow  # runs experiments on a simulated data set
 def test_unloading_runs_on_a_dask_cluster(small_dataset: Path) -> None:
     from distributed import Client, LocalCluster
 
@@ -255,6 +263,7 @@ def test_unloading_runs_on_a_dask_cluster(small_dataset: Path) -> None:
         assert all(sorted(run["order"]) == sorted(pile["runs"]["highest"]["order"]) for run in pile["runs"].values())
 
 
+@pytest.mark.slow  # runs experiments on a simulated data set
 def test_unloading_orders_are_reproducible_for_a_seed(small_dataset: Path) -> None:
     from unstack.experiments.unloading import unloading_orders
     from unstack.scene import load_scene

@@ -14,9 +14,8 @@ from unstack.sim.ground_truth import removal_responses, support_labels, transiti
 from unstack.sim.settings import SimulationSettings
 from unstack.sim.world import PhysicsWorld
 
-pytestmark = pytest.mark.slow  # runs removals in the physics engine
 
-
+@pytest.mark.slow  # runs removals in the physics engine
 def test_a_column_of_three(settings: SimulationSettings) -> None:
     with PhysicsWorld(settings, door=False) as world:
         for level in range(3):
@@ -31,6 +30,7 @@ def test_a_column_of_three(settings: SimulationSettings) -> None:
     assert np.array_equal(before, after)  # the world is left in the settled state
 
 
+@pytest.mark.slow  # runs removals in the physics engine
 def test_side_by_side_boxes_do_not_support_each_other(settings: SimulationSettings) -> None:
     with PhysicsWorld(settings, door=False) as world:
         world.add_box([0.4, 0.3, 0.3], [0.5, -0.3, 0.15], [0, 0, 0, 1], mass=8.0)
