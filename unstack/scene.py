@@ -49,6 +49,11 @@ MAX_POINTS = 5_000_000
 MAX_CLOUD_FILE_BYTES = 256 * 2**20
 
 
+def _check_mass(mass: float | None, source: str, path: str) -> float | None:
+    """A box's mass as a positive float, or None when not given."""
+    return None if mass is None else float(check_vector([mass], 1, positive=True, source=source, path=path)[0])
+
+
 def _check_edges(size: np.ndarray, source: str, path: str) -> np.ndarray:
     """Refuse box edges no carton has (the unit is metres)."""
     for k, edge in enumerate(size):
@@ -129,9 +134,7 @@ class Box:
                 check_vector(position, 3, source=source, path=f"{path}.position"), source, f"{path}.position"
             ),
             orientation_xyzw=check_quaternion_xyzw(orientation_xyzw, source=source, path=f"{path}.orientation_xyzw"),
-            mass=None
-            if mass is None
-            else float(check_vector([mass], 1, positive=True, source=source, path=f"{path}.mass")[0]),
+            mass=_check_mass(mass, source, f"{path}.mass"),
         )
 
     def to_dict(self) -> dict[str, Any]:
