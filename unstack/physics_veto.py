@@ -14,7 +14,7 @@ the hybrid's pick, the default's whenever some box is below the free cost; when 
 hybrid takes the lowest expected cost and the default the near ties): over the five
 families of 30 fresh piles it moved 0.55 +- 0.26 boxes per pile fewer than highest first with
 every seen box detected, 1.41 +- 0.27 fewer with a detector missing half the boxes (on a later
-set of 120 piles of four families level with it both ways; over four sets of four sizes,
+set of 150 piles 0.83 +- 0.33 and 0.53 +- 0.25 fewer, most of it on dropped piles; over four sets of four sizes,
 stacked and mixed piles 0.46 +- 0.11 fewer at full detection, most of it on stacked piles), at
 0.40 s a pick for 5 detected boxes (benchmarks page).
 
