@@ -12,11 +12,10 @@ are tried too and the one expected to move the fewest is taken, ties to the box 
 highest. It is the container maker ``hybrid_faces_free`` of the results page (which starts from
 the hybrid's pick, the default's whenever some box is below the free cost; when none is, the
 hybrid takes the lowest expected cost and the default the near ties): over the five
-families of 30 fresh piles it moved 0.55 +- 0.26 boxes per pile fewer than highest first with
-every seen box detected, 1.41 +- 0.27 fewer with a detector missing half the boxes (on a later
-set of 150 piles 0.83 +- 0.33 and 0.53 +- 0.25 fewer, most of it on dropped piles; over four sets of four sizes,
-stacked and mixed piles 0.46 +- 0.11 fewer at full detection, most of it on stacked piles), at
-0.40 s a pick for 5 detected boxes (benchmarks page).
+families of 30 fresh piles it moved fewer boxes than highest first with every seen box detected
+and with a detector missing half the boxes -- on stacked piles in every set of piles, on the
+other families in some sets (results page) -- at 0.40 s a pick for 5 detected boxes (benchmarks
+page).
 
 The scene must be in the container frame of the simulator (x from the door inwards, y across
 the container about its middle, the floor at z = 0): the container's walls stand in the belief
