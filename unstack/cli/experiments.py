@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import click
 from rich.console import Console
@@ -60,6 +62,26 @@ def experiment() -> None:
     """
 
 
+def iset_options(checked: Callable[[str], Any], *, isets: int, isets_help: str) -> Callable[[Any], Any]:
+    """The options of an experiment on ISets: ``--r`` boxes each, ``--isets`` of them (``isets`` by
+    default), drawn as ``--isets-from`` says; ``checked`` gives each the constraints of the library
+    function it is passed to."""
+
+    def decorate(command: Any) -> Any:
+        options = (
+            click.option("--r", "r", type=checked("r"), default=5, show_default=True, help="Boxes per ISet."),
+            click.option("--isets", type=checked("isets"), default=isets, show_default=True, help=isets_help),
+            click.option(
+                "--isets-from", "draw", type=checked("draw"), default="random", show_default=True, help=ISETS_FROM_HELP
+            ),
+        )
+        for option in reversed(options):
+            command = option(command)
+        return command
+
+    return decorate
+
+
 def _paired(difference: dict[str, float | None] | None) -> str:
     """``+0.16 ± 0.08``: a paired difference and its standard error (blank for unstack itself)."""
     if difference is None:
@@ -71,6 +93,29 @@ def _paired(difference: dict[str, float | None] | None) -> str:
 def _results_in(paths: list[Path]) -> str:
     """``results in a.json and a.png``."""
     return "results in " + " and ".join(str(path) for path in paths)
+
+
+def _print_results(table: Table, written: list[Path] | None = None, *lines: str) -> None:
+    """Print an experiment's table, then ``lines``, then where its results were written."""
+    Console().print(table)
+    for line in lines:
+        click.echo(line)
+    if written is not None:
+        click.echo(_results_in(written))
+
+
+def _run_piles(
+    run: Callable[..., dict[str, Any]], scheduler: str | None, out: str, checkpoints: str, **arguments: Any
+) -> tuple[Path, dict[str, Any]]:
+    """Run an experiment on piles (on a dask.distributed scheduler's workers when given one) with a
+    progress bar, each pile's result kept in ``OUT/checkpoints``: the results folder and the result."""
+    from unstack.sim.dataset import scheduler_client
+
+    with scheduler_client(scheduler) as client:  # fails in seconds, before any output
+        folder = results_folder(out)
+        with progress_bar("piles") as report:
+            result = run(**arguments, progress=report, checkpoints=folder / checkpoints, client=client)
+    return folder, result
 
 
 @experiment.command()
@@ -86,12 +131,8 @@ def table1(out: str, max_n: int, full: bool) -> None:
         max_n = 7
     rows = count(range(3, max_n + 1))
     save_results(results_folder(out), "table1.json", rows)
-    table = number_table(
-        "Table I: consistent worlds q' of n boxes",
-        ("n", "all worlds q", "exact engine", "SAT listing", "paper", "OEIS A000798"),
-    )
-    for row in rows:
-        table.add_row(
+    figures = (
+        (
             str(row["n"]),
             f"{row['all_worlds']:,}",
             f"{row['exact']:,}",
@@ -99,18 +140,16 @@ def table1(out: str, max_n: int, full: bool) -> None:
             f"{row['paper']:,}" if row["paper"] else "-",
             f"{row['oeis']:,}",
         )
-    Console().print(table)
+        for row in rows
+    )
+    header = ("n", "all worlds q", "exact engine", "SAT listing", "paper", "OEIS A000798")
+    _print_results(number_table("Table I: consistent worlds q' of n boxes", header, figures))
 
 
 @experiment.command(short_help="Fig. 5a: the validation confusion matrix of the SVM, beside the paper's.")
 @data_dir_argument
 @out_folder_option("Folder for fig5a.json.")
-@click.option("--r", "r", type=FIG5A("r"), default=5, show_default=True,
-              help="Boxes per ISet.")  # fmt: skip
-@click.option("--isets", type=FIG5A("isets"), default=1, show_default=True,
-              help="ISets per configuration.")  # fmt: skip
-@click.option("--isets-from", "draw", type=FIG5A("draw"), default="random",
-              show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
+@iset_options(FIG5A, isets=1, isets_help="ISets per configuration.")
 @click.option("--learner", type=FIG5A("learner"), default="svm",
               show_default=True, help="svm: the paper's RBF SVM with probabilities.")  # fmt: skip
 @click.option("--split-by", type=FIG5A("split_by"), default="pairs", show_default=True,
@@ -176,20 +215,14 @@ def fig5a(
         "78.4 %",
         f"{100 * result['validation_roc']['not_supp_recall_at_paper_supp_recall']:.1f} %",
     )
-    Console().print(table)
-    Console().print(_results_in(written))
+    _print_results(table, written)
 
 
 @experiment.command(short_help="Fig. 4 and beyond: MSE(cost), first pick right, disturbance per decision maker.")
 @data_dir_argument
 @out_folder_option("Folder for decisions.json and fig4.png.")
 @model_path_option
-@click.option("--r", "r", type=DECISIONS("r"), default=5, show_default=True,
-              help="Boxes per ISet.")  # fmt: skip
-@click.option("--isets", type=DECISIONS("isets"), default=50, show_default=True,
-              help="Test ISets (the paper: 493).")  # fmt: skip
-@click.option("--isets-from", "draw", type=FIG5A("draw"), default="random",
-              show_default=True, help=ISETS_FROM_HELP)  # fmt: skip
+@iset_options(DECISIONS, isets=50, isets_help="Test ISets (the paper: 493).")
 @click.option("--seed", type=DECISIONS("seed"), default=0, show_default=True,
               help="Seed of the ISets.")  # fmt: skip
 @click.option("--full", is_flag=True, help="The paper's size: 493 test ISets (overrides --isets).")
@@ -232,27 +265,25 @@ def decisions(
         except ValueError as error:
             raise UnstackError(f"{pair_with}: {error}") from None
     written = save_results(folder, "decisions.json", result, plot_fig4, "fig4.png")
-    table = number_table(
-        f"{result['isets']} test ISets of {r} boxes ({data_dir})",
-        ("decision maker", "MSE(cost)", "first pick right", "boxes moved > 2 cm", "moved - unstack's (± s.e.)",
-         "displacement (m)"),
-    )  # fmt: skip
-    for maker in DECISION_MAKERS:
-        row = result["summary"][maker]
-        paired = result["against_reasoner"].get(maker, {}).get("boxes_moved")
-        table.add_row(
+    summary, against = result["summary"], result["against_reasoner"]
+    figures = (
+        (
             maker,
-            f"{row['mse_cost']:.3f}",
-            f"{100 * row['first_pick_right']:.1f} %",
-            f"{row['boxes_moved']:.2f}",
-            _paired(paired),
-            f"{row['displacement_m']:.3f}",
+            f"{summary[maker]['mse_cost']:.3f}",
+            f"{100 * summary[maker]['first_pick_right']:.1f} %",
+            f"{summary[maker]['boxes_moved']:.2f}",
+            _paired(against.get(maker, {}).get("boxes_moved")),
+            f"{summary[maker]['displacement_m']:.3f}",
         )
-    Console().print(table)
-    if earlier is not None:
-        paired = result["against_earlier_run"]
-        click.echo(f"unstack's boxes moved, this run minus {pair_with}: {_paired(paired)}")
-    click.echo(_results_in(written))
+        for maker in DECISION_MAKERS
+    )
+    header = ("decision maker", "MSE(cost)", "first pick right", "boxes moved > 2 cm", "moved - unstack's (± s.e.)",
+              "displacement (m)")  # fmt: skip
+    table = number_table(f"{result['isets']} test ISets of {r} boxes ({data_dir})", header, figures)
+    earlier_line = () if earlier is None else (
+        f"unstack's boxes moved, this run minus {pair_with}: {_paired(result['against_earlier_run'])}",
+    )  # fmt: skip
+    _print_results(table, written, *earlier_line)
 
 
 @experiment.command()
@@ -275,15 +306,14 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
     table = number_table(
         f"first pick right, {result['piles']} simulated 7-box piles ({data_dir})",
         ("r", "ISets", "paper", "unstack", "highest first", "random"),
+        summary_rows(result),
     )
-    for row in summary_rows(result):
-        table.add_row(*row)
-    Console().print(table)
     worst = result["worst_mse"]
-    click.echo(
-        f"worst MSE(cost) over r: unstack {worst['reasoner']:.3f}, random {worst['random']:.3f} (paper 0.5 vs 3.5)"
+    _print_results(
+        table,
+        written,
+        f"worst MSE(cost) over r: unstack {worst['reasoner']:.3f}, random {worst['random']:.3f} (paper 0.5 vs 3.5)",
     )
-    click.echo(_results_in(written))
 
 
 @experiment.command()
@@ -334,37 +364,29 @@ def unload(
     if full:
         configs = found
     model, name = load_model_option(model_path)
-    from unstack.sim.dataset import scheduler_client
-
-    with scheduler_client(scheduler) as client:  # fails in seconds, before any output
-        folder = results_folder(out)
-        with progress_bar("piles") as report:
-            result = unloading_experiment(
-                data_dir, model, configs=configs, samples=None if time_limit else samples, time_limit=time_limit,
-                seed=seed, progress=report,
-                checkpoints=folder / "unloading-piles", closed_loop=closed_loop, cost=cost, statics=statics,
-                n_jobs=jobs, client=client,
-            )  # fmt: skip
+    folder, result = _run_piles(
+        unloading_experiment, scheduler, out, "unloading-piles", data_dir=data_dir, model=model, configs=configs,
+        samples=None if time_limit else samples, time_limit=time_limit, seed=seed, closed_loop=closed_loop,
+        cost=cost, statics=statics, n_jobs=jobs,
+    )  # fmt: skip
     result["model"] = name
     written = save_results(folder, "unloading.json", result, plot_unloading)
-    table = number_table(
-        f"Unloading every detected box of {result['configs']} piles ({data_dir}) in the simulator",
-        ("decision maker", "boxes moved > 2 cm per pile", "minus unstack's (± s.e.)", "per pick",
-         "picks moving nothing", "displacement (m)"),
-    )  # fmt: skip
-    for maker in result["makers"]:
-        row = result["summary"][maker]
-        paired = result["against_reasoner"].get(maker, {}).get("boxes_moved")
-        table.add_row(
+    summary, against = result["summary"], result["against_reasoner"]
+    figures = (
+        (
             maker,
-            f"{row['boxes_moved_per_pile']:.2f}",
-            _paired(paired),
-            f"{row['boxes_moved_per_pick']:.3f}",
-            f"{100 * row['calm_picks']:.1f} %",
-            f"{row['displacement_m_per_pile']:.3f}",
+            f"{summary[maker]['boxes_moved_per_pile']:.2f}",
+            _paired(against.get(maker, {}).get("boxes_moved")),
+            f"{summary[maker]['boxes_moved_per_pick']:.3f}",
+            f"{100 * summary[maker]['calm_picks']:.1f} %",
+            f"{summary[maker]['displacement_m_per_pile']:.3f}",
         )
-    Console().print(table)
-    click.echo(_results_in(written))
+        for maker in result["makers"]
+    )
+    header = ("decision maker", "boxes moved > 2 cm per pile", "minus unstack's (± s.e.)", "per pick",
+              "picks moving nothing", "displacement (m)")  # fmt: skip
+    title = f"Unloading every detected box of {result['configs']} piles ({data_dir}) in the simulator"
+    _print_results(number_table(title, header, figures), written)
 
 
 @experiment.command()
@@ -431,38 +453,30 @@ def container(
     chosen = tuple(name.strip() for name in makers.split(",") if name.strip())
     model, name = load_model_option(model_path)
     container_policies(model, seed=seed, makers=chosen)  # an unknown maker is one line, before any work
-    from unstack.sim.dataset import scheduler_client
-
-    with scheduler_client(scheduler) as client:  # fails in seconds, before any output
-        folder = results_folder(out)
-        with progress_bar("piles") as report:
-            result = container_experiment(
-                data_dir, model, piles=piles, makers=chosen, detector_noise=detector_noise,
-                detector_misses=detector_misses, reach=reach,
-                max_picks=max_picks, samples=samples, seed=seed, progress=report,
-                checkpoints=folder / "container-piles", n_jobs=jobs, client=client, disturbance=disturbance_path,
-                occupancy=occupancy,
-            )  # fmt: skip
+    folder, result = _run_piles(
+        container_experiment, scheduler, out, "container-piles", data_dir=data_dir, model=model, piles=piles,
+        makers=chosen, detector_noise=detector_noise, detector_misses=detector_misses, reach=reach,
+        max_picks=max_picks, samples=samples, seed=seed, n_jobs=jobs, disturbance=disturbance_path,
+        occupancy=occupancy,
+    )  # fmt: skip
     result["model"] = name
     written = save_results(folder, "container.json", result)
-    table = number_table(
-        f"Emptying {result['piles']} piles of {data_dir}, detecting again before every pick",
-        ("decision maker", "picks", "boxes moved", "minus unstack's", "fallen", "minus unstack's", "calm"),
-    )
-    for maker in result["makers"]:
-        row = result["summary"][maker]
-        paired = result["against_unstack"].get(maker, {})
-        table.add_row(
+    summary, against = result["summary"], result["against_unstack"]
+    figures = (
+        (
             maker,
-            f"{row['picks_per_pile']:.1f}",
-            f"{row['boxes_moved_per_pile']:.2f}",
-            _paired(paired.get("boxes_moved")),
-            f"{row['boxes_fallen_per_pile']:.2f}",
-            _paired(paired.get("boxes_fallen")),
-            f"{100 * row['calm_picks_per_pile']:.0f} %",
+            f"{summary[maker]['picks_per_pile']:.1f}",
+            f"{summary[maker]['boxes_moved_per_pile']:.2f}",
+            _paired(against.get(maker, {}).get("boxes_moved")),
+            f"{summary[maker]['boxes_fallen_per_pile']:.2f}",
+            _paired(against.get(maker, {}).get("boxes_fallen")),
+            f"{100 * summary[maker]['calm_picks_per_pile']:.0f} %",
         )
-    Console().print(table)
-    click.echo(_results_in(written))
+        for maker in result["makers"]
+    )
+    header = ("decision maker", "picks", "boxes moved", "minus unstack's", "fallen", "minus unstack's", "calm")
+    title = f"Emptying {result['piles']} piles of {data_dir}, detecting again before every pick"
+    _print_results(number_table(title, header, figures), written)
 
 
 @experiment.command()
@@ -567,13 +581,13 @@ def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, pi
             f"{1000 * summary['whole_position_error_m_median']:.1f}",
             f"{1000 * summary['whole_position_error_m_p90']:.1f}",
         )
-    Console().print(table)
-    click.echo(
+    _print_results(
+        table,
+        written,
         f"sizes right {100 * summary['size_right_share']:.0f} %; fitted from the top face "
         f"{100 * summary['top_faces_share']:.0f} %; the same decision as on the true poses in "
-        f"{100 * summary['same_decision_share']:.0f} % of piles"
+        f"{100 * summary['same_decision_share']:.0f} % of piles",
     )
-    click.echo(_results_in(written))
 
 
 @experiment.command("belief-calibration")
@@ -611,24 +625,25 @@ def belief_calibration_command(
             fill=fill, view=view, n_jobs=jobs, progress=report,
         )  # fmt: skip
     written = save_results(folder, "belief-calibration.json", result)
-    table = number_table(
-        f"Expected against actual boxes moved per candidate ({result['piles']} piles of {data_dir})",
-        ("expected", "candidates", "mean expected", "mean actual"),
+    bins = (
+        (
+            f"{row['predicted_from']:g} - {'' if row['predicted_to'] is None else format(row['predicted_to'], 'g')}",
+            str(row["picks"]),
+            f"{row['mean_predicted']:.2f}",
+            f"{row['mean_actual']:.2f}",
+        )
+        for row in result["calibration"]["bins"]
     )
-    for row in result["calibration"]["bins"]:
-        upper = "" if row["predicted_to"] is None else f"{row['predicted_to']:g}"
-        table.add_row(f"{row['predicted_from']:g} - {upper}", str(row["picks"]), f"{row['mean_predicted']:.2f}",
-                      f"{row['mean_actual']:.2f}")  # fmt: skip
-    console = Console()
-    console.print(table)
+    title = f"Expected against actual boxes moved per candidate ({result['piles']} piles of {data_dir})"
     picks = result["picks"]
-    console.print(f"Spearman's rank correlation: {result['calibration']['spearman']:.3f}")
-    console.print(
+    _print_results(
+        number_table(title, ("expected", "candidates", "mean expected", "mean actual"), bins),
+        written,
+        f"Spearman's rank correlation: {result['calibration']['spearman']:.3f}",
         f"boxes the pick would have moved over {picks['states']} states: highest first {picks['highest']}, "
         f"the belief's fewest {picks['belief']}, height vetoed by the belief {picks['belief_veto']}, "
-        f"the look-ahead's {picks['lookahead']}"
+        f"the look-ahead's {picks['lookahead']}",
     )
-    click.echo(_results_in(written))
 
 
 @experiment.command("pick-responses")
@@ -700,13 +715,17 @@ def train_disturbance_command(states: str, out: str, model_path: str | None, fol
     disturbance.metadata["training"] = {"states": str(states), "support_model": name, "seed": seed}
     save_disturbance_model(disturbance, folder / "disturbance.skops")
     save_results(folder, "disturbance.json", result)
-    table = number_table(
-        f"Boxes the next pick moved, held out ({result['piles']} piles, {result['records']} views)",
-        ("family / view", "states", "highest", "load cost", "moves", "look-ahead"),
+    scores = (
+        (key, str(row["states"]), *(f"{row[policy]:.3f}" for policy in ("highest", "load", "moves", "lookahead")))
+        for key, row in result["pick_scores"].items()
     )
-    for key, row in result["pick_scores"].items():
-        scores = (f"{row[policy]:.3f}" for policy in ("highest", "load", "moves", "lookahead"))
-        table.add_row(key, str(row["states"]), *scores)
-    Console().print(table)
-    click.echo(f"Spearman's rank correlation, predicted against actual: {result['calibration']['spearman']:.3f}")
-    click.echo(f"model in {folder / 'disturbance.skops'}, report in {folder / 'disturbance.json'}")
+    _print_results(
+        number_table(
+            f"Boxes the next pick moved, held out ({result['piles']} piles, {result['records']} views)",
+            ("family / view", "states", "highest", "load cost", "moves", "look-ahead"),
+            scores,
+        ),
+        None,
+        f"Spearman's rank correlation, predicted against actual: {result['calibration']['spearman']:.3f}",
+        f"model in {folder / 'disturbance.skops'}, report in {folder / 'disturbance.json'}",
+    )

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -35,17 +35,20 @@ def counted(number: int, noun: str) -> str:
     return f"{number:,} {noun}{'' if number == 1 else 's'}"
 
 
-def number_table(title: str, columns: Sequence[str]) -> Table:
-    """A rich table of figures: its title and its columns, each aligned right.
+def number_table(title: str, columns: Sequence[str], rows: Iterable[Sequence[str]] = ()) -> Table:
+    """A rich table of figures: its title, its columns (each aligned right) and its rows.
 
     Examples
     --------
-    >>> [column.header for column in number_table("Table I", ("n", "worlds")).columns]
-    ['n', 'worlds']
+    >>> table = number_table("Table I", ("n", "worlds"), [("3", "29"), ("4", "355")])
+    >>> [column.header for column in table.columns], table.row_count
+    (['n', 'worlds'], 2)
     """
     from rich.table import Table
 
     table = Table(title=title)
     for column in columns:
         table.add_column(column, justify="right")
+    for row in rows:
+        table.add_row(*row)
     return table

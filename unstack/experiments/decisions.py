@@ -63,7 +63,8 @@ from typing import Any
 
 import numpy as np
 
-from unstack.parameters import COUNT, ISET_SIZE, SEED, validate_params
+from unstack.learning.training_data import ISET_DRAWS
+from unstack.parameters import COUNT, ISET_SIZE, SEED, OneOf, validate_params
 from unstack.sim.settings import DISPLACEMENT_THRESHOLD
 
 __all__ = [
@@ -256,7 +257,7 @@ def _binned(isets: list[IsetOutcome], scores: dict[str, dict[str, np.ndarray]]) 
 PAPER_TEST_ISETS = 493
 
 
-@validate_params({"r": ISET_SIZE, "isets": COUNT, "seed": SEED})
+@validate_params({"r": ISET_SIZE, "isets": COUNT, "seed": SEED, "draw": OneOf(ISET_DRAWS)})
 def evaluate_decisions(
     data_dir: str | os.PathLike[str],
     model: Any,
