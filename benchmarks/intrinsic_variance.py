@@ -23,11 +23,9 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from script_arguments import pile_probabilities
 
-from unstack.learning.model_file import default_model_path, load_model
-from unstack.pipeline import scene_support_probabilities
 from unstack.reasoner.sampling import sample_worlds
-from unstack.scene import load_scene
 
 
 def autocorrelation_time(series: np.ndarray) -> float:
@@ -51,10 +49,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--worlds", type=int, default=3000, help="sweeps per chain")
     parser.add_argument("--chains", type=int, default=2)
     args = parser.parse_args(argv)
-    model = load_model(default_model_path())
-    for path in sorted(args.dataset.glob("config-*.json")):
-        scene = load_scene(path)
-        probabilities = scene_support_probabilities(scene, model, boxes=list(scene.box_ids)).probabilities
+    for path, scene, probabilities in pile_probabilities(args.dataset):
         draws = [sample_worlds(probabilities, args.worlds, seed=seed) for seed in range(args.chains)]
         rows = []
         for box in range(len(probabilities)):

@@ -141,16 +141,9 @@ def part_blocks(sizes: list[int], seeds: int, time_limit: float) -> list[dict[st
 
 def scene_matrices(dataset: Path) -> dict[str, np.ndarray]:
     """The shipped model's support probabilities for every box of every configuration."""
-    from unstack.learning.model_file import default_model_path, load_model
-    from unstack.pipeline import scene_support_probabilities
-    from unstack.scene import load_scene
+    from script_arguments import pile_probabilities
 
-    model = load_model(default_model_path())
-    matrices = {}
-    for path in sorted(dataset.glob("config-*.json")):
-        scene = load_scene(path)
-        matrices[path.stem] = scene_support_probabilities(scene, model, boxes=list(scene.box_ids)).probabilities
-    return matrices
+    return {path.stem: probabilities for path, _, probabilities in pile_probabilities(dataset)}
 
 
 @contextmanager

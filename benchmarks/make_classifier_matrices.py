@@ -17,22 +17,16 @@ import sys
 from pathlib import Path
 
 import numpy as np
-
-from unstack.learning.model_file import default_model_path, load_model
-from unstack.pipeline import scene_support_probabilities
-from unstack.scene import load_scene
+from script_arguments import pile_probabilities
 
 OUTPUT = Path(__file__).resolve().parent / "data" / "classifier-matrices.npz"
 
 
 def main(argv: list[str]) -> int:
     dataset = Path(argv[0])
-    model = load_model(default_model_path())
     matrices = {}
-    for path in sorted(dataset.glob("config-*.json")):
-        scene = load_scene(path)
-        supports = scene_support_probabilities(scene, model, boxes=list(scene.box_ids))
-        matrices[path.stem] = supports.probabilities
+    for path, scene, probabilities in pile_probabilities(dataset):
+        matrices[path.stem] = probabilities
         print(f"{path.stem}: {len(scene.box_ids)} boxes")
     OUTPUT.parent.mkdir(exist_ok=True)
     np.savez_compressed(OUTPUT, **matrices)

@@ -22,11 +22,9 @@ import time
 from pathlib import Path
 
 import numpy as np
+from script_arguments import pile_probabilities
 
-from unstack.learning.model_file import default_model_path, load_model
-from unstack.pipeline import scene_support_probabilities
 from unstack.reasoner.sampling import sampled_marginals
-from unstack.scene import load_scene
 
 
 def spread(p: np.ndarray, runs: int, samples: int, revisits: bool) -> tuple[np.ndarray, np.ndarray, float]:
@@ -54,10 +52,7 @@ def main(argv: list[str]) -> int:
     print(
         f"python benchmarks/revisits.py {args.dataset} --piles {args.piles} --runs {args.runs} --samples {args.samples}"
     )
-    model = load_model(default_model_path())
-    for path in sorted(args.dataset.glob("config-*.json"))[: args.piles]:
-        scene = load_scene(path)
-        p = scene_support_probabilities(scene, model, boxes=list(scene.box_ids)).probabilities
+    for path, _, p in pile_probabilities(args.dataset, args.piles):
         for revisits in (False, True):
             real, reported, seconds = spread(p, args.runs, args.samples, revisits)
             top = np.argsort(-real)[:6]
