@@ -265,11 +265,11 @@ def test_unloading_runs_on_a_dask_cluster(small_dataset: Path) -> None:
 
 @pytest.mark.slow  # runs experiments on a simulated data set
 def test_unloading_orders_are_reproducible_for_a_seed(small_dataset: Path) -> None:
-    from unstack.experiments.unloading import unloading_orders
+    from unstack.experiments.unloading import DecisionSettings, unloading_orders
     from unstack.scene import load_scene
 
     scene = load_scene(sorted(small_dataset.glob("config-*.json"))[0])
     model = load_model(default_model_path())
-    first = unloading_orders(scene, model, seed=3, samples=64)
-    assert first == unloading_orders(scene, model, seed=3, samples=64)
+    first = unloading_orders(scene, model, DecisionSettings(seed=3, samples=64))
+    assert first == unloading_orders(scene, model, DecisionSettings(seed=3, samples=64))
     assert sorted(first["reasoner"]) == sorted(scene.detected)

@@ -35,8 +35,10 @@ Examples
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -50,6 +52,7 @@ __all__ = [
     "CLOSED_LOOP_MAKERS",
     "UNLOADING_MAKERS",
     "UNLOAD_SAMPLES",
+    "DecisionSettings",
     "closed_loop_policies",
     "plot_unloading",
     "unloading_experiment",
@@ -62,11 +65,40 @@ UNLOADING_MAKERS = ("reasoner", "priors", "highest", "free", "random")
 #: every box; 3 times the sweeps since a sweep re-inserts
 #: :data:`~unstack.reasoner.sampling.MOVES` boxes, as the default budget).
 UNLOAD_SAMPLES = 3072
-#: ``(samples, time_limit)`` of every decision.
-Budget = tuple[int | None, float | None]
 #: The makers that sense the pile again before each pick (``closed_loop=True``; the others
 #: plan on the untouched pile).
 CLOSED_LOOP_MAKERS = ("reasoner_closed_loop", "highest_closed_loop")
+
+
+@dataclass(frozen=True)
+class DecisionSettings:
+    """How unstack decides at every pick of an unloading run: the sampler's seed and budget, the
+    cost and whether statics raise the probabilities.
+
+    Attributes
+    ----------
+    seed : int
+        Seed of the sampler (and of the ``random`` order).
+    samples : int, optional
+        Recorded sweeps per sampled group of each decision.
+    time_limit : float, optional
+        Seconds per decision instead of ``samples`` (not reproducible).
+    cost : str
+        The cost of unstack's decisions (:data:`unstack.reasoner.costs.COSTS`).
+    statics : bool
+        As in :func:`~unstack.pipeline.scene_support_probabilities`.
+
+    Examples
+    --------
+    >>> DecisionSettings(seed=3, samples=64).cost
+    'load'
+    """
+
+    seed: int
+    samples: int | None = None
+    time_limit: float | None = None
+    cost: str = DEFAULT_COST
+    statics: bool = True
 
 
 def _repeated(pick: Callable[[list[str]], str], boxes: list[str]) -> list[str]:
@@ -79,23 +111,17 @@ def _repeated(pick: Callable[[list[str]], str], boxes: list[str]) -> list[str]:
     return order
 
 
-def closed_loop_policies(
-    model: Any,
-    *,
-    seed: int,
-    samples: int | None = None,
-    time_limit: float | None = None,
-    cost: str = DEFAULT_COST,
-    statics: bool = True,
-) -> dict[str, Callable[[Any], str]]:
-    """The closed-loop decision makers: each maps the freshly sensed scene to the box to take
-    (``statics``: as in :func:`~unstack.pipeline.scene_support_probabilities`)."""
+def closed_loop_policies(model: Any, settings: DecisionSettings) -> dict[str, Callable[[Any], str]]:
+    """The closed-loop decision makers: each maps the freshly sensed scene to the box to take."""
     from unstack.pipeline import scene_support_probabilities
     from unstack.reasoner.decision import decide
 
     def reasoner(scene: Any) -> str:
-        supports = scene_support_probabilities(scene, model, statics=statics)
-        decision = decide(supports, cost=cost, samples=samples, time_limit=time_limit, seed=seed, near_tie_margin=0.0)
+        supports = scene_support_probabilities(scene, model, statics=settings.statics)
+        decision = decide(
+            supports, cost=settings.cost, samples=settings.samples, time_limit=settings.time_limit,
+            seed=settings.seed, near_tie_margin=0.0,
+        )  # fmt: skip
         return str(decision.choice)
 
     def highest(scene: Any) -> str:
@@ -104,28 +130,21 @@ def closed_loop_policies(
     return {"reasoner_closed_loop": reasoner, "highest_closed_loop": highest}
 
 
-def unloading_orders(
-    scene: Any,
-    model: Any,
-    *,
-    seed: int,
-    samples: int | None = None,
-    time_limit: float | None = None,
-    cost: str = DEFAULT_COST,
-    statics: bool = True,
-) -> dict[str, list[str]]:
-    """The order of the scene's detected boxes for every decision maker (``statics``: as in
-    :func:`~unstack.pipeline.scene_support_probabilities`; the baselines do not
+def unloading_orders(scene: Any, model: Any, settings: DecisionSettings) -> dict[str, list[str]]:
+    """The order of the scene's detected boxes for every decision maker (the baselines do not
     use the probabilities except ``priors``)."""
     from unstack.experiments.decisions import free_pick
     from unstack.pipeline import scene_support_probabilities
     from unstack.reasoner.decision import choose
     from unstack.reasoner.plan import unloading_plan
 
-    supports = scene_support_probabilities(scene, model, statics=statics)
+    supports = scene_support_probabilities(scene, model, statics=settings.statics)
     detected = list(scene.detected)
     # Eq. 13's minimum at every step (no near ties by height): the open-loop figures of the results page
-    plan = unloading_plan(supports, cost=cost, samples=samples, time_limit=time_limit, seed=seed, near_tie_margin=0.0)
+    plan = unloading_plan(
+        supports, cost=settings.cost, samples=settings.samples, time_limit=settings.time_limit, seed=settings.seed,
+        near_tie_margin=0.0,
+    )  # fmt: skip
 
     def raw_priors(remaining: list[str]) -> str:
         subset = supports.subset(remaining)
@@ -140,15 +159,13 @@ def unloading_orders(
         "priors": _repeated(raw_priors, detected),
         "highest": sorted(detected, key=lambda box_id: (-heights[box_id], box_id)),
         "free": _repeated(footprint_rule, detected),
-        "random": [str(box_id) for box_id in np.random.default_rng(seed).permutation(detected)],
+        "random": [str(box_id) for box_id in np.random.default_rng(settings.seed).permutation(detected)],
     }
 
 
-def _pile_key(
-    path: Path, model: Any, budget: Budget, seed: int, closed_loop: bool, cost: str, statics: bool = True
-) -> dict[str, Any]:
-    """What a pile's result depends on: the scene file, the model, the budget, the seed, the
-    makers, the cost and statics."""
+def _pile_key(path: Path, model: Any, settings: DecisionSettings, closed_loop: bool) -> dict[str, Any]:
+    """What a pile's result depends on: the scene file, the model, the decisions' settings and
+    the makers."""
     import hashlib
     import json
 
@@ -157,12 +174,12 @@ def _pile_key(
         "scene": path.name,
         "scene_sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
         "model_sha256": model_digest,
-        "samples": budget[0],
-        "time_limit": budget[1],
-        "seed": seed,
+        "samples": settings.samples,
+        "time_limit": settings.time_limit,
+        "seed": settings.seed,
         "closed_loop": closed_loop,
-        "cost": cost,
-        "statics": statics,
+        "cost": settings.cost,
+        "statics": settings.statics,
     }
 
 
@@ -182,29 +199,16 @@ def _finished_pile(checkpoints: Path | None, key: dict[str, Any]) -> dict[str, A
 
 
 def _run_pile(
-    path: Path,
-    number: int,
-    model: Any,
-    budget: Budget,
-    seed: int,
-    closed_loop: bool,
-    cost: str = DEFAULT_COST,
-    statics: bool = True,
+    path: Path, number: int, model: Any, settings: DecisionSettings, closed_loop: bool
 ) -> tuple[int, dict[str, Any]]:
     """Every decision maker's run on one pile (``number`` is passed back for the caller's order)."""
     from unstack.scene import load_scene
     from unstack.sim.unloading import execute_policy, execute_unloading
 
     scene = load_scene(path)
-    orders = unloading_orders(
-        scene, model, samples=budget[0], time_limit=budget[1], seed=seed, cost=cost, statics=statics
-    )
+    orders = unloading_orders(scene, model, settings)
     executed = {maker: execute_unloading(scene, orders[maker]).to_dict() for maker in orders}
-    policies = {}
-    if closed_loop:
-        policies = closed_loop_policies(
-            model, samples=budget[0], time_limit=budget[1], seed=seed, cost=cost, statics=statics
-        )
+    policies = closed_loop_policies(model, settings) if closed_loop else {}
     for maker, policy in policies.items():
         executed[maker] = execute_policy(scene, policy, scene.detected).to_dict()
     return number, {"scene": path.name, "boxes": len(scene.boxes), "detected": len(scene.detected), "runs": executed}
@@ -251,19 +255,18 @@ def unloading_experiment(
 
     if samples is None and time_limit is None:
         samples = UNLOAD_SAMPLES
-    budget: Budget = (samples, time_limit)
+    settings = DecisionSettings(seed=seed, samples=samples, time_limit=time_limit, cost=cost, statics=statics)
     files = require_configurations(data_dir)[:configs]
     folder = None if checkpoints is None else Path(checkpoints)
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
-    keys = [
-        _pile_key(path, model, budget, seed + number, closed_loop, cost, statics) for number, path in enumerate(files)
-    ]
+    per_pile_settings = [dataclasses.replace(settings, seed=seed + number) for number in range(len(files))]
+    keys = [_pile_key(path, model, per_pile_settings[number], closed_loop) for number, path in enumerate(files)]
     piles: list[dict[str, Any] | None] = [_finished_pile(folder, key) for key in keys]
     todo = [number for number, pile in enumerate(piles) if pile is None]
     if progress is not None:
         progress(len(files) - len(todo), len(files))
-    arguments = [(files[number], number, model, budget, seed + number, closed_loop, cost, statics) for number in todo]
+    arguments = [(files[number], number, model, per_pile_settings[number], closed_loop) for number in todo]
     results = run_unordered(_run_pile, arguments, n_jobs=n_jobs, client=client)
     for number, pile in results:
         piles[number] = pile
