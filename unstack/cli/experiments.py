@@ -62,7 +62,7 @@ def experiment() -> None:
     """
 
 
-def iset_options(checked: Callable[[str], Any], *, isets: int, isets_help: str) -> Callable[[Any], Any]:
+def _iset_options(checked: Callable[[str], Any], *, isets: int, isets_help: str) -> Callable[[Any], Any]:
     """The options of an experiment on ISets: ``--r`` boxes each, ``--isets`` of them (``isets`` by
     default), drawn as ``--isets-from`` says; ``checked`` gives each the constraints of the library
     function it is passed to."""
@@ -149,7 +149,7 @@ def table1(out: str, max_n: int, full: bool) -> None:
 @experiment.command(short_help="Fig. 5a: the validation confusion matrix of the SVM, beside the paper's.")
 @data_dir_argument
 @out_folder_option("Folder for fig5a.json.")
-@iset_options(FIG5A, isets=1, isets_help="ISets per configuration.")
+@_iset_options(FIG5A, isets=1, isets_help="ISets per configuration.")
 @click.option("--learner", type=FIG5A("learner"), default="svm",
               show_default=True, help="svm: the paper's RBF SVM with probabilities.")  # fmt: skip
 @click.option("--split-by", type=FIG5A("split_by"), default="pairs", show_default=True,
@@ -222,7 +222,7 @@ def fig5a(
 @data_dir_argument
 @out_folder_option("Folder for decisions.json and fig4.png.")
 @model_path_option
-@iset_options(DECISIONS, isets=50, isets_help="Test ISets (the paper: 493).")
+@_iset_options(DECISIONS, isets=50, isets_help="Test ISets (the paper: 493).")
 @click.option("--seed", type=DECISIONS("seed"), default=0, show_default=True,
               help="Seed of the ISets.")  # fmt: skip
 @click.option("--full", is_flag=True, help="The paper's size: 493 test ISets (overrides --isets).")
