@@ -88,6 +88,7 @@ def test_a_constraint_on_a_parameter_the_function_lacks_is_a_programming_error()
         (container_experiment, {"occupancy": 1.5}, "occupancy must be at most 1, got 1.5"),
         (belief_calibration, {"worlds": 0}, "worlds must be at least 1, got 0"),
         (evaluate_decisions, {"r": 1}, "r must be at least 2, got 1"),
+        (evaluate_decisions, {"draw": "all"}, "unknown draw 'all'; expected one of random, neighbours, mixed"),
         (fig5a, {"cv": 1}, "cv must be at least 2, got 1"),
         (fig5a, {"split_by": "boxes"}, "unknown split_by 'boxes'; expected one of pairs, configuration"),
     ],
