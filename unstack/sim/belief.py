@@ -378,19 +378,20 @@ def behind_seen_faces(scene: Scene, blocks: Sequence[BeliefBlock]) -> np.ndarray
     >>> behind_seen_faces(scene, blocks).tolist()   # the first inside the detected box: nothing unexplained
     [False, True]
     """
-    from unstack.understanding.cloud_columns import CloudColumns
     from unstack.understanding.hidden_load import unexplained_points
 
     points = scene.points
     detected = [scene.box(box_id) for box_id in scene.detected]
     loose = points[unexplained_points(points, detected) & (points[:, 2] > FLOOR_LEVEL)] if len(points) else points
-    columns = CloudColumns(loose)
+    # sorted by depth, the points within a block's reach in x are one slice
+    depths, across, heights = (np.ascontiguousarray(axis) for axis in loose[np.argsort(loose[:, 0], kind="stable")].T)
     behind = np.zeros(len(blocks), dtype=bool)
     for k, block in enumerate(blocks):
         low = block.center - block.size / 2 - FACE_REACH
         high = block.center + block.size / 2 + FACE_REACH
-        heights = loose[columns.indices_over(low[:2], high[:2]), 2]
-        behind[k] = bool(np.any((heights > low[2]) & (heights < high[2])))
+        first, last = np.searchsorted(depths, low[0], side="left"), np.searchsorted(depths, high[0], side="right")
+        y, z = across[first:last], heights[first:last]
+        behind[k] = bool(np.any((y >= low[1]) & (y <= high[1]) & (z > low[2]) & (z < high[2])))
     return behind
 
 
