@@ -63,6 +63,10 @@ def list_configurations(folder: str | os.PathLike[str]) -> list[Path]:
 def require_configurations(folder: str | os.PathLike[str]) -> list[Path]:
     """:func:`list_configurations`, or an error naming the folder when it holds none.
 
+    Warns (:class:`UserWarning`) when the folder's manifest lists more configurations than are
+    finished: a simulation still running, or stopped, whose finished part would otherwise be
+    taken for the whole data set.
+
     Examples
     --------
     >>> require_configurations("/x")
@@ -73,7 +77,28 @@ def require_configurations(folder: str | os.PathLike[str]) -> list[Path]:
     files = list_configurations(folder)
     if not files:
         raise UnstackError(f"{folder}: expected a data set folder with config-NNNN.json scene files, found none")
+    listed = _listed_configurations(folder)
+    if listed is not None and len(files) < listed:
+        import warnings
+
+        warnings.warn(
+            f"{folder}: {len(files)} of the {listed} configurations its manifest lists are finished (a simulation "
+            "still running, or stopped); only those are read",
+            stacklevel=2,
+        )
     return files
+
+
+def _listed_configurations(folder: str | os.PathLike[str]) -> int | None:
+    """How many configurations the folder's manifest says the data set has (``None`` without a
+    readable count: the manifest itself is checked where it is read)."""
+    import json
+
+    try:
+        listed = json.loads((Path(folder) / MANIFEST).read_text(encoding="utf-8")).get("configs")
+    except (OSError, ValueError, AttributeError):
+        return None
+    return listed if isinstance(listed, int) and not isinstance(listed, bool) else None
 
 
 def read_manifest(folder: str | os.PathLike[str]) -> dict[str, Any] | None:

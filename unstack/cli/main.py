@@ -399,9 +399,15 @@ def warm_up(jobs: int | None) -> None:
     click.echo(f"warm-up: done in {time.perf_counter() - start:.1f} s; numba's cache holds the kernels")
 
 
+_WARNED: set[str] = set()
+
+
 def _warning_line(message: Warning | str, category: type[Warning], *_: object, **__: object) -> None:
-    """Library warnings (an empty point cloud, say) as one line on stderr, without source lines."""
-    _warn(str(message))
+    """Library warnings (an empty point cloud, say) as one line on stderr, without source lines;
+    a message said once (a data set checked by the command and again by the library it calls)."""
+    if str(message) not in _WARNED:
+        _WARNED.add(str(message))
+        _warn(str(message))
 
 
 def main() -> None:

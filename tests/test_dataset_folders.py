@@ -1,0 +1,46 @@
+"""Data-set folders: the finished scene files, and a manifest that lists more than are finished."""
+
+from __future__ import annotations
+
+import json
+import warnings
+from pathlib import Path
+
+import pytest
+
+from unstack.dataset_folders import MANIFEST, config_name, require_configurations
+
+
+def data_set(folder: Path, finished: int, listed: int | None) -> Path:
+    """A folder with ``finished`` scene files and, unless ``listed`` is None, a manifest listing that many."""
+    for index in range(finished):
+        (folder / f"{config_name(index)}.json").write_text("{}")
+    if listed is not None:
+        (folder / MANIFEST).write_text(json.dumps({"format": "unstack.dataset/1", "configs": listed}))
+    return folder
+
+
+def test_an_unfinished_data_set_is_read_with_a_warning_naming_both_counts(tmp_path: Path) -> None:
+    folder = data_set(tmp_path, finished=2, listed=30)
+    with pytest.warns(UserWarning, match=r"2 of the 30 configurations its manifest lists are finished"):
+        files = require_configurations(folder)
+    assert [path.name for path in files] == ["config-0000.json", "config-0001.json"]
+
+
+@pytest.mark.parametrize(("finished", "listed"), [(3, 3), (3, None), (3, 2)])
+def test_a_finished_data_set_or_one_without_a_manifest_is_read_silently(
+    tmp_path: Path, finished: int, listed: int | None
+) -> None:
+    folder = data_set(tmp_path, finished, listed)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert len(require_configurations(folder)) == finished
+
+
+@pytest.mark.parametrize("manifest", ["not json", '{"configs": "30"}', "[30]", '{"configs": true}'])
+def test_a_manifest_without_a_readable_count_leaves_the_check_to_its_reader(tmp_path: Path, manifest: str) -> None:
+    folder = data_set(tmp_path, finished=1, listed=None)
+    (folder / MANIFEST).write_text(manifest)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert len(require_configurations(folder)) == 1
