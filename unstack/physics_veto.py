@@ -14,7 +14,7 @@ the hybrid's pick, the default's whenever some box is below the free cost; when 
 hybrid takes the lowest expected cost and the default the near ties): over the five
 families of 30 fresh piles it moved fewer boxes than highest first with every seen box detected
 and with a detector missing half the boxes -- on stacked piles in every set of piles, on the
-other families in some sets (results page) -- at 0.40 s a pick for 5 detected boxes (benchmarks
+other families in some sets (results page) -- at about 0.35 s a pick for 5 detected boxes (benchmarks
 page).
 
 The scene must be in the container frame of the simulator (x from the door inwards, y across
