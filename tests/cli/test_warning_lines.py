@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import warnings
-
 import pytest
 
 from unstack.cli.main import _warning_line
@@ -19,5 +17,5 @@ def test_a_library_warning_is_printed_once_however_often_it_is_raised(capsys: py
 def test_different_warnings_are_each_printed_on_a_line_of_their_own(capsys: pytest.CaptureFixture[str]) -> None:
     messages = [f"box b{k} floats above the floor (each its own)" for k in range(3)]
     for message in messages:
-        _warning_line(warnings.WarningMessage(message, UserWarning, "x.py", 1).message, UserWarning)
+        _warning_line(UserWarning(message), UserWarning)
     assert capsys.readouterr().err.splitlines() == [f"unstack: warning: {message}" for message in messages]

@@ -415,6 +415,7 @@ def main() -> None:
     import warnings
 
     warnings.showwarning = _warning_line
+    _WARNED.clear()  # once per run of the command, also when it is run again in one process
     try:
         status = cli.main(prog_name="unstack", standalone_mode=False)
     except click.exceptions.NoArgsIsHelpError as error:  # bare "unstack": the help, as click shows it
