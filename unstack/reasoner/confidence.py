@@ -4,7 +4,8 @@ Exact methods give every expected cost without error, so the choice is certain. 
 expected costs carry a covariance (from the batch means, see
 :mod:`unstack.reasoner.sampling`); treating the estimate as normal around the true values,
 the probability that the chosen box is the true minimum is the share of draws from
-``N(estimate, covariance)`` in which it has the smallest cost. Boxes too far above the
+``N(estimate, covariance)`` in which it has the smallest cost (a draw below zero counts as
+zero: an expected count of boxes is never negative). Boxes too far above the
 choice to win (:data:`CONTENDER_SIGMAS`) are left out of the draws. Boxes in different groups of
 linked boxes are estimated independently, so the covariance is block-diagonal.
 
@@ -43,6 +44,10 @@ def choice_probability(
 ) -> float:
     """Probability that box ``choice`` has the smallest true expected cost (within ``margin``).
 
+    A box tied with others at the smallest cost has it: exact costs tied at the minimum (the
+    zeros of boxes that certainly hold nothing up) make a choice among them certain, whichever
+    of them it is.
+
     Parameters
     ----------
     expected_costs : numpy.ndarray, shape (n,)
@@ -74,8 +79,7 @@ def choice_probability(
     samples = np.tile(expected_costs[contenders], (draws, 1))
     columns = np.searchsorted(contenders, uncertain)
     block = covariance[np.ix_(uncertain, uncertain)]
-    samples[:, columns] = rng.multivariate_normal(expected_costs[uncertain], block, size=draws, method="eigh")
-    if margin == 0.0:
-        return float(np.mean(contenders[np.argmin(samples, axis=1)] == choice))
+    drawn = rng.multivariate_normal(expected_costs[uncertain], block, size=draws, method="eigh")
+    samples[:, columns] = np.maximum(drawn, 0.0)  # an expected count of boxes is never negative
     own = int(np.searchsorted(contenders, choice))
     return float(np.mean(samples[:, own] <= samples.min(axis=1) + margin))
