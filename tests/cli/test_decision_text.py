@@ -7,13 +7,14 @@ import json
 from pathlib import Path
 
 import jsonschema
+import numpy as np
 import pytest
 from rich.console import Console
 
 import unstack
 from tests.conftest import EXAMPLES, PILE5
 from tests.conftest import unstack as unstack_cli
-from unstack.cli.render import decision_view
+from unstack.cli.render import decision_view, plan_view
 from unstack.jsonio import load_schema
 from unstack.supports import Supports
 
@@ -102,3 +103,25 @@ def test_a_first_call_that_compiles_says_so_and_the_next_one_is_quiet(tmp_path: 
 def test_a_call_in_plain_python_says_nothing(tmp_path: Path) -> None:
     result = unstack_cli("decide", PILE5, env={"NUMBA_CACHE_DIR": str(tmp_path)})
     assert result.returncode == 0 and result.stderr == ""
+
+
+def plan_text(result: unstack.Plan) -> str:
+    buffer = io.StringIO()
+    Console(file=buffer, width=400, highlight=False).print(plan_view(result))
+    return buffer.getvalue()
+
+
+def test_an_exact_plan_says_what_its_ec_column_counts() -> None:
+    text = plan_text(unstack.plan(Supports(["top", "bottom"], [[0.0, 0.1], [0.9, 0.0]])))
+    assert "EC: the expected cost of the pick among the boxes in place, cost 'load'" in text
+    assert "± s.e." not in text and "P(minimum)" not in text
+
+
+def test_a_sampled_plan_says_what_its_error_and_probability_columns_mean() -> None:
+    rng = np.random.default_rng(3)
+    probabilities = rng.uniform(0.0, 1.0, (12, 12)) * (rng.uniform(size=(12, 12)) < 0.3)
+    np.fill_diagonal(probabilities, 0.0)
+    result = unstack.plan(Supports([f"b{i}" for i in range(12)], probabilities), method="approx", samples=200, seed=0)
+    text = plan_text(result)
+    assert "± s.e.: its standard error" in text
+    assert "P(minimum): the probability that the pick truly has the lowest EC at its step" in text

@@ -187,8 +187,11 @@ def payoff_view(table: PayoffMatrix, limit: int) -> Group:
     return Group(view, note)
 
 
-def plan_view(result: Plan) -> Table:
-    """The unloading order, one row per pick, with errors when steps were sampled."""
+def plan_view(result: Plan) -> Group:
+    """The unloading order, one row per pick, with errors when steps were sampled, and what
+    the columns mean."""
+    from unstack.describe import cost_in_words
+
     table = Table(title="Unloading plan (each step decided on the boxes still in place)", title_justify="left")
     sampled = any(step.decision.sampling is not None for step in result.steps)
     columns = ("step", "unload", "EC", *(("± s.e.", "P(minimum)") if sampled else ()), "boxes in place")
@@ -197,7 +200,18 @@ def plan_view(result: Plan) -> Table:
     for number, step in enumerate(result.steps, start=1):
         errors = (f"{step.expected_cost_error:.4f}", f"{step.decision.choice_probability:.3f}") if sampled else ()
         table.add_row(str(number), _id(step.choice), f"{step.expected_cost:.4f}", *errors, str(len(step.remaining)))
-    return table
+    if not result.steps:
+        return Group(table)
+    note = f"EC: the expected cost of the pick among the boxes in place, {cost_in_words(result.steps[0].decision.cost)}"
+    if sampled:
+        note += (
+            "; ± s.e.: its standard error (the step was sampled); P(minimum): the probability that the pick "
+            "truly has the lowest EC at its step"
+        )
+        free = {step.decision.free_cost for step in result.steps if step.decision.free_cost}
+        if free:
+            note += f" (at a step that took the highest box below {min(free):g}: that its EC is truly below it)"
+    return Group(table, Text(note, style="dim"))
 
 
 def _tie_rule(margin: float, free_cost: float) -> str:
