@@ -25,7 +25,7 @@ from __future__ import annotations
 import contextlib
 import os
 import tempfile
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any, BinaryIO
 
@@ -69,13 +69,16 @@ def process_umask() -> int:
         return 0o777 & ~probe.stat().st_mode
 
 
-def check_output_path(path: str | os.PathLike[str]) -> Path:
+def check_output_path(path: str | os.PathLike[str], *, inputs: Iterable[str | os.PathLike[str] | None] = ()) -> Path:
     """Check, before any work, that a file can be written at ``path``.
 
     Parameters
     ----------
     path : str or path-like
         Where an output will go.
+    inputs : iterable of str or path-like
+        Files the same work reads (``None`` and ``"-"``, standard input, are passed over):
+        ``path`` must not be one of them, or the output would replace its own input.
 
     Returns
     -------
@@ -84,7 +87,8 @@ def check_output_path(path: str | os.PathLike[str]) -> Path:
     Raises
     ------
     InvalidArgument
-        The folder does not exist or is not a folder, or ``path`` is a folder.
+        The folder does not exist or is not a folder, ``path`` is a folder, or it is one of
+        ``inputs``.
 
     Examples
     --------
@@ -92,10 +96,17 @@ def check_output_path(path: str | os.PathLike[str]) -> Path:
     Traceback (most recent call last):
     ...
     unstack.errors.InvalidArgument: /no/such/out.json: cannot write there: the folder /no/such does not exist
+    >>> check_output_path("pile.json", inputs=["./pile.json"])
+    Traceback (most recent call last):
+    ...
+    unstack.errors.InvalidArgument: pile.json: cannot write there: it is the input file ./pile.json
     """
     from unstack.errors import InvalidArgument
 
     target = Path(path)
+    for given in inputs:
+        if given is not None and str(given) != "-" and _same_file(target, Path(given)):
+            raise InvalidArgument(f"{path}: cannot write there: it is the input file {given}")
     folder = target.parent
     if target.is_dir():
         raise InvalidArgument(f"{path}: cannot write there: it is a folder")
@@ -106,6 +117,14 @@ def check_output_path(path: str | os.PathLike[str]) -> Path:
     if not os.access(folder, os.W_OK):
         raise InvalidArgument(f"{path}: cannot write there: the folder {folder} is not writable")
     return target
+
+
+def _same_file(first: Path, second: Path) -> bool:
+    """Whether two paths name one file (one that exists: the same inode; else the same absolute path)."""
+    try:
+        return os.path.samefile(first, second)
+    except OSError:
+        return first.resolve() == second.resolve()
 
 
 @contextlib.contextmanager

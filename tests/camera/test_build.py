@@ -75,3 +75,23 @@ def test_ids_must_match_the_masks(three_cartons) -> None:
     depth, masks, pose = render_tops(three_cartons)
     with pytest.raises(UnstackError, match="expected 3 distinct box ids"):
         scene_from_depth(depth, INTRINSICS, pose, masks, ids=["a", "a", "b"])
+
+
+def test_a_pose_whose_z_points_down_is_refused(three_cartons) -> None:
+    depth, masks, pose = render_tops(three_cartons)
+    upside_down = np.diag([1.0, -1.0, -1.0, 1.0]) @ pose  # turned half a turn about x: the floor above the camera
+    with pytest.raises(UnstackError, match="the pose's z points down"):
+        scene_from_depth(depth, INTRINSICS, upside_down, masks, known_sizes=SIZES)
+
+
+@pytest.mark.parametrize("door", [[0.0, 0.0, 1.0], [0.1, 0.0, -1.0]])
+def test_a_door_along_gravity_is_refused(three_cartons, door: list[float]) -> None:
+    depth, masks, pose = render_tops(three_cartons)
+    with pytest.raises(UnstackError, match="within 15 degrees of the vertical"):
+        scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES, door=door)
+
+
+def test_boxes_no_carton_is_are_named_with_what_was_fitted(three_cartons) -> None:
+    depth, masks, pose = render_tops(three_cartons)
+    with pytest.raises(UnstackError, match=r"no box could be fitted: b00: the fitted box's size\[0\]: expected a box"):
+        scene_from_depth(depth / 100.0, INTRINSICS, pose, masks)  # metres read as hundredths

@@ -51,6 +51,10 @@ def test_a_depth_image_without_readings_is_refused(tmp_path: Path) -> None:
         ((2 * np.eye(4)).tolist(), "expected the last row 0 0 0 1"),
         (np.diag([2.0, 1.0, 1.0, 1.0]).tolist(), "expected a rotation"),
         ({"a": np.eye(4).tolist(), "b": np.eye(4).tolist()}, "exactly one matrix"),
+        (
+            [[1, 0, 0, float("nan")], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]],
+            r"\$\[0\]\[3\]: expected a finite number",
+        ),
     ],
 )
 def test_a_pose_that_is_not_a_rigid_transform_is_refused(tmp_path: Path, pose: object, message: str) -> None:
@@ -107,3 +111,28 @@ def test_a_mask_holding_depth_values_is_a_mask_where_they_are_not_zero(tmp_path:
 def test_an_empty_mask_is_refused(tmp_path: Path) -> None:
     with pytest.raises(InvalidFile, match="the mask is empty"):
         load_mask(_png(tmp_path / "m.png", np.zeros((4, 5), dtype=np.uint8)))
+
+
+def _intrinsics(tmp_path: Path, **change: object) -> Path:
+    intrinsics = {"fx": 600.0, "fy": 600.0, "cx": 320.0, "cy": 240.0, "width": 640, "height": 480, **change}
+    (tmp_path / "k.json").write_text(json.dumps({key: value for key, value in intrinsics.items() if value is not None}))
+    return tmp_path / "k.json"
+
+
+def test_intrinsics_missing_a_key_say_which(tmp_path: Path) -> None:
+    with pytest.raises(InvalidFile, match=r"\$: missing required key 'cy'"):
+        load_intrinsics(_intrinsics(tmp_path, cy=None))
+
+
+@pytest.mark.parametrize(("key", "value"), [("k1", 0.01), ("D", [0.1, 0.0, 0.0, 0.0, 0.0]), ("p2", "x")])
+def test_intrinsics_with_a_lens_distortion_are_refused(tmp_path: Path, key: str, value: object) -> None:
+    with pytest.raises(InvalidFile, match=rf"\$\.{key}: expected no lens distortion"):
+        load_intrinsics(_intrinsics(tmp_path, **{key: value}))
+
+
+def test_intrinsics_with_zero_distortion_and_other_keys_are_read_with_a_warning(tmp_path: Path) -> None:
+    with pytest.warns(UserWarning, match="keys passed over .*: camera_name, distortion_model"):
+        intrinsics = load_intrinsics(
+            _intrinsics(tmp_path, D=[0, 0, 0, 0, 0], distortion_model="plumb_bob", camera_name="front")
+        )
+    assert intrinsics.fx == 600.0

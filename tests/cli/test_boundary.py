@@ -302,3 +302,15 @@ def test_learning_commands_refuse_lengths_that_are_not_finite(
     arguments = [str(small_dataset) if part == "DATA" else str(model) if part == "MODEL" else part for part in command]
     one_line_error(unstack(*arguments), fragment)
     assert not model.exists()
+
+
+@pytest.mark.parametrize("command", ["decide", "plan", "worlds", "probabilities"])
+def test_an_output_on_the_input_file_is_refused_and_the_input_kept(tmp_path: Path, command: str) -> None:
+    source = Path("examples/scene3.json" if command == "probabilities" else "examples/stack5.supports.json")
+    given = tmp_path / source.name
+    given.write_text(source.read_text())
+    if command == "probabilities":
+        (tmp_path / "scene3.points.npy").write_bytes(Path("examples/scene3.points.npy").read_bytes())
+    result = unstack(command, str(given), "--output", str(tmp_path / "." / given.name))
+    one_line_error(result, f"cannot write there: it is the input file {given}")
+    assert given.read_text() == source.read_text()

@@ -49,6 +49,9 @@ def test_the_scene_is_written_and_decided(camera_files: list[str], tmp_path: Pat
         (["--sizes", "0.4x0.3"], "--sizes: expected three edges"),
         (["--ids", "a"], "--ids names 1 boxes but 2 masks"),
         (["--depth-units", "m"], "declared in m but the median reading is"),
+        (["--ids", "a,"], "--ids: expected 2 non-empty box ids separated by commas, got 'a,'"),
+        (["--sizes", ""], "--sizes: expected sizes like 0.4x0.3x0.3 separated by commas, got ''"),
+        (["--door", "0,0,1"], "within 15 degrees of the vertical"),
     ],
 )
 def test_bad_input_is_one_line_and_no_file(
@@ -100,3 +103,27 @@ def test_a_scene_with_a_box_in_the_floor_is_written_and_warned_about(tmp_path: P
                   "--out", str(out))  # fmt: skip
     assert run.returncode == 0 and out.exists()
     assert f"unstack: warning: {out}: box 'sunk' reaches 0.15 m into the floor" in run.stderr
+
+
+def test_an_unwritable_report_stops_the_command_before_the_scene_is_written(
+    camera_files: list[str], tmp_path: Path
+) -> None:
+    out = tmp_path / "scene.json"
+    run = unstack("scene", *camera_files, "--out", str(out), "--report", str(tmp_path / "missing" / "report.json"))
+    assert run.returncode == 2 and "cannot write there: the folder" in run.stderr
+    assert not out.exists() and not (tmp_path / "scene.points.npy").exists()
+
+
+@pytest.mark.parametrize("report", ["scene.json", "scene.points.npy", "pose.json"])
+def test_a_report_on_the_scene_or_an_input_is_refused_before_any_work(
+    camera_files: list[str], tmp_path: Path, report: str
+) -> None:
+    before = (tmp_path / "pose.json").read_text()
+    run = unstack("scene", *camera_files, "--out", str(tmp_path / "scene.json"), "--report", str(tmp_path / report))
+    assert run.returncode == 2 and len(run.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "scene.json").exists() and (tmp_path / "pose.json").read_text() == before
+
+
+def test_a_mask_given_twice_is_named(camera_files: list[str], tmp_path: Path) -> None:
+    run = unstack("scene", *camera_files, camera_files[-1], "--out", str(tmp_path / "scene.json"))
+    assert run.returncode == 2 and f"{camera_files[-1]}: the same mask file is given twice" in run.stderr

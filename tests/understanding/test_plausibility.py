@@ -112,3 +112,12 @@ def test_the_overlap_of_a_turned_box_is_estimated_on_a_grid() -> None:
         Box("a", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2]), Box("b", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2], eighth)
     )
     assert share == pytest.approx(2 * (np.sqrt(2) - 1), abs=0.03)  # the regular octagon inside the square
+
+
+def test_a_box_smaller_than_a_carton_is_warned_about_and_a_small_carton_is_not() -> None:
+    parcel = Box("parcel", [0.047, 0.027, 0.035], [1.0, 0.0, 0.0175])
+    carton = Box("carton", [0.09, 0.06, 0.05], [1.5, 0.0, 0.025])
+    warnings = scene_warnings(Scene([parcel, carton], [[1.0, 0.0, 0.035], [1.5, 0.0, 0.05]], ["parcel", "carton"]))
+    assert warnings == [
+        "<array>: box 'parcel' is 4.7 x 2.7 x 3.5 cm, smaller than a carton; are its size and the cloud in metres?"
+    ]

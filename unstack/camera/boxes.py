@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from unstack.camera.planes import PLANE_THRESHOLD, fit_plane
-from unstack.errors import UnstackError
+from unstack.errors import InvalidFile, UnstackError
 from unstack.scene import Box
 
 __all__ = ["DUPLICATE_SHARE", "FittedBox", "boxes_from_masks", "duplicate_masks", "fit_box", "min_area_rectangle"]
@@ -373,6 +373,8 @@ def boxes_from_masks(
         surfaces = [0.0, *(top for j, top in enumerate(tops) if j != k)]
         try:
             fitted.append(fit_box(box_id, points, known_sizes=known_sizes, surfaces=surfaces, rng=rng))
+        except InvalidFile as error:  # a box no carton is: say so of the fit, not of an array
+            unfitted[box_id] = f"the fitted box's {error.json_path[2:]}: {error.message}"
         except UnstackError as error:
             unfitted[box_id] = str(error)
     return fitted, unfitted

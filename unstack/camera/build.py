@@ -34,6 +34,20 @@ MAX_MASK_POINTS = 20_000
 MAX_SCENE_POINTS = 200_000
 
 
+def _check_upright(frame: GravityFrame, pose: np.ndarray) -> None:
+    """Raise when the pose's z points down: a camera sees horizontal surfaces (the floor, the tops
+    of boxes) from above, so most of their points lie below it -- unless the frame is upside down."""
+    camera_height = float(frame.apply(pose[None, :3, 3])[0, 2])
+    below = sum(count for height, count in frame.plane_heights if height < camera_height)
+    above = sum(count for height, count in frame.plane_heights if height > camera_height)
+    if above > below:
+        raise UnstackError(
+            f"the camera sees {above} of the {above + below} points of horizontal surfaces from below (a camera sees "
+            "the floor and the tops of boxes from above): the pose's z points down; expected a camera-to-world "
+            "pose whose z is up"
+        )
+
+
 @dataclass(frozen=True)
 class CameraScene:
     """The scene built from camera files, and how it was built.
@@ -140,6 +154,7 @@ def scene_from_depth(
         horizontal = np.linalg.norm(toward_camera[:2])
         door = list(toward_camera if horizontal > 0.3 * np.linalg.norm(toward_camera) else [-1.0, 0.0, 0.0])
     frame = gravity_frame(cloud, door=np.asarray(door, dtype=np.float64), seed=seed)
+    _check_upright(frame, pose)
     duplicates = duplicate_masks(masks)
     kept = [k for k in range(len(masks)) if k not in duplicates]
     mask_points = []
@@ -150,7 +165,7 @@ def scene_from_depth(
         mask_points.append(points)
     fitted, unfitted = boxes_from_masks(mask_points, [names[k] for k in kept], known_sizes=known_sizes, seed=seed)
     if not fitted:
-        raise UnstackError(f"no box could be fitted: {'; '.join(unfitted.values())}")
+        raise UnstackError(f"no box could be fitted: {'; '.join(f'{k}: {why}' for k, why in unfitted.items())}")
     fitted = _without_overlaps(fitted, unfitted)
     boxes: list[Box] = [item.box for item in fitted]
     metadata = {

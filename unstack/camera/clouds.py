@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import json
 import os
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -31,6 +32,7 @@ import numpy as np
 
 from unstack.camera.build import CameraScene
 from unstack.camera.planes import gravity_frame
+from unstack.checks import check_quaternion_xyzw
 from unstack.errors import InvalidFile, UnstackError
 from unstack.scene import Box, Scene
 
@@ -38,6 +40,8 @@ __all__ = ["load_cloud", "load_detections", "scene_from_cloud"]
 
 #: The largest yaw a detection may give (degrees, either way): ten turns; beyond, a typing slip.
 MAX_YAW_DEG = 3600.0
+#: What a detection is read from (the yaw or the quaternion, not both).
+DETECTION_KEYS = ("id", "center", "size", "yaw_deg", "orientation_xyzw")
 _PCD_TYPES = {("F", 4): "<f4", ("F", 8): "<f8", ("I", 1): "<i1", ("I", 2): "<i2", ("I", 4): "<i4",
               ("U", 1): "<u1", ("U", 2): "<u2", ("U", 4): "<u4"}  # fmt: skip
 
@@ -130,7 +134,8 @@ def load_cloud(path: str | os.PathLike[str]) -> np.ndarray:
 
 
 def load_detections(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
-    """Box detections from JSON (see the module docstring), checked field by field."""
+    """Box detections from JSON (see the module docstring), checked field by field; keys other
+    than a box's are left out (with a warning)."""
     file = Path(path)
     source = str(file)
     try:
@@ -145,12 +150,17 @@ def load_detections(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
     if not isinstance(data, list) or not data:
         raise InvalidFile(source, base, "expected a non-empty list of boxes {id, center, size, yaw_deg}")
     check_detections(data, source=source, base=base)
-    return data
+    return [{key: value for key, value in item.items() if key in DETECTION_KEYS} for item in data]
 
 
 def check_detections(detections: Sequence[Any], *, source: str = "<detections>", base: str = "$") -> None:
-    """Raise :class:`~unstack.errors.InvalidFile` at the first detection that is not a box."""
+    """Raise :class:`~unstack.errors.InvalidFile` at the first detection that is not a box.
+
+    Keys other than a box's (a detector's ``score`` or ``label``) are passed over, with one
+    warning naming them.
+    """
     seen = set()
+    ignored: set[str] = set()
     for index, item in enumerate(detections):
         where = f"{base}[{index}]"
         if not isinstance(item, dict) or not isinstance(item.get("id"), str) or not item["id"]:
@@ -171,10 +181,11 @@ def check_detections(detections: Sequence[Any], *, source: str = "<detections>",
                 raise InvalidFile(source, f"{where}.{name}", f"expected {length} finite numbers (metres)")
         if not all(edge > 0 for edge in item["size"]):
             raise InvalidFile(source, f"{where}.size", "expected positive edges")
+        if "orientation_xyzw" in item and "yaw_deg" in item:
+            raise InvalidFile(source, where, "expected yaw_deg or orientation_xyzw, not both")
         if "orientation_xyzw" in item:
-            quaternion = item["orientation_xyzw"]
-            if not isinstance(quaternion, list) or len(quaternion) != 4 or not np.linalg.norm(quaternion) > 0:
-                raise InvalidFile(source, f"{where}.orientation_xyzw", "expected a quaternion x, y, z, w")
+            check_quaternion_xyzw(item["orientation_xyzw"], source=source, path=f"{where}.orientation_xyzw",
+                                  error=InvalidFile)  # fmt: skip
         elif not isinstance(item.get("yaw_deg", 0.0), int | float) or isinstance(item.get("yaw_deg"), bool):
             raise InvalidFile(source, f"{where}.yaw_deg", "expected a number of degrees")
         elif not abs(item.get("yaw_deg", 0.0)) <= MAX_YAW_DEG:  # NaN too
@@ -183,6 +194,14 @@ def check_detections(detections: Sequence[Any], *, source: str = "<detections>",
                 f"{where}.yaw_deg",
                 f"expected a yaw within {MAX_YAW_DEG:g} degrees either way, got {item['yaw_deg']}",
             )
+        try:  # the edges and coordinates a scene's box may have, at the detection's own path
+            Box(item["id"], item["size"], item["center"], source=source, path=where)
+        except InvalidFile as error:
+            raise InvalidFile(source, error.json_path.replace(".position", ".center"), error.message) from None
+        ignored.update(str(key) for key in item if key not in DETECTION_KEYS)
+    if ignored:
+        warnings.warn(f"{source}: detection keys passed over (a box is read from {', '.join(DETECTION_KEYS)}): "
+                      f"{', '.join(sorted(ignored))}", stacklevel=2)  # fmt: skip
 
 
 def _heading(rotation: np.ndarray, size: np.ndarray) -> tuple[float, np.ndarray]:
@@ -216,7 +235,13 @@ def scene_from_cloud(
             rotation = np.array([[np.cos(yaw), -np.sin(yaw), 0.0], [np.sin(yaw), np.cos(yaw), 0.0], [0.0, 0.0, 1.0]])
         heading, size = _heading(frame.rotation @ rotation, np.asarray(item["size"], dtype=np.float64))
         centre = frame.apply(np.asarray(item["center"], dtype=np.float64)[None])[0]
-        boxes.append(Box(item["id"], size, centre, [0.0, 0.0, np.sin(heading / 2), np.cos(heading / 2)]))
+        try:
+            boxes.append(Box(item["id"], size, centre, [0.0, 0.0, np.sin(heading / 2), np.cos(heading / 2)]))
+        except InvalidFile as error:  # the detection was checked: the cloud's frame put it there
+            raise UnstackError(
+                f"detection {item['id']!r}, moved into the gravity frame the cloud gives: {error.json_path[2:]}: "
+                f"{error.message}; are the cloud and the detections in one frame?"
+            ) from None
     metadata = {"camera": {"tilt_deg": frame.tilt_deg, "gravity_rotation": frame.rotation.tolist(),
                            "gravity_translation": frame.translation.tolist()}}  # fmt: skip
     scene = Scene(boxes, frame.apply(cloud), [box.id for box in boxes], metadata=metadata, source="<cloud>")

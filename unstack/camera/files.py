@@ -21,6 +21,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -40,6 +41,13 @@ MAX_DEPTH_M = 20.0
 FIELD_OF_VIEW = (1.0, 170.0)
 #: The widest and tallest depth image read (pixels; depth cameras give 1-2 thousand).
 MAX_PIXELS = 16384
+#: The keys of a pinhole camera's intrinsics.
+INTRINSICS_KEYS = ("fx", "fy", "cx", "cy", "width", "height")
+#: Keys that give a lens distortion (OpenCV's and ROS's names, in lower case).
+DISTORTION_KEYS = frozenset(
+    {"k1", "k2", "k3", "k4", "k5", "k6", "p1", "p2", "s1", "s2", "s3", "s4", "d", "dist", "distortion",
+     "dist_coeffs", "distortion_coefficients", "coeffs"}
+)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -70,13 +78,21 @@ def _read_json(path: str | os.PathLike[str]) -> tuple[Any, str]:
 
 
 def load_intrinsics(path: str | os.PathLike[str]) -> Intrinsics:
-    """Read ``{"fx", "fy", "cx", "cy", "width", "height"}`` (pixels) from a JSON file."""
+    """Read ``{"fx", "fy", "cx", "cy", "width", "height"}`` (pixels) from a JSON file.
+
+    The camera is a pinhole: distortion coefficients other than 0 (``k1`` ... ``k6``,
+    ``p1``, ``p2``, ``D``, ...) are refused, since nothing here would undo them; other keys
+    are passed over with a warning naming them.
+    """
     data, source = _read_json(path)
     if not isinstance(data, dict):
         raise InvalidFile(source, "$", "expected an object with fx, fy, cx, cy, width and height")
+    _refuse_distortion(data, source)
     values = {}
-    for name in ("fx", "fy", "cx", "cy", "width", "height"):
-        value = data.get(name)
+    for name in INTRINSICS_KEYS:
+        if name not in data:
+            raise InvalidFile(source, "$", f"missing required key {name!r} (expected fx, fy, cx, cy, width, height)")
+        value = data[name]
         if isinstance(value, bool) or not isinstance(value, int | float) or not np.isfinite(value) or value <= 0:
             raise InvalidFile(source, f"$.{name}", f"expected a positive number of pixels, got {value!r}")
         values[name] = float(value)
@@ -99,9 +115,27 @@ def load_intrinsics(path: str | os.PathLike[str]) -> Intrinsics:
                 f"expected a focal length that sees {FIELD_OF_VIEW[0]:g} to {FIELD_OF_VIEW[1]:g} degrees across "
                 f"{values[side]:g} px ({low:.3g} to {high:.3g} px), got {values[focal]:g}",
             )
+    ignored = sorted(str(key) for key in data if key not in INTRINSICS_KEYS and str(key).lower() not in DISTORTION_KEYS)
+    if ignored:
+        warnings.warn(f"{source}: keys passed over (a pinhole camera needs only fx, fy, cx, cy, width, height): "
+                      f"{', '.join(ignored)}", stacklevel=2)  # fmt: skip
     return Intrinsics(
         values["fx"], values["fy"], values["cx"], values["cy"], int(values["width"]), int(values["height"])
     )
+
+
+def _refuse_distortion(data: dict[str, Any], source: str) -> None:
+    """Raise where the intrinsics give a lens distortion other than none."""
+    for key, value in data.items():
+        if str(key).lower() not in DISTORTION_KEYS:
+            continue
+        coefficients = value if isinstance(value, list) else [value]
+        numbers = [entry for entry in coefficients if isinstance(entry, int | float) and not isinstance(entry, bool)]
+        if len(numbers) != len(coefficients) or any(entry != 0 for entry in numbers):
+            raise InvalidFile(
+                source, f"$.{key}", f"expected no lens distortion (a pinhole camera), got {value!r}: undistort the "
+                "depth image and the masks first (OpenCV's undistort) and give the new camera's intrinsics"
+            )  # fmt: skip
 
 
 def load_pose(path: str | os.PathLike[str]) -> np.ndarray:
@@ -122,8 +156,11 @@ def load_pose(path: str | os.PathLike[str]) -> np.ndarray:
         pose = np.array(data, dtype=np.float64)
     except (TypeError, ValueError):
         raise InvalidFile(source, json_path, "expected a 4 x 4 matrix of numbers") from None
-    if pose.shape != (4, 4) or not np.all(np.isfinite(pose)):
+    if pose.shape != (4, 4):
         raise InvalidFile(source, json_path, f"expected a 4 x 4 matrix of finite numbers, got shape {pose.shape}")
+    if not np.all(np.isfinite(pose)):
+        row, column = (int(index) for index in np.argwhere(~np.isfinite(pose))[0])
+        raise InvalidFile(source, f"{json_path}[{row}][{column}]", f"expected a finite number, got {pose[row, column]}")
     rotation = pose[:3, :3]
     if not np.allclose(pose[3], [0.0, 0.0, 0.0, 1.0]):
         raise InvalidFile(source, f"{json_path}[3]", "expected the last row 0 0 0 1")

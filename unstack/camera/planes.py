@@ -37,6 +37,9 @@ HORIZONTAL_TOLERANCE_DEG = 25.0
 PARALLEL_DEG = 2.0
 #: Planes found in turn (each plane's inliers removed before the next).
 MAX_PLANES = 8
+#: A door direction rising or falling more than this (degrees from the horizontal) is refused
+#: (a default towards a camera above the pile rises at most 72.5: see ``scene_from_depth``).
+MAX_DOOR_RISE_DEG = 75.0
 #: A plane holding fewer than this share of the points ends the search.
 MIN_PLANE_SHARE = 0.02
 #: A proposal takes its second and third points among an anchor's this many nearest neighbours.
@@ -154,6 +157,8 @@ class GravityFrame:
         Horizontal planes that gave the direction.
     floor_inliers : int
         Points on the floor plane (0 when the floor was taken as the lowest points).
+    plane_heights : tuple of (float, int)
+        Each of those horizontal planes' height in the gravity frame (metres) and its points.
     """
 
     rotation: np.ndarray
@@ -161,6 +166,7 @@ class GravityFrame:
     tilt_deg: float
     planes: int
     floor_inliers: int
+    plane_heights: tuple[tuple[float, int], ...] = ()
 
     def apply(self, points: np.ndarray) -> np.ndarray:
         """The points in the gravity frame."""
@@ -229,6 +235,11 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
     up /= np.linalg.norm(up)
     found = parallel
     heading = np.array([-1.0, 0.0, 0.0]) if door is None else np.asarray(door, dtype=np.float64)
+    if door is not None and abs(heading @ up) > np.sin(np.radians(MAX_DOOR_RISE_DEG)) * np.linalg.norm(heading):
+        raise UnstackError(
+            f"the door's direction {heading.tolist()} is within {90 - MAX_DOOR_RISE_DEG:g} degrees of the vertical "
+            "the cloud shows: expected a roughly horizontal direction out through the door"
+        )
     rotation = _rotation_onto_z(up, heading)
     heights = points @ up
     floor_heights = [offset / (normal @ up) for normal, offset, _ in found]
@@ -238,4 +249,7 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
     if floor_level > np.percentile(heights, 5) + 0.05:  # the lowest plane is not under the cloud: no floor seen
         floor_level, floor_inliers = float(np.percentile(heights, 1)), 0
     tilt = float(np.degrees(np.arccos(np.clip(up @ up_guess, -1.0, 1.0))))
-    return GravityFrame(rotation, np.array([0.0, 0.0, -floor_level]), tilt, len(found), floor_inliers)
+    plane_heights = tuple(
+        (float(height - floor_level), count) for height, (*_, count) in zip(floor_heights, found, strict=True)
+    )
+    return GravityFrame(rotation, np.array([0.0, 0.0, -floor_level]), tilt, len(found), floor_inliers, plane_heights)

@@ -8,20 +8,22 @@ residual, the duplicates left out and the masks that could not be fitted.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
+from collections.abc import Iterator
 from pathlib import Path
 
 import click
 
-from unstack.errors import UnstackError
+from unstack.errors import InvalidFile, UnstackError
 
 __all__ = ["scene"]
 
 
 def _sizes(text: str | None) -> list[tuple[float, float, float]] | None:
     """``0.255x0.155x0.1,0.34x0.25x0.095`` -> sizes (metres)."""
-    if not text:
+    if text is None:
         return None
     sizes = []
     for item in text.split(","):
@@ -40,6 +42,32 @@ def _require_depth(depth_file: str | None, intrinsics_file: str | None, pose_fil
                                         ("--pose", pose_file)) if value is None]  # fmt: skip
     if missing:
         raise UnstackError(f"{what} with a depth image need {', '.join(missing)} (or give --cloud and --detections)")
+
+
+def _check_outputs(target: Path, report_file: str | None, inputs: list[str | None]) -> None:
+    """Fail before any work when the scene, its cloud or the report cannot be written, when two
+    of them are one file, or when one would replace an input."""
+    from unstack.atomic import check_output_path
+
+    outputs = [target, target.with_name(f"{target.stem}.points.npy")]
+    if report_file is not None:
+        outputs.append(Path(report_file))
+    for output in outputs:
+        check_output_path(output, inputs=inputs)
+    resolved = [output.resolve() for output in outputs]
+    if len(set(resolved)) != len(resolved):
+        raise UnstackError(f"--report: {report_file} is also where the scene (or its cloud) goes; give another file")
+
+
+@contextlib.contextmanager
+def _naming(inputs: str) -> Iterator[None]:
+    """Name ``inputs`` in an error of the scene's building that names no file (gravity, the fits)."""
+    try:
+        yield
+    except InvalidFile:
+        raise
+    except UnstackError as error:
+        raise UnstackError(f"{inputs}: {error}") from None
 
 
 def _mask_id(path: str) -> str:
@@ -108,6 +136,8 @@ def scene(
     target = Path(out)
     if target.suffix.lower() != ".json":
         raise UnstackError(f"--out: expected a .json file name, got {out!r}")
+    _check_outputs(target, report_file, [*mask_files, depth_file, intrinsics_file, pose_file, cloud_file,
+                                         detections_file])  # fmt: skip
     direction = _door(door)
     if detections_file is not None:  # boxes a detector found: the cloud, or the depth image's points, gives gravity
         if mask_files:
@@ -126,7 +156,8 @@ def scene(
             assert depth_file is not None and intrinsics_file is not None and pose_file is not None
             cloud = depth_points(load_depth(depth_file, units=depth_units), load_intrinsics(intrinsics_file),
                                  load_pose(pose_file))  # fmt: skip
-        built = scene_from_cloud(cloud, load_detections(detections_file), door=direction, seed=seed)
+        with _naming(cloud_file or f"{depth_file} seen from {pose_file}"):
+            built = scene_from_cloud(cloud, load_detections(detections_file), door=direction, seed=seed)
     elif cloud_file is not None:
         raise UnstackError("--cloud needs --detections: the boxes a 3-D detector found in the cloud")
     else:
@@ -134,16 +165,26 @@ def scene(
         if not mask_files:
             raise UnstackError("give one mask file per detected box, or --detections")
         assert depth_file is not None and intrinsics_file is not None and pose_file is not None
-        names = [name.strip() for name in ids.split(",")] if ids else [_mask_id(path) for path in mask_files]
+        names = [name.strip() for name in ids.split(",")] if ids is not None else [_mask_id(p) for p in mask_files]
         if len(names) != len(mask_files):
             raise UnstackError(f"--ids names {len(names)} boxes but {len(mask_files)} masks were given")
+        if ids is not None and not all(names):
+            raise UnstackError(f"--ids: expected {len(mask_files)} non-empty box ids separated by commas, got {ids!r}")
+        repeated = sorted({path for path in mask_files if mask_files.count(path) > 1})
+        if repeated:
+            raise UnstackError(f"{repeated[0]}: the same mask file is given twice")
         depth = load_depth(depth_file, units=depth_units)
         intrinsics = load_intrinsics(intrinsics_file)
+        if (intrinsics.width, intrinsics.height) != (depth.shape[1], depth.shape[0]):
+            pixels = f"{depth.shape[1]} x {depth.shape[0]} pixels ({depth_file})"
+            given = f"{intrinsics.width} x {intrinsics.height}"
+            raise InvalidFile(intrinsics_file, "$.width", f"expected the depth image's {pixels}, got {given}")
         pose = load_pose(pose_file)
         masks = [load_mask(path, depth.shape) for path in mask_files]
-        built = scene_from_depth(
-            depth, intrinsics, pose, masks, ids=names, known_sizes=known, door=direction, seed=seed
-        )
+        with _naming(f"{depth_file} seen from {pose_file}"):
+            built = scene_from_depth(
+                depth, intrinsics, pose, masks, ids=names, known_sizes=known, door=direction, seed=seed
+            )
     built.scene.save(target, points_file=f"{target.stem}.points.npy")
     if report_file is not None:
         atomic_write_text(Path(report_file), json.dumps(built.report(), indent=2) + "\n")

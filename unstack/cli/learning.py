@@ -262,9 +262,11 @@ def evaluate(
 @click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)
 def probabilities(scene_file: str, model_path: str | None, output: str | None, statics: bool) -> None:
     """Support probabilities of a scene's detected boxes, as unstack.supports/1 JSON."""
-    from unstack.atomic import atomic_write_text
+    from unstack.atomic import atomic_write_text, check_output_path
     from unstack.scene import load_scene
 
+    if output:
+        check_output_path(output, inputs=[scene_file])
     supports = scene_supports(load_scene(scene_file), model_path, statics)
     for line in supports.metadata.get("warnings", []):
         click.echo(f"unstack: warning: {line}", err=True)

@@ -97,12 +97,13 @@ class _Group(click.Group):
         return None
 
 
-def _check_output(path: str | None) -> None:
-    """Fail before any work when ``--output`` cannot be written (naming the user's path)."""
+def _check_output(path: str | None, source: str) -> None:
+    """Fail before any work when ``--output`` cannot be written (naming the user's path) or
+    would replace the input file ``source``."""
     if path is not None:
         from unstack.atomic import check_output_path
 
-        check_output_path(path)
+        check_output_path(path, inputs=[source])
 
 
 def _write_output(path: str | None, document: dict[str, Any]) -> None:
@@ -287,7 +288,7 @@ def decide(file: str, as_json: bool, output: str | None, timing: bool, model: st
     """
     import unstack
 
-    _check_output(output)
+    _check_output(output, file)
     loaded = _load_input(file, model, reasoning["statics"])
     with _first_call(loaded):
         decision = unstack.decide(loaded, model=model, **reasoning)
@@ -308,7 +309,7 @@ def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str, 
     """
     from unstack.api import payoff
 
-    _check_output(output)
+    _check_output(output, file)
     table = payoff(_load_input(file, model), model, cost=cost)
     _deliver(table.to_dict(), output, as_json, "payoff_view", table, limit)
 
@@ -331,7 +332,7 @@ def plan(file: str, as_json: bool, output: str | None, model: str | None, **reas
     import unstack
     from unstack.cli.progress import progress_bar
 
-    _check_output(output)
+    _check_output(output, file)
     supports = _load_input(file, model, reasoning["statics"])
     with _first_call(supports), progress_bar("planning: steps") as report:
         result = unstack.plan(supports, model=model, progress=report, **reasoning)

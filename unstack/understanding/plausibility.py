@@ -10,8 +10,8 @@ sharing more than :data:`REFUSED_OVERLAP` of the smaller one's volume.
 :func:`scene_warnings` lists what is doubtful but possible, one line each: boxes that
 overlap by more than :data:`WARNED_OVERLAP` of the smaller volume, boxes that reach
 more than :data:`BELOW_FLOOR` into the floor, detected boxes that float (nothing under them
-within :data:`FLOAT_GAP`: no box, no floor, no point of the cloud), and a cloud that is empty or
-lies far from the boxes.
+within :data:`FLOAT_GAP`: no box, no floor, no point of the cloud) or are smaller than a carton
+(no edge reaching :data:`SMALL_BOX`), and a cloud that is empty or lies far from the boxes.
 
 Examples
 --------
@@ -47,6 +47,7 @@ __all__ = [
     "MAX_COORDINATE",
     "MIN_BOX_EDGE",
     "REFUSED_OVERLAP",
+    "SMALL_BOX",
     "WARNED_OVERLAP",
     "overlap_share",
     "overlapping_pairs",
@@ -61,6 +62,9 @@ WARNED_OVERLAP = 0.05
 FLOAT_GAP = 0.05
 #: A box reaching deeper than this below the floor (z = 0) is warned about (metres).
 BELOW_FLOOR = 0.02
+#: A detected box no edge of which reaches this is smaller than a carton (metres): a sign of
+#: sizes or depths in another unit (centimetres read as millimetres).
+SMALL_BOX = 0.08
 #: A cloud whose points are mostly farther than this from every box is "far" (metres) ...
 FAR_CLOUD = 0.5
 #: ... when less than this share of its points is nearer.
@@ -139,6 +143,12 @@ def scene_warnings(scene: Scene) -> list[str]:
             warnings.append(f"{source}: box {box.id!r} {where} the floor (z = 0); check its pose and the frame")
     index = {box.id: k for k, box in enumerate(scene.boxes)}
     for box_id in scene.detected:
+        size = scene.boxes[index[box_id]].size
+        if size.max() < SMALL_BOX:
+            warnings.append(
+                f"{source}: box {box_id!r} is {' x '.join(f'{100 * edge:.1f}' for edge in size)} cm, smaller than a "
+                "carton; are its size and the cloud in metres?"
+            )
         height = _floating(scene, bounds, index[box_id])
         if height is not None:
             warnings.append(
