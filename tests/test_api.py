@@ -7,6 +7,7 @@ import os
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -140,3 +141,27 @@ def test_a_payoff_of_supports_takes_no_model() -> None:
 
     with pytest.raises(InvalidArgument, match="the model would be ignored"):
         payoff(unstack.Supports(["a", "b"], [[0, 0.2], [0.7, 0]]), "general")
+
+
+@pytest.mark.parametrize("path", [None, 123, ["pile.json"]])
+@pytest.mark.parametrize("reader", [unstack.load, unstack.validate])
+def test_a_path_that_is_not_one_is_an_invalid_argument(reader: Any, path: Any) -> None:
+    with pytest.raises(
+        InvalidArgument, match=f"expected a file name \\(a str or path-like\\), got {type(path).__name__}"
+    ):
+        reader(path)
+
+
+def test_the_constructors_refuse_what_is_not_theirs_with_the_path() -> None:
+    from unstack.errors import InvalidScene, InvalidSupports
+
+    with pytest.raises(InvalidSupports, match=r"\$\.probabilities: expected real numbers, got dtype complex128"):
+        unstack.Supports(["a", "b"], np.array([[0, 0.1j], [0.2, 0]]))
+    with pytest.raises(InvalidScene, match=r"\$\.size\[0\]: expected a real number"):
+        unstack.Box("a", np.array([0.4, 0.4, 0.4 + 0.5j]), [0.0, 0.0, 0.2])
+    with pytest.raises(
+        InvalidSupports, match=r"\$\.metadata: expected an object \(a dict with string keys\), got list"
+    ):
+        unstack.Supports(["a", "b"], [[0, 0.1], [0.2, 0]], metadata=[1, 2])  # type: ignore[arg-type]
+    with pytest.raises(InvalidScene, match=r"\$\.boxes\[0\]: expected a Box, got dict"):
+        unstack.Scene([{"id": "a"}], [], ["a"])  # type: ignore[list-item]

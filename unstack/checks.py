@@ -14,7 +14,7 @@ array([[0. , 0.7],
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -28,6 +28,7 @@ __all__ = [
     "QUATERNION_NORM_TOLERANCE",
     "REFUSED_OVERLAP",
     "check_ids",
+    "check_metadata",
     "check_points",
     "check_probability_matrix",
     "check_quaternion_xyzw",
@@ -53,8 +54,8 @@ def _matrix(value: Any, n_objects: int, source: str, path: str, error: type[Inva
     if isinstance(value, np.ndarray):
         if value.ndim != 2 or value.shape != (n_objects, n_objects):
             raise error(source, path, f"expected a {n_objects} x {n_objects} matrix, got shape {value.shape}")
-        if not np.issubdtype(value.dtype, np.number) and value.dtype != np.bool_:
-            raise error(source, path, f"expected numbers, got dtype {value.dtype}")
+        if (not np.issubdtype(value.dtype, np.number) and value.dtype != np.bool_) or np.iscomplexobj(value):
+            raise error(source, path, f"expected real numbers, got dtype {value.dtype}")
         return np.ascontiguousarray(value, dtype=np.float64)
     if not isinstance(value, Sequence) or isinstance(value, str):
         raise error(source, path, f"expected a {n_objects} x {n_objects} matrix (a list of rows)")
@@ -68,6 +69,8 @@ def _matrix(value: Any, n_objects: int, source: str, path: str, error: type[Inva
         for j, cell in enumerate(row):
             if isinstance(cell, bool) or not isinstance(cell, int | float | np.number):
                 raise error(source, f"{path}[{i}][{j}]", f"expected a number, got {cell!r}")
+            if isinstance(cell, np.complexfloating):
+                raise error(source, f"{path}[{i}][{j}]", f"expected a real number, got {cell!r}")
     return np.array(value, dtype=np.float64).reshape(n_objects, n_objects)
 
 
@@ -150,6 +153,25 @@ def check_ids(
     return tuple(value)
 
 
+def check_metadata(value: Any, *, source: str = "<array>", error: type[InvalidFile] = InvalidScene) -> dict[str, Any]:
+    """Check free-form metadata (an object with string keys, or None) and return a copy.
+
+    Examples
+    --------
+    >>> check_metadata(None)
+    {}
+    >>> check_metadata([1, 2])
+    Traceback (most recent call last):
+    ...
+    unstack.errors.InvalidScene: <array>: $.metadata: expected an object (a dict with string keys), got list
+    """
+    if value is None:
+        return {}
+    if not isinstance(value, Mapping) or not all(isinstance(key, str) for key in value):
+        raise error(source, "$.metadata", f"expected an object (a dict with string keys), got {type(value).__name__}")
+    return dict(value)
+
+
 def check_vector(
     value: Any,
     length: int,
@@ -172,6 +194,8 @@ def check_vector(
     for index, item in enumerate(array):
         if isinstance(item, bool) or not isinstance(item, int | float | np.number):
             raise error(source, f"{path}[{index}]", f"expected a number, got {item!r}")
+        if isinstance(item, np.complexfloating):
+            raise error(source, f"{path}[{index}]", f"expected a real number, got {item!r}")
     vector = np.array(array, dtype=np.float64)
     for index, item in enumerate(vector):
         if not np.isfinite(item):

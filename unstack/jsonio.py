@@ -167,6 +167,10 @@ def read_document(path: str | os.PathLike[str]) -> Document:
         The file is missing, a directory, unreadable, not JSON, not a JSON object, or
         holds a non-finite number (``NaN``, ``Infinity``).
     """
+    if not isinstance(path, str | os.PathLike):
+        from unstack.errors import InvalidArgument
+
+        raise InvalidArgument(f"expected a file name (a str or path-like), got {type(path).__name__}")
     source = str(path)
     if source == "-":
         source, base_dir = STDIN_NAME, Path.cwd()

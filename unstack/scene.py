@@ -31,6 +31,7 @@ from unstack.checks import (
     MIN_BOX_EDGE,
     REFUSED_OVERLAP,
     check_ids,
+    check_metadata,
     check_points,
     check_quaternion_xyzw,
     check_vector,
@@ -271,6 +272,9 @@ class Scene:
             raise InvalidScene(source, "$.boxes", "expected at least one box, got an empty list")
         ids: dict[str, int] = {}
         for index, box in enumerate(boxes):
+            if not isinstance(box, Box):
+                raise InvalidScene(source, f"$.boxes[{index}]", f"expected a Box, got {type(box).__name__} "
+                                   "(Scene.from_document and unstack.load read JSON boxes)")  # fmt: skip
             if box.id in ids:
                 raise InvalidScene(
                     source, f"$.boxes[{index}].id", f"duplicate id {box.id!r} (also at index {ids[box.id]})"
@@ -303,7 +307,7 @@ class Scene:
             points=cloud,
             detected=detected_ids,
             ground_truth=truth,
-            metadata=dict(metadata or {}),
+            metadata=check_metadata(metadata, source=source),
             source=source,
         )
 

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from unstack.atomic import atomic_write_text
-from unstack.checks import check_ids, check_probability_matrix, check_vector
+from unstack.checks import check_ids, check_metadata, check_probability_matrix, check_vector
 from unstack.errors import InvalidSupports
 from unstack.frozen import set_frozen_fields
 from unstack.jsonio import Document, read_document, validate_document
@@ -115,9 +115,36 @@ class Supports:
             objects=ids,
             probabilities=matrix,
             masses=mass_vector,
-            metadata=dict(metadata or {}),
+            metadata=check_metadata(metadata, source=source, error=InvalidSupports),
             source=source,
         )
+
+    def named(self, message: str) -> str:
+        """``message`` led by the file these probabilities came from (as is for in-memory ones).
+
+        Examples
+        --------
+        >>> Supports(["a"], [[0.0]], source="pile.json").named("31 boxes: too many")
+        'pile.json: 31 boxes: too many'
+        """
+        return message if self.source in ("", "<array>") else f"{self.source}: {message}"
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        """The doubts about the input that the scene checks and the support model left in
+        ``metadata["warnings"]``, one sentence each (none for probabilities given as such).
+
+        Examples
+        --------
+        >>> Supports(["a", "b"], [[0, 0.5], [0.5, 0]], metadata={"warnings": ["a doubt"]}).warnings
+        ('a doubt',)
+        """
+        found = self.metadata.get("warnings", [])
+        if isinstance(found, str):
+            return (found,)
+        if not isinstance(found, list | tuple):
+            return ()
+        return tuple(str(item) for item in found)
 
     @property
     def n_objects(self) -> int:

@@ -127,7 +127,7 @@ def test_validate_checks_every_file_and_summarises(tmp_path: Path, contradiction
     errors = result.stderr.splitlines()
     assert len(errors) == 2 and all(line.startswith("unstack: error: ") for line in errors)
     assert f"{missing}: $: no such file" in errors[0]
-    assert f"{contradiction}: no consistent world" in errors[1]
+    assert f"{contradiction}: $.probabilities[0][2]: no consistent world" in errors[1]
     assert f"{PILE5}: valid unstack.supports/1" in result.stdout
     assert result.stdout.splitlines()[-1] == "4 files: 2 valid, 2 invalid"
     good = unstack("validate", PILE5)
@@ -135,7 +135,9 @@ def test_validate_checks_every_file_and_summarises(tmp_path: Path, contradiction
 
 
 def test_a_contradiction_in_decide_names_the_file(contradiction: Path) -> None:
-    one_line_error(unstack("decide", str(contradiction)), f"{contradiction}: no consistent world")
+    one_line_error(
+        unstack("decide", str(contradiction)), f"{contradiction}: $.probabilities[0][2]: no consistent world"
+    )
 
 
 def test_warnings_in_the_supports_metadata_are_printed(tmp_path: Path) -> None:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from unstack.cli.main import _warning_line
+from unstack.cli.main import _warn, _warning_line
 
 
 def test_a_library_warning_is_printed_once_however_often_it_is_raised(capsys: pytest.CaptureFixture[str]) -> None:
@@ -19,3 +19,14 @@ def test_different_warnings_are_each_printed_on_a_line_of_their_own(capsys: pyte
     for message in messages:
         _warning_line(UserWarning(message), UserWarning)
     assert capsys.readouterr().err.splitlines() == [f"unstack: warning: {message}" for message in messages]
+
+
+def test_a_warning_the_scene_and_its_decision_both_carry_is_printed_once(capsys: pytest.CaptureFixture[str]) -> None:
+    scene_warning = "s.json: box 'top' floats (the scene's, and again the decision's)"
+    _warn(scene_warning)
+    _warning_line(scene_warning, UserWarning)
+    _warn("s.json: out of distribution (the decision's only)")
+    assert capsys.readouterr().err.splitlines() == [
+        f"unstack: warning: {scene_warning}",
+        "unstack: warning: s.json: out of distribution (the decision's only)",
+    ]

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import jsonschema
 import numpy as np
 import pytest
 
 from tests.conftest import random_probabilities, supports_of
 from tests.reasoner.oracle import brute_force
+from unstack.jsonio import load_schema
 from unstack.reasoner import enumerate_worlds, payoff_matrix
 from unstack.supports import Supports
 
@@ -54,3 +56,11 @@ def test_mass_weighted_payoff(rng: np.random.Generator) -> None:
     table = payoff_matrix(Supports(["a", "b", "c"], probabilities, masses), cost="mass")
     expected = table.worlds.marginals() @ masses
     np.testing.assert_allclose(table.expected_costs(), expected, rtol=1e-12)
+
+
+def test_the_payoff_matrix_carries_the_inputs_warnings_into_its_document() -> None:
+    doubtful = Supports(["a", "b"], [[0, 0.9], [0.0, 0]], metadata={"warnings": ["box 'a' floats"]})
+    table = payoff_matrix(doubtful)
+    assert table.warnings == ("box 'a' floats",) and table.to_dict()["warnings"] == ["box 'a' floats"]
+    jsonschema.validate(table.to_dict(), load_schema("unstack.payoff/1"))
+    assert "warnings" not in payoff_matrix(Supports(["a", "b"], [[0, 0.9], [0.0, 0]])).to_dict()

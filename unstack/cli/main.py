@@ -65,13 +65,21 @@ LAZY_COMMANDS = {
 }
 
 
+#: The warnings said in this run of a command (emptied by :func:`main`).
+_WARNED: set[str] = set()
+
+
 def _fail(message: str) -> None:
     click.echo(f"unstack: error: {printable(message)}", err=True)
     sys.exit(2)
 
 
 def _warn(message: str) -> None:
-    click.echo(f"unstack: warning: {printable(message)}", err=True)
+    """One line on stderr; a warning said already in this run (the scene's, then the decision's
+    that repeats it) is not said again."""
+    if message not in _WARNED:
+        _WARNED.add(message)
+        click.echo(f"unstack: warning: {printable(message)}", err=True)
 
 
 class _Group(click.Group):
@@ -311,7 +319,7 @@ def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str, 
 
     _check_output(output, file)
     table = payoff(_load_input(file, model), model, cost=cost)
-    _deliver(table.to_dict(), output, as_json, "payoff_view", table, limit)
+    _deliver(table.to_dict(), output, as_json, "payoff_view", table, limit, warnings=table.warnings)
 
 
 @cli.command()
@@ -400,15 +408,10 @@ def warm_up(jobs: int | None) -> None:
     click.echo(f"warm-up: done in {time.perf_counter() - start:.1f} s; numba's cache holds the kernels")
 
 
-_WARNED: set[str] = set()
-
-
 def _warning_line(message: Warning | str, category: type[Warning], *_: object, **__: object) -> None:
     """Library warnings (an empty point cloud, say) as one line on stderr, without source lines;
     a message said once (a data set checked by the command and again by the library it calls)."""
-    if str(message) not in _WARNED:
-        _WARNED.add(str(message))
-        _warn(str(message))
+    _warn(str(message))
 
 
 def main() -> None:

@@ -92,6 +92,8 @@ def render(
         if colour in ("truth", "none"):
             raise UnstackError(f"{file}: a supports file has no ground truth or geometry; it is coloured by cost")
         values = decision_values(loaded, decision_file, with_plan=with_plan, model=model, seed=seed)
+        for warning in values.warnings:
+            _warn(warning)
         from unstack.pictures.graph import render_support_graph
 
         render_support_graph(values, output, threshold=threshold, title=title, dpi=dpi)
@@ -103,6 +105,8 @@ def render(
     values = (
         decision_values(scene, decision_file, with_plan=with_plan, model=model, seed=seed) if needs_decision else None
     )
+    for warning in values.warnings if values is not None else ():
+        _warn(warning)
     from unstack.pictures.render import render_scene
 
     render_scene(
@@ -154,6 +158,8 @@ def view(
     if isinstance(loaded, unstack.Supports):
         raise UnstackError(f"{file}: a supports file has no geometry to show in 3D; unstack render draws its graph")
     values = decision_values(loaded, decision_file, with_plan=with_plan, model=model, seed=seed)
+    for warning in values.warnings:
+        _warn(warning)
     from unstack.pictures.view import write_view
 
     size = write_view(loaded, output, values=values, max_points=max_points, seed=seed, title=title or Path(file).name)

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from unstack.errors import InvalidArgument, InvalidFile
+from unstack.errors import InvalidArgument
 from unstack.frozen import set_frozen_fields
 
 __all__ = ["DecisionValues", "check_threshold", "read_decision_values"]
@@ -65,6 +65,8 @@ class DecisionValues:
         What the cost counts, for the colour bar.
     source : str
         Where the values came from (for error messages).
+    warnings : sequence of str
+        The decision's doubts about its input, one sentence each (a picture shows none of them).
     """
 
     objects: tuple[str, ...]
@@ -75,6 +77,7 @@ class DecisionValues:
     probabilities: np.ndarray | None
     cost_name: str
     source: str
+    warnings: tuple[str, ...]
 
     def __init__(
         self,
@@ -87,6 +90,7 @@ class DecisionValues:
         probabilities: Any = None,
         cost_name: str = "expected cost",
         source: str = "<values>",
+        warnings: Sequence[str] = (),
     ) -> None:
         ids = tuple(str(box) for box in objects)
         n = len(ids)
@@ -119,6 +123,7 @@ class DecisionValues:
             probabilities=matrix,
             cost_name=cost_name,
             source=source,
+            warnings=tuple(str(warning) for warning in warnings),
         )
 
     @classmethod
@@ -142,6 +147,7 @@ class DecisionValues:
             probabilities=decision.marginals,
             cost_name=f"expected cost ({decision.cost})",
             source=source,
+            warnings=decision.warnings,
         )
 
     def index(self, box: str) -> int:
@@ -247,22 +253,13 @@ def read_decision_values(path: str | os.PathLike[str]) -> DecisionValues:
     'a'
     """
     from unstack.jsonio import read_document, validate_document
+    from unstack.validation import check_decision_document
 
     document = read_document(path)
     validate_document(document, ["unstack.decision/1"])
+    check_decision_document(document)
     data = document.data
-    objects = data["objects"]
-    n = len(objects)
-    for key in ("expected_costs", "expected_cost_errors"):
-        if key in data and len(data[key]) != n:
-            raise InvalidFile(
-                document.source, f"$.{key}", f"expected {n} numbers (one per object), got {len(data[key])}"
-            )
-    marginals = data["marginals"]
-    if len(marginals) != n or any(len(row) != n for row in marginals):
-        raise InvalidFile(document.source, "$.marginals", f"expected a {n} x {n} matrix")
-    if data["choice"] not in objects:
-        raise InvalidFile(document.source, "$.choice", f"expected one of the objects, got {data['choice']!r}")
+    objects, marginals = data["objects"], data["marginals"]
     return DecisionValues(
         objects,
         data["expected_costs"],
@@ -271,4 +268,5 @@ def read_decision_values(path: str | os.PathLike[str]) -> DecisionValues:
         probabilities=marginals,
         cost_name=f"expected cost ({data['cost']})",
         source=document.source,
+        warnings=data.get("warnings", ()),
     )

@@ -40,13 +40,13 @@ from typing import Any
 
 import numpy as np
 
-from unstack.errors import InvalidArgument, NoConsistentWorld
+from unstack.errors import InvalidArgument, TooLarge
 from unstack.reasoner.arguments import check_budget, check_choice, check_count, check_margin, check_samples, check_seed
 from unstack.reasoner.components import support_components
 from unstack.reasoner.confidence import choice_probability
 from unstack.reasoner.costs import COSTS, DEFAULT_COST, cost_weights, expected_costs, own_costs
 from unstack.reasoner.marginals import EXACT_MAX_BOXES
-from unstack.reasoner.pruning import Evidence, propagate_evidence
+from unstack.reasoner.pruning import Evidence, hard_evidence
 from unstack.reasoner.reasons import REASON_COSTS, pick_reasons
 from unstack.reasoner.reuse import WARM_BURN_IN, WorkCache
 from unstack.reasoner.sampling import SampledMarginals
@@ -468,26 +468,6 @@ def _sampling_summary(results: list[_GroupResult], seed: int | None) -> dict[str
     return summary
 
 
-def _propagate(supports: Supports) -> Evidence:
-    """Hard evidence of ``supports``; a contradiction names the file it came from."""
-    try:
-        return propagate_evidence(supports.objects, supports.probabilities)
-    except NoConsistentWorld as error:
-        if supports.source in ("", "<array>"):
-            raise
-        raise NoConsistentWorld(f"{supports.source}: {error}", error.conflict) from None
-
-
-def _model_warnings(supports: Supports) -> tuple[str, ...]:
-    """The warning sentences a support model left in the metadata (``"warnings"``)."""
-    found = supports.metadata.get("warnings", [])
-    if isinstance(found, str):
-        return (found,)
-    if not isinstance(found, list | tuple):
-        return ()
-    return tuple(str(item) for item in found)
-
-
 def decide(
     supports: Supports,
     *,
@@ -578,7 +558,7 @@ def decide(
     margin = _near_tie_margin(supports, near_tie_margin)
     n = supports.n_objects
     weights = cost_weights(supports, cost)
-    evidence = _propagate(supports)
+    evidence = hard_evidence(supports)
     groups = support_components(evidence.probabilities)
     methods = _group_methods(method, [len(group) for group in groups], time_limit, max_boxes)
     seeds = _group_seeds(len(groups), seed)
@@ -596,7 +576,10 @@ def decide(
         if group_method == "approx":
             budget["time_limit"] = _time_share(deadline, group, waiting)
             waiting -= len(group)
-        result = _group_marginals(supports, evidence, group, group_method, max_boxes, budget, cache)
+        try:
+            result = _group_marginals(supports, evidence, group, group_method, max_boxes, budget, cache)
+        except TooLarge as error:  # a method asked for a group past its engine's limit
+            raise TooLarge(supports.named(str(error))) from None
         results.append(result)
         block = np.ix_(group, group)
         marginals[block] = result.marginals
@@ -627,7 +610,7 @@ def decide(
         ties=ties,
         evidence=evidence,
         seconds=time.perf_counter() - start,
-        warnings=_model_warnings(supports) + ((sampling["warning"],) if sampling and "warning" in sampling else ()),
+        warnings=supports.warnings + ((sampling["warning"],) if sampling and "warning" in sampling else ()),
         sampling_seconds=sum(result.sampled.seconds for result in results if result.sampled is not None),
         near_tie_margin=margin,
         reasons=tuple(pick_reasons(supports, marginals, costs)) if cost in REASON_COSTS else (),

@@ -45,11 +45,14 @@ class PayoffMatrix:
         ``costs[i, j]`` = cost of unloading box ``j`` first in world ``i``.
     cost : str
         ``"count"`` (Eq. 11) or ``"mass"``.
+    warnings : tuple of str
+        Doubts about the input (:attr:`unstack.supports.Supports.warnings`), one sentence each.
     """
 
     worlds: WorldSet
     costs: np.ndarray
     cost: str
+    warnings: tuple[str, ...] = ()
 
     @property
     def objects(self) -> tuple[str, ...]:
@@ -92,6 +95,7 @@ class PayoffMatrix:
                 }
                 for i in range(len(self.worlds))
             ],
+            **({"warnings": list(self.warnings)} if self.warnings else {}),
         }
 
 
@@ -110,4 +114,4 @@ def payoff_matrix(supports: Supports, *, cost: str = "count", max_boxes: int = S
     weights = cost_weights(supports, cost)
     worlds = enumerate_worlds(supports, max_boxes=max_boxes)
     costs = worlds.worlds.astype(np.float64) @ weights
-    return PayoffMatrix(worlds, costs, cost)
+    return PayoffMatrix(worlds, costs, cost, supports.warnings)

@@ -36,8 +36,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from unstack.errors import NoConsistentWorld
+from unstack.supports import Supports
 
-__all__ = ["Evidence", "propagate_evidence"]
+__all__ = ["Evidence", "hard_evidence", "propagate_evidence"]
 
 
 @dataclass(frozen=True)
@@ -61,6 +62,33 @@ class Evidence:
 
 def _name(a: str, b: str) -> str:
     return f"SUPP({a}, {b})"
+
+
+def hard_evidence(supports: Supports) -> Evidence:
+    """:func:`propagate_evidence` of ``supports``; a contradiction in a file names the file and the
+    JSON path of the relation that transitivity forbids.
+
+    Raises
+    ------
+    NoConsistentWorld
+        The hard evidence contradicts transitivity.
+
+    Examples
+    --------
+    >>> chain = Supports(["a", "b", "c"], [[0, 1, 0], [0, 0, 1], [0.5, 0, 0]], source="chain.json")
+    >>> hard_evidence(chain)
+    Traceback (most recent call last):
+    ...
+    unstack.errors.NoConsistentWorld: chain.json: $.probabilities[0][2]: no consistent world: ...
+    """
+    try:
+        return propagate_evidence(supports.objects, supports.probabilities)
+    except NoConsistentWorld as error:
+        if supports.source in ("", "<array>"):
+            raise
+        supporter, supported, _ = error.conflict[-1]
+        where = f"$.probabilities[{supports.index(supporter)}][{supports.index(supported)}]"
+        raise NoConsistentWorld(f"{supports.source}: {where}: {error}", error.conflict) from None
 
 
 def propagate_evidence(objects: Sequence[str], probabilities: np.ndarray) -> Evidence:

@@ -26,7 +26,7 @@ import numpy as np
 
 from unstack.errors import TooLarge
 from unstack.reasoner.consistency import PREORDER_COUNTS, transitivity_clauses
-from unstack.reasoner.pruning import Evidence, propagate_evidence
+from unstack.reasoner.pruning import Evidence, hard_evidence
 from unstack.reasoner.variables import SupportVariables
 from unstack.supports import Supports
 
@@ -116,12 +116,14 @@ def enumerate_worlds(supports: Supports, *, solver: str = SAT_SOLVER, max_boxes:
     n = len(objects)
     if n > max_boxes:
         raise TooLarge(
-            f"{n} boxes: listing consistent worlds is limited to {max_boxes} boxes "
-            f"(n = {max_boxes + 1} has {PREORDER_COUNTS[max_boxes + 1]:,} worlds); "
-            "decide without listing them (unstack decide FILE, or method 'auto': exact up to 8 linked boxes, "
-            "sampled above)"
+            supports.named(
+                f"{n} boxes: listing consistent worlds is limited to {max_boxes} boxes "
+                f"(n = {max_boxes + 1} has {PREORDER_COUNTS[max_boxes + 1]:,} worlds); "
+                "decide without listing them (unstack decide FILE, or method 'auto': exact up to 8 linked boxes, "
+                "sampled above)"
+            )
         )
-    evidence = propagate_evidence(objects, supports.probabilities)
+    evidence = hard_evidence(supports)
     variables = SupportVariables(objects)
     index = {name: i for i, name in enumerate(objects)}
     rows = np.array([index[x] for x, _ in variables.pairs], dtype=np.int64)

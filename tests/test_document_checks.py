@@ -1,0 +1,62 @@
+"""What a decision's or a plan's schema cannot say, checked by ``validate`` and by the pictures."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+import unstack
+from unstack.errors import InvalidFile
+from unstack.pictures.values import read_decision_values
+
+SUPPORTS = unstack.Supports(["a", "b", "c"], [[0, 0.8, 0.1], [0.1, 0, 0.7], [0.0, 0.1, 0]])
+
+
+def _written(tmp_path: Path, document: dict[str, Any]) -> Path:
+    path = tmp_path / "document.json"
+    path.write_text(json.dumps(document))
+    return path
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"choice": "z"}, r"\$\.choice: expected one of the objects, got 'z'"),
+        ({"expected_costs": [0.0, 1.0]}, r"\$\.expected_costs: expected 3 numbers \(one per object\), got 2"),
+        ({"marginals": [[0.0] * 3] * 2}, r"\$\.marginals: expected a 3 x 3 matrix"),
+        ({"ties": ["a", "z"]}, r"\$\.ties\[1\]: expected one of the objects, got 'z'"),
+    ],
+)
+def test_a_decision_at_odds_with_its_objects_is_invalid_for_validate_and_render(
+    tmp_path: Path, change: dict[str, Any], message: str
+) -> None:
+    path = _written(tmp_path, {**unstack.decide(SUPPORTS).to_dict(), **change})
+    with pytest.raises(InvalidFile, match=message):
+        unstack.validate(path)
+    with pytest.raises(InvalidFile, match=message):
+        read_decision_values(path)
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (
+            lambda plan: {"order": plan["order"][:-1] + plan["order"][:1]},
+            r"\$\.order: expected each of the objects once",
+        ),
+        (lambda plan: {"order": plan["order"][::-1]}, r"\$\.steps\[0\]\.choice: expected '.*', the order's box"),
+        (lambda plan: {"steps": plan["steps"][:2]}, r"\$\.steps: expected 3 steps"),
+    ],
+)
+def test_a_plan_whose_steps_do_not_follow_its_order_is_invalid(tmp_path: Path, change: Any, message: str) -> None:
+    plan = unstack.plan(SUPPORTS).to_dict()
+    with pytest.raises(InvalidFile, match=message):
+        unstack.validate(_written(tmp_path, {**plan, **change(plan)}))
+
+
+def test_a_decision_and_a_plan_as_written_are_valid(tmp_path: Path) -> None:
+    assert unstack.validate(_written(tmp_path, unstack.decide(SUPPORTS).to_dict())).format == "unstack.decision/1"
+    assert unstack.validate(_written(tmp_path, unstack.plan(SUPPORTS).to_dict())).format == "unstack.plan/1"
