@@ -11,8 +11,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from unstack.errors import NoConsistentWorld, TooLarge, UnstackError
+from unstack.errors import InvalidArgument, NoConsistentWorld, TooLarge, UnstackError
 from unstack.reasoner import decide
+from unstack.reasoner.plan import unloading_plan
 from unstack.supports import Supports
 
 probability_values = st.one_of(
@@ -237,3 +238,11 @@ def test_default_budget_is_a_number_of_sweeps_reproducible_for_a_seed() -> None:
     assert first.sampling is not None and first.sampling["samples"] == [default_samples(9)] == [8192]
     np.testing.assert_array_equal(first.expected_costs, second.expected_costs)
     np.testing.assert_array_equal(first.expected_cost_errors, second.expected_cost_errors)
+
+
+@pytest.mark.parametrize("method", ["exact", "sat"])
+def test_a_sample_budget_for_a_method_that_counts_every_world_is_refused(method: str) -> None:
+    supports = Supports(["a", "b"], [[0, 0.2], [0.7, 0]])
+    with pytest.raises(InvalidArgument, match=f"samples: method '{method}' samples nothing"):
+        decide(supports, method=method, samples=100)
+    assert unloading_plan(supports, method=method).order == ["a", "b"]

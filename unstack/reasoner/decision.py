@@ -67,6 +67,8 @@ __all__ = [
 DECISION_FORMAT = "unstack.decision/1"
 #: Reasoning methods: ``exact`` (weighted preorder counting), ``sat`` (list worlds).
 METHODS = ("auto", "exact", "sat", "approx")
+#: The methods that count every world (a sample budget means nothing to them).
+UNSAMPLED_METHODS = ("exact", "sat")
 #: With a time limit below this (seconds), ``auto`` samples groups of 8 boxes instead of
 #: counting them (exact n = 8 dense: 2.6 s on a quiet 2-core machine, 4.1 s loaded).
 AUTO_EXACT8_SECONDS = 10.0
@@ -554,6 +556,8 @@ def decide(
         time_limit = check_budget(time_limit, "time_limit")
     if samples is not None:
         samples = check_samples(samples)
+        if method in UNSAMPLED_METHODS:
+            raise InvalidArgument(f"samples: method {method!r} samples nothing (use method 'approx' or 'auto')")
     seed = check_seed(seed)
     margin = _near_tie_margin(supports, near_tie_margin)
     n = supports.n_objects

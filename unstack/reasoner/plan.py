@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from unstack.reasoner.costs import DEFAULT_COST
-from unstack.reasoner.decision import Decision, decide
+from unstack.reasoner.decision import UNSAMPLED_METHODS, Decision, decide
 from unstack.reasoner.reuse import WorkCache
 from unstack.supports import Supports
 
@@ -170,7 +170,7 @@ def unloading_plan(
     remaining = list(supports.objects) if isinstance(supports, Supports) else []
     steps: list[PlanStep] = []
     work = WorkCache()
-    if samples is None and time_limit is None:
+    if samples is None and time_limit is None and method not in UNSAMPLED_METHODS:
         samples = PLAN_SAMPLES
     while True:
         decision = decide(
