@@ -45,18 +45,23 @@ def compare_by_size(
 ) -> dict[str, dict[str, float]]:
     """The speed scripts' whole run: arguments, scenes of each size, alternate timing, report.
 
-    Reads the command line (a data set; ``--piles``, ``--repeat``, ``--sizes``, ``--json``),
+    Reads the command line (one data set or several, ``--piles`` of each; ``--repeat``,
+    ``--sizes``, ``--json``),
     times ``calls`` alternately on each size's scenes, prints the medians and the ratio of the
     first call to the second, and writes them to ``--json`` when given.
     """
     parser = argparse.ArgumentParser(description=description)
-    parser.add_argument("data", type=Path)
+    parser.add_argument("data", type=Path, nargs="+")
     parser.add_argument("--piles", type=int, default=piles)
     parser.add_argument("--repeat", type=int, default=repeat)
     parser.add_argument("--sizes", default="5,40")
     parser.add_argument("--json", type=Path, default=None)
     arguments = parser.parse_args()
-    loaded = [load_scene(path) for path in sorted(arguments.data.glob("config-*.json"))[: arguments.piles]]
+    loaded = [
+        load_scene(path)
+        for folder in arguments.data
+        for path in sorted(folder.glob("config-*.json"))[: arguments.piles]
+    ]
     measured, reference = list(calls)[:2]
     result: dict[str, dict[str, float]] = {}
     for size in (int(text) for text in arguments.sizes.split(",")):

@@ -335,7 +335,8 @@ def plan(file: str, as_json: bool, output: str | None, model: str | None, **reas
 
     With sampling, the budget (--samples or --time-limit) applies to each step; without one
     each step samples 2048 sweeps per group, starting from the previous step's chains, so a
-    seed reproduces the plan. A progress bar on a terminal counts the steps.
+    seed reproduces the plan. A progress bar on a terminal counts the steps (in a pipe or a log, a
+    line every 30 s of a long plan).
     """
     import unstack
     from unstack.cli.progress import progress_bar
