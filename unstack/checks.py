@@ -15,11 +15,14 @@ array([[0. , 0.7],
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from unstack.errors import InvalidFile, InvalidScene, InvalidSupports
+
+if TYPE_CHECKING:
+    from unstack.jsonio import Document
 
 __all__ = [
     "MAX_BOX_EDGE",
@@ -27,8 +30,10 @@ __all__ = [
     "MIN_BOX_EDGE",
     "QUATERNION_NORM_TOLERANCE",
     "REFUSED_OVERLAP",
+    "check_decision_document",
     "check_ids",
     "check_metadata",
+    "check_plan_document",
     "check_points",
     "check_probability_matrix",
     "check_quaternion_xyzw",
@@ -264,3 +269,61 @@ def check_points(
         i, k = bad[0]
         raise error(source, f"{path}[{i}][{k}]", f"expected a finite coordinate, got {points[i, k]}")
     return points
+
+
+def check_decision_document(document: Document) -> None:
+    """What the ``unstack.decision/1`` schema cannot say: one cost (and error) per object, a
+    square matrix of them, the choice and the ties among them.
+
+    Raises
+    ------
+    InvalidFile
+        At the first array of another length, or a box that is not one of the objects.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> from unstack.jsonio import Document
+    >>> check_decision_document(Document({"objects": ["a"], "choice": "b", "expected_costs": [0.0],
+    ...                                   "marginals": [[0.0]]}, "d.json", Path(".")))
+    Traceback (most recent call last):
+    ...
+    unstack.errors.InvalidFile: d.json: $.choice: expected one of the objects, got 'b'
+    """
+    data, source = document.data, document.source
+    objects = data["objects"]
+    n = len(objects)
+    for key in ("expected_costs", "expected_cost_errors"):
+        if key in data and len(data[key]) != n:
+            raise InvalidFile(source, f"$.{key}", f"expected {n} numbers (one per object), got {len(data[key])}")
+    marginals = data["marginals"]
+    if len(marginals) != n or any(len(row) != n for row in marginals):
+        raise InvalidFile(source, "$.marginals", f"expected a {n} x {n} matrix (one row and column per object)")
+    known = set(objects)
+    if data["choice"] not in known:
+        raise InvalidFile(source, "$.choice", f"expected one of the objects, got {data['choice']!r}")
+    for index, box in enumerate(data.get("ties", [])):
+        if box not in known:
+            raise InvalidFile(source, f"$.ties[{index}]", f"expected one of the objects, got {box!r}")
+
+
+def check_plan_document(document: Document) -> None:
+    """What the ``unstack.plan/1`` schema cannot say: the order takes each object once, and
+    step ``k`` takes the ``k``-th box of the order from the boxes still in place.
+
+    Raises
+    ------
+    InvalidFile
+        At the first box out of place.
+    """
+    data, source = document.data, document.source
+    order, objects = data["order"], data["objects"]
+    if sorted(order) != sorted(objects) or len(set(order)) != len(order):
+        raise InvalidFile(source, "$.order", "expected each of the objects once")
+    if len(data["steps"]) != len(order):
+        raise InvalidFile(source, "$.steps", f"expected {len(order)} steps (one per box of the order)")
+    for index, (step, box) in enumerate(zip(data["steps"], order, strict=True)):
+        if step["choice"] != box:
+            raise InvalidFile(source, f"$.steps[{index}].choice", f"expected {box!r}, the order's box")
+        if box not in step["remaining"]:
+            raise InvalidFile(source, f"$.steps[{index}].remaining", f"expected the boxes in place to hold {box!r}")

@@ -15,10 +15,10 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 
-from unstack.errors import InvalidFile
-from unstack.jsonio import Document, read_document, validate_document
+from unstack.checks import check_decision_document, check_plan_document
+from unstack.jsonio import read_document, validate_document
 
-__all__ = ["Validated", "check_decision_document", "check_plan_document", "validate"]
+__all__ = ["Validated", "validate"]
 
 
 @dataclass(frozen=True)
@@ -102,61 +102,3 @@ def validate(path: str | os.PathLike[str]) -> Validated:
         check_decision_document(document)
         detail = f"choice {document.data['choice']!r}"
     return Validated(document.source, tag, detail)
-
-
-def check_decision_document(document: Document) -> None:
-    """What the ``unstack.decision/1`` schema cannot say: one cost (and error) per object, a
-    square matrix of them, the choice and the ties among them.
-
-    Raises
-    ------
-    InvalidFile
-        At the first array of another length, or a box that is not one of the objects.
-
-    Examples
-    --------
-    >>> from pathlib import Path
-    >>> from unstack.jsonio import Document
-    >>> check_decision_document(Document({"objects": ["a"], "choice": "b", "expected_costs": [0.0],
-    ...                                   "marginals": [[0.0]]}, "d.json", Path(".")))
-    Traceback (most recent call last):
-    ...
-    unstack.errors.InvalidFile: d.json: $.choice: expected one of the objects, got 'b'
-    """
-    data, source = document.data, document.source
-    objects = data["objects"]
-    n = len(objects)
-    for key in ("expected_costs", "expected_cost_errors"):
-        if key in data and len(data[key]) != n:
-            raise InvalidFile(source, f"$.{key}", f"expected {n} numbers (one per object), got {len(data[key])}")
-    marginals = data["marginals"]
-    if len(marginals) != n or any(len(row) != n for row in marginals):
-        raise InvalidFile(source, "$.marginals", f"expected a {n} x {n} matrix (one row and column per object)")
-    known = set(objects)
-    if data["choice"] not in known:
-        raise InvalidFile(source, "$.choice", f"expected one of the objects, got {data['choice']!r}")
-    for index, box in enumerate(data.get("ties", [])):
-        if box not in known:
-            raise InvalidFile(source, f"$.ties[{index}]", f"expected one of the objects, got {box!r}")
-
-
-def check_plan_document(document: Document) -> None:
-    """What the ``unstack.plan/1`` schema cannot say: the order takes each object once, and
-    step ``k`` takes the ``k``-th box of the order from the boxes still in place.
-
-    Raises
-    ------
-    InvalidFile
-        At the first box out of place.
-    """
-    data, source = document.data, document.source
-    order, objects = data["order"], data["objects"]
-    if sorted(order) != sorted(objects) or len(set(order)) != len(order):
-        raise InvalidFile(source, "$.order", "expected each of the objects once")
-    if len(data["steps"]) != len(order):
-        raise InvalidFile(source, "$.steps", f"expected {len(order)} steps (one per box of the order)")
-    for index, (step, box) in enumerate(zip(data["steps"], order, strict=True)):
-        if step["choice"] != box:
-            raise InvalidFile(source, f"$.steps[{index}].choice", f"expected {box!r}, the order's box")
-        if box not in step["remaining"]:
-            raise InvalidFile(source, f"$.steps[{index}].remaining", f"expected the boxes in place to hold {box!r}")

@@ -252,8 +252,8 @@ def read_decision_values(path: str | os.PathLike[str]) -> DecisionValues:
     >>> read_decision_values(path).choice
     'a'
     """
+    from unstack.checks import check_decision_document
     from unstack.jsonio import read_document, validate_document
-    from unstack.validation import check_decision_document
 
     document = read_document(path)
     validate_document(document, ["unstack.decision/1"])
