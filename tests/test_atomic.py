@@ -8,7 +8,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from unstack.atomic import atomic_path, atomic_save_array, atomic_write, atomic_write_text, process_umask
+from unstack.atomic import (
+    atomic_path,
+    atomic_save_array,
+    atomic_write,
+    atomic_write_text,
+    check_output_path,
+    process_umask,
+)
 from unstack.errors import InvalidArgument
 
 
@@ -68,3 +75,23 @@ def test_a_figure_is_written_in_the_format_of_its_suffix(tmp_path: Path, suffix:
 def test_a_missing_folder_is_refused_before_writing(tmp_path: Path) -> None:
     with pytest.raises(InvalidArgument, match=r"the folder .* does not exist"):
         atomic_write_text(tmp_path / "no" / "out.json", "{}")
+
+
+def test_an_output_with_the_longest_name_the_file_system_allows_is_written(tmp_path: Path) -> None:
+    target = tmp_path / ("c" * 250 + ".json")
+    atomic_write_text(target, "{}")
+    assert target.read_text() == "{}" and [path.name for path in tmp_path.iterdir()] == [target.name]
+
+
+@pytest.mark.parametrize("kind", ["fifo", "loop"])
+def test_an_output_that_is_a_pipe_or_a_symlink_loop_is_refused(tmp_path: Path, kind: str) -> None:
+    import os
+
+    target = tmp_path / "out.json"
+    if kind == "fifo":
+        os.mkfifo(target)
+    else:
+        target.symlink_to(tmp_path / "other.json")
+        (tmp_path / "other.json").symlink_to(target)
+    with pytest.raises(InvalidArgument, match=r"cannot write there: it is a (pipe|symlink loop)"):
+        check_output_path(target)

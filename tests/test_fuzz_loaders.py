@@ -170,3 +170,14 @@ def test_the_seeds_of_the_fuzzer_are_valid(tmp_path: Path, document: dict[str, A
     file = tmp_path / "valid.json"
     file.write_text(json.dumps(document))
     unstack.validate(file)
+
+
+@pytest.mark.parametrize("reader", ["load", "validate"])
+def test_a_pipe_or_a_device_is_refused_without_reading_it(tmp_path: Path, reader: str) -> None:
+    import os
+
+    fifo = tmp_path / "pile.json"
+    os.mkfifo(fifo)  # opening it to read would wait for a writer forever
+    for path, kind in ((fifo, "a pipe"), (Path("/dev/zero"), "a device")):
+        with pytest.raises(UnstackError, match=f"{path}: \\$: expected a regular file, got {kind}"):
+            getattr(unstack, reader)(path)

@@ -102,8 +102,11 @@ def check_output_path(path: str | os.PathLike[str], *, inputs: Iterable[str | os
     unstack.errors.InvalidArgument: pile.json: cannot write there: it is the input file ./pile.json
     """
     from unstack.errors import InvalidArgument
+    from unstack.jsonio import special_file
 
     target = Path(path)
+    if special_file(target) is not None:  # a rename would replace a pipe or a device with a file
+        raise InvalidArgument(f"{path}: cannot write there: it is {special_file(target)}, not a regular file")
     for given in inputs:
         if given is not None and str(given) != "-" and _same_file(target, Path(given)):
             raise InvalidArgument(f"{path}: cannot write there: it is the input file {given}")
@@ -124,12 +127,15 @@ def _same_file(first: Path, second: Path) -> bool:
     try:
         return os.path.samefile(first, second)
     except OSError:
-        return first.resolve() == second.resolve()
+        return os.path.abspath(first) == os.path.abspath(second)  # no resolve(): a symlink loop raises there
 
 
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     """Yield a unique temporary path beside ``path``; on success it replaces ``path``.
+
+    The temporary name is short (``.unstack-XXXXXXXX.tmp`` and the target's suffix), so any
+    name the file system allows for ``path`` can be written.
 
     For writers that insist on a file name (``savefig``, ``np.save``): write to the yielded
     path; when the block ends without an exception the file is synced and renamed over
@@ -155,7 +161,7 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     """
     target = check_output_path(path)
     try:
-        handle, name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=f".tmp{target.suffix}", dir=target.parent)
+        handle, name = tempfile.mkstemp(prefix=".unstack-", suffix=f".tmp{target.suffix}", dir=target.parent)
     except OSError as error:  # a folder that looks writable but is not (/proc, a full disk)
         from unstack.errors import InvalidArgument
 

@@ -14,9 +14,11 @@ Examples
 
 from __future__ import annotations
 
+import errno
 import json
 import math
 import os
+import stat
 import sys
 from collections.abc import Callable, Iterable, Iterator
 from functools import cache
@@ -34,6 +36,8 @@ __all__ = [
     "format_json_path",
     "load_schema",
     "read_document",
+    "refuse_special_file",
+    "special_file",
     "validate_document",
 ]
 
@@ -186,6 +190,7 @@ def read_document(path: str | os.PathLike[str]) -> Document:
             raise InvalidFile(source, "$", f"cannot read standard input: {error}") from None
     else:
         file = Path(path)
+        refuse_special_file(file)
         if file.is_dir():
             raise InvalidFile(source, "$", "expected a JSON file, got a directory")
         try:
@@ -221,6 +226,38 @@ def read_document(path: str | os.PathLike[str]) -> Document:
     for bad in _find_non_finite(data, []):
         raise InvalidFile(source, format_json_path(bad), f"expected a finite number, got {_get(data, bad)}")
     return Document(data, source, base_dir, len(text))
+
+
+def special_file(path: str | os.PathLike[str]) -> str | None:
+    """What ``path`` names when it is there but no regular file or folder (reading it would block
+    or never end), in words; ``None`` for a file, a folder or nothing.
+
+    Examples
+    --------
+    >>> special_file("/dev/zero"), special_file("examples"), special_file("no-such-file")
+    ('a device', None, None)
+    """
+    try:
+        mode = os.stat(path).st_mode
+    except OSError as error:
+        return "a symlink loop" if error.errno == errno.ELOOP else None
+    if stat.S_ISREG(mode) or stat.S_ISDIR(mode):
+        return None
+    if stat.S_ISFIFO(mode):
+        return "a pipe (FIFO)"
+    return "a socket" if stat.S_ISSOCK(mode) else "a device"
+
+
+def refuse_special_file(path: str | os.PathLike[str], error: type[InvalidFile] = InvalidFile, **where: str) -> None:
+    """Raise ``error`` when ``path`` is a pipe, a device, a socket or a symlink loop.
+
+    ``where`` gives the error's ``source`` and ``json_path`` (default: the path and ``$``).
+    """
+    kind = special_file(path)
+    if kind is not None:
+        source = where.get("source", str(path))
+        named = "" if source == str(path) else f": {path}"
+        raise error(source, where.get("json_path", "$"), f"expected a regular file, got {kind}{named}")
 
 
 @cache

@@ -39,7 +39,7 @@ from unstack.checks import (
 from unstack.errors import InvalidScene
 from unstack.frozen import set_frozen_fields
 from unstack.geometry import overlapping_pairs
-from unstack.jsonio import Document, read_document, validate_document
+from unstack.jsonio import Document, read_document, refuse_special_file, validate_document
 
 __all__ = ["MAX_CLOUD_FILE_BYTES", "MAX_POINTS", "SCENE_FORMAT", "Box", "Scene", "load_points", "load_scene"]
 
@@ -164,6 +164,7 @@ def load_points(
         The file is missing, a directory, unreadable or not an N x 3 cloud.
     """
     file = Path(path)
+    refuse_special_file(file, InvalidScene, source=source, json_path=json_path)
     if file.is_dir():
         raise InvalidScene(source, json_path, f"expected a point cloud file, got the directory {str(file)!r}")
     if not file.exists():

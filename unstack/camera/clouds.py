@@ -34,6 +34,7 @@ from unstack.camera.build import CameraScene
 from unstack.camera.planes import gravity_frame
 from unstack.checks import check_quaternion_xyzw
 from unstack.errors import InvalidFile, UnstackError
+from unstack.jsonio import refuse_special_file
 from unstack.scene import Box, Scene
 
 __all__ = ["load_cloud", "load_detections", "scene_from_cloud"]
@@ -118,6 +119,7 @@ def load_cloud(path: str | os.PathLike[str]) -> np.ndarray:
     if file.suffix.lower() != ".pcd":
         cloud = np.asarray(load_points(file, source=str(file), json_path="$"))
         return cloud
+    refuse_special_file(file)
     if not file.is_file():
         raise InvalidFile(str(file), "$", "the point cloud file does not exist")
     size = file.stat().st_size
@@ -138,6 +140,7 @@ def load_detections(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
     than a box's are left out (with a warning)."""
     file = Path(path)
     source = str(file)
+    refuse_special_file(file)
     try:
         data = json.loads(file.read_text(encoding="utf-8"))
     except FileNotFoundError:

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from unstack.errors import InvalidFile
+from unstack.jsonio import refuse_special_file
 
 __all__ = ["DEPTH_UNITS", "MAX_DEPTH_M", "Intrinsics", "load_depth", "load_intrinsics", "load_mask", "load_pose"]
 
@@ -69,6 +70,7 @@ class Intrinsics:
 def _read_json(path: str | os.PathLike[str]) -> tuple[Any, str]:
     file = Path(path)
     source = str(file)
+    refuse_special_file(file)
     try:
         return json.loads(file.read_text(encoding="utf-8")), source
     except FileNotFoundError:
@@ -190,6 +192,7 @@ def load_depth(path: str | os.PathLike[str], *, units: str | None = None) -> np.
     """
     file = Path(path)
     source = str(file)
+    refuse_special_file(file)
     if not file.is_file():
         raise InvalidFile(source, "$", "the depth image does not exist")
     suffix = file.suffix.lower()
@@ -234,6 +237,7 @@ def load_mask(path: str | os.PathLike[str], shape: tuple[int, int] | None = None
     """Read an instance mask (a PNG, or a ``.npy`` array): True where the box is, of ``shape`` if given."""
     file = Path(path)
     source = str(file)
+    refuse_special_file(file)
     if not file.is_file():
         raise InvalidFile(source, "$", "the mask does not exist")
     try:

@@ -40,6 +40,7 @@ from threadpoolctl import ThreadpoolController
 
 from unstack.atomic import atomic_write_bytes
 from unstack.errors import InvalidFile
+from unstack.jsonio import refuse_special_file
 from unstack.learning.classifier import SupportClassifier
 from unstack.learning.features import FeatureSettings
 
@@ -290,6 +291,7 @@ def read_payload(path: str | os.PathLike[str], expected_format: str) -> dict[str
 
     source = str(path)
     target = Path(path)
+    refuse_special_file(target, InvalidModel)
     if target.is_dir():
         raise InvalidModel(source, "$", "expected a model file, got a directory")
     try:
