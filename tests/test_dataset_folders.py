@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from unstack.dataset_folders import MANIFEST, config_name, require_configurations
+from unstack.errors import UnstackError
 
 
 def data_set(folder: Path, finished: int, listed: int | None) -> Path:
@@ -16,7 +17,8 @@ def data_set(folder: Path, finished: int, listed: int | None) -> Path:
     for index in range(finished):
         (folder / f"{config_name(index)}.json").write_text("{}")
     if listed is not None:
-        (folder / MANIFEST).write_text(json.dumps({"format": "unstack.dataset/1", "configs": listed}))
+        manifest = {"format": "unstack.dataset/1", "seed": 0, "configs": listed, "settings": {}}
+        (folder / MANIFEST).write_text(json.dumps(manifest))
     return folder
 
 
@@ -37,10 +39,16 @@ def test_a_finished_data_set_or_one_without_a_manifest_is_read_silently(
         assert len(require_configurations(folder)) == finished
 
 
-@pytest.mark.parametrize("manifest", ["not json", '{"configs": "30"}', "[30]", '{"configs": true}'])
-def test_a_manifest_without_a_readable_count_leaves_the_check_to_its_reader(tmp_path: Path, manifest: str) -> None:
+@pytest.mark.parametrize(
+    ("manifest", "message"),
+    [
+        ("not json", r"manifest\.json: \$: invalid JSON"),
+        ('{"format": "unstack.dataset/1", "seed": 0, "configs": "30", "settings": {}}', r"\$\.configs"),
+        ("[30]", r"manifest\.json: \$: expected a JSON object"),
+    ],
+)
+def test_a_manifest_that_is_not_a_data_sets_is_refused(tmp_path: Path, manifest: str, message: str) -> None:
     folder = data_set(tmp_path, finished=1, listed=None)
     (folder / MANIFEST).write_text(manifest)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        assert len(require_configurations(folder)) == 1
+    with pytest.raises(UnstackError, match=message):
+        require_configurations(folder)

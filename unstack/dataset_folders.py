@@ -65,7 +65,8 @@ def require_configurations(folder: str | os.PathLike[str]) -> list[Path]:
 
     Warns (:class:`UserWarning`) when the folder's manifest lists more configurations than are
     finished: a simulation still running, or stopped, whose finished part would otherwise be
-    taken for the whole data set.
+    taken for the whole data set. A manifest that is not a valid ``unstack.dataset/1`` is an
+    error.
 
     Examples
     --------
@@ -77,7 +78,8 @@ def require_configurations(folder: str | os.PathLike[str]) -> list[Path]:
     files = list_configurations(folder)
     if not files:
         raise UnstackError(f"{folder}: expected a data set folder with config-NNNN.json scene files, found none")
-    listed = _listed_configurations(folder)
+    manifest = read_manifest(folder)  # a manifest there must be one (refused in one line, not passed over)
+    listed = None if manifest is None else manifest["configs"]
     if listed is not None and len(files) < listed:
         import warnings
 
@@ -87,18 +89,6 @@ def require_configurations(folder: str | os.PathLike[str]) -> list[Path]:
             stacklevel=2,
         )
     return files
-
-
-def _listed_configurations(folder: str | os.PathLike[str]) -> int | None:
-    """How many configurations the folder's manifest says the data set has (``None`` without a
-    readable count: the manifest itself is checked where it is read)."""
-    import json
-
-    try:
-        listed = json.loads((Path(folder) / MANIFEST).read_text(encoding="utf-8")).get("configs")
-    except (OSError, ValueError, AttributeError):
-        return None
-    return listed if isinstance(listed, int) and not isinstance(listed, bool) else None
 
 
 def read_manifest(folder: str | os.PathLike[str]) -> dict[str, Any] | None:

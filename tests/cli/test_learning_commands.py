@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import shutil
 from pathlib import Path
 
 import jsonschema
@@ -113,10 +114,13 @@ def test_decide_on_a_scene_with_a_given_model(model: Path) -> None:
             "Invalid value for '--r': 1 is not in the range x>=2",
         ),
         (["evaluate", "nope.skops", "examples"], "nope.skops: $: cannot read the model file"),
+        (["train", "{data}", "-o", "{tmp}/m.json"], "-o: expected a model file name ending in .skops, got"),
+        (["train", "{data}", "{data}/", "-o", "{tmp}/m.skops"], "the data set is given twice"),
+        (["train", "{data}", "-o", "{tmp}/m.skops", "--cv", "1"], "--cv: expected at least 2 cross-validation folds"),
     ],
 )
-def test_bad_input_is_one_line(arguments: list[str], message: str, tmp_path: Path) -> None:
-    result = unstack(*[argument.format(tmp=tmp_path) for argument in arguments])
+def test_bad_input_is_one_line(arguments: list[str], message: str, tmp_path: Path, small_dataset: Path) -> None:
+    result = unstack(*[argument.format(tmp=tmp_path, data=small_dataset) for argument in arguments])
     assert_one_line_error(result, message, nothing_written_in=tmp_path)
 
 
@@ -163,3 +167,15 @@ def test_no_statics_keeps_the_models_probabilities(tmp_path: Path) -> None:
 def test_no_statics_on_a_supports_file_is_one_line() -> None:
     result = unstack("decide", "examples/stack5.supports.json", "--no-statics")
     assert_one_line_error(result, "--no-statics applies to a scene file")
+
+
+def test_a_model_is_not_written_over_a_file_of_its_data_set(small_dataset: Path, tmp_path: Path) -> None:
+    data = tmp_path / "data"
+    shutil.copytree(small_dataset, data)
+    scene = sorted(data.glob("config-*.json"))[0]
+    target = scene.with_suffix(".skops")
+    target.write_bytes(scene.read_bytes())  # a data set file under a model's name
+    before = target.read_bytes()
+    result = unstack("train", str(data), "-o", str(target))
+    assert_one_line_error(result, f"{target}: cannot write there: it is the input file")
+    assert target.read_bytes() == before

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from sklearn.utils.estimator_checks import parametrize_with_checks
 
+from unstack.errors import InvalidArgument
 from unstack.learning.classifier import LEARNERS, SupportClassifier
 
 pytestmark = pytest.mark.slow  # scikit-learn's estimator checks and grid searches
@@ -113,3 +114,10 @@ def test_groups_must_match_the_rows(fixed_rng: np.random.Generator) -> None:
     features, labels = separable(fixed_rng)
     with pytest.raises(ValueError, match="groups has 3 labels for 160 rows"):
         SupportClassifier(cv=3, param_grid=SMALL_GRID).fit(features, labels, groups=[0, 1, 2])
+
+
+def test_too_few_of_a_class_for_the_folds_is_one_clear_error(fixed_rng: np.random.Generator) -> None:
+    labels = np.array([1, 1, 1] + [0] * 27)  # three SUPP: some fold's training part holds one or none
+    groups = np.arange(30) // 3  # ten piles of three relations, the SUPP all in the first
+    with pytest.raises(InvalidArgument, match="too few examples to cross-validate: the training part of fold"):
+        SupportClassifier(cv=3, param_grid=SMALL_GRID).fit(fixed_rng.normal(size=(30, 19)), labels, groups=groups)

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import os
+from pathlib import Path
 from typing import Any
 
 import click
@@ -106,6 +108,14 @@ def _examples(
         )  # fmt: skip
 
 
+def _files_in(folder: str) -> list[Path]:
+    """The files of a data set in its folder: the manifest and the configurations' scenes and
+    clouds (none when it is no folder: the folder is checked later)."""
+    if not Path(folder).is_dir():
+        return []
+    return [path for path in Path(folder).iterdir() if path.name.startswith("config-") or path.name == "manifest.json"]
+
+
 @click.command()
 @click.argument("data_dirs", nargs=-1, required=True, type=click.Path(file_okay=False))
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Model file to write.")
@@ -159,9 +169,19 @@ def train(
     from unstack.learning.model_file import save_model
     from unstack.learning.training import train_support_model, training_provenance
 
-    if r < 2 or isets < 1 or cv < 2 or jobs < 1 or not 0.0 <= validation_size < 1.0:
-        raise UnstackError("expected --r >= 2, --isets >= 1, --cv >= 2, --jobs >= 1 and 0 <= --validation-size < 1")
-    check_output_path(output)
+    if cv < 2:
+        raise UnstackError(f"--cv: expected at least 2 cross-validation folds, got {cv}")
+    if not 0.0 <= validation_size < 1.0:  # NaN too
+        raise UnstackError(f"--validation-size: expected a share from 0 up to (not including) 1, got {validation_size}")
+    if Path(output).suffix.lower() != ".skops":
+        raise UnstackError(f"-o: expected a model file name ending in .skops, got {output!r}")
+    resolved = [os.path.realpath(folder) for folder in data_dirs]
+    repeated = next(
+        (folder for folder, real in zip(data_dirs, resolved, strict=True) if resolved.count(real) > 1), None
+    )
+    if repeated is not None:
+        raise UnstackError(f"{repeated}: the data set is given twice (each pile would count twice)")
+    check_output_path(output, inputs=[path for folder in data_dirs for path in _files_in(folder)])
     settings = FeatureSettings(offset=offset, sigma=sigma, feature_set=feature_set)
     examples = _examples(data_dirs, r, isets, seed, jobs, settings, draw, vary_clouds, pose_noise)
     console = Console(stderr=as_json)

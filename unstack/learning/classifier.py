@@ -47,6 +47,7 @@ from sklearn.pipeline import Pipeline
 from sklearn.utils.multiclass import type_of_target, unique_labels
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from unstack.errors import InvalidArgument
 from unstack.learning.choices import LEARNERS
 
 __all__ = ["LEARNERS", "SupportClassifier", "default_grid", "fold_splitter", "make_learner"]
@@ -109,6 +110,22 @@ def fold_splitter(cv: int, y: np.ndarray, groups: np.ndarray | None, random_stat
         else StratifiedGroupKFold(folds, shuffle=True, random_state=random_state)
     )
     return splitter, folds, calibration_folds
+
+
+def _require_both_classes_in_every_fold(
+    splitter: Any, X: Any, y: np.ndarray, groups: np.ndarray | None, calibration_folds: int
+) -> None:
+    """Raise where a fold's training part holds fewer than ``calibration_folds`` examples of a
+    class: a fit there fails (the calibration inside it needs that many of each)."""
+    for fold, (train, _) in enumerate(splitter.split(X, y, groups)):
+        classes, counts = np.unique(y[train], return_counts=True)
+        if len(classes) < 2 or counts.min() < calibration_folds:
+            rarest = 0 if len(classes) < 2 else int(counts.min())
+            raise InvalidArgument(
+                f"too few examples to cross-validate: the training part of fold {fold + 1} holds {rarest} of a class "
+                f"(at least {calibration_folds} needed; {int(np.sum(y == y.max()))} SUPP of {len(y)} relations in "
+                "all); give more piles or more ISets, or fewer folds"
+            )
 
 
 class SupportClassifier(ClassifierMixin, BaseEstimator):
@@ -184,6 +201,7 @@ class SupportClassifier(ClassifierMixin, BaseEstimator):
         if group_labels is not None and len(group_labels) != len(y):
             raise ValueError(f"groups has {len(group_labels)} labels for {len(y)} rows")
         splitter, folds, calibration_folds = fold_splitter(self.cv, y, group_labels, self.random_state)
+        _require_both_classes_in_every_fold(splitter, X, y, group_labels, calibration_folds)
         search = GridSearchCV(
             make_learner(self.learner, self.random_state, calibration_folds=calibration_folds),
             self.param_grid or default_grid(self.learner),

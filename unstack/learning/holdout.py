@@ -34,6 +34,7 @@ import numpy as np
 from sklearn.base import clone
 from sklearn.model_selection import GroupShuffleSplit, cross_val_predict, train_test_split
 
+from unstack.errors import InvalidArgument
 from unstack.learning.classifier import SupportClassifier, fold_splitter
 
 __all__ = ["HoldoutResult", "evaluate_holdout", "holdout_split", "out_of_fold_probabilities"]
@@ -158,7 +159,9 @@ def evaluate_holdout(
         labels, groups=group_labels, validation_size=validation_size, random_state=classifier.random_state
     )
     if len(np.unique(labels[train])) < 2:
-        raise ValueError("the training part holds one class only; use more groups or a smaller validation_size")
+        raise InvalidArgument(
+            "the training part holds one class only; use more groups (piles) or a smaller validation_size"
+        )
     train_groups = None if group_labels is None else group_labels[train]
     fitted = clone(classifier).fit(features[train], labels[train], groups=train_groups)
     probabilities = fitted.predict_proba(features[held_out])[:, 1]
