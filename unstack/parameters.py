@@ -42,6 +42,9 @@ __all__ = [
     "DETECTOR_NOISE",
     "FOLDS",
     "ISET_SIZE",
+    "JOBS",
+    "MAX_CONFIGS",
+    "MAX_JOBS",
     "MISSED_SHARE",
     "OPTIONAL_COUNT",
     "SEED",
@@ -189,6 +192,12 @@ COUNT = Interval(int, 1)
 OPTIONAL_COUNT = Interval(int, 1, optional=True)
 #: A seed: a non-negative integer.
 SEED = Interval(int, 0)
+#: The most worker processes a call starts (beyond, a typing slip: each is a whole Python).
+MAX_JOBS = 256
+#: Worker processes: at least one, at most :data:`MAX_JOBS`.
+JOBS = Interval(int, 1, MAX_JOBS)
+#: The most configurations a simulated data set holds (the paper's largest has 200; beyond, a typing slip).
+MAX_CONFIGS = 100_000
 #: Boxes per ISet (the paper's r): at least two.
 ISET_SIZE = Interval(int, 2)
 #: Cross-validation folds: at least two.

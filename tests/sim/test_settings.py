@@ -43,7 +43,10 @@ def test_round_trip_through_json(sizes: str) -> None:
         ({"boxes": (-1, 5)}, r"settings\.boxes\[0\]: expected a number at least 1, got -1"),
         ({"boxes": (0, 0)}, r"settings\.boxes\[0\]: expected a number at least 1, got 0"),
         ({"boxes": (300, 400)}, r"400 boxes of size set 'paper2' do not fit a 2.0 x 2.35 x 2.39 m container"),
-        ({"container": Container(depth=0.2)}, r"do not fit a 0.2 m container"),
+        (
+            {"container": Container(depth=0.2)},
+            r"\(smallest edges 0\.3 m\) do not fit a 0\.2 x 2\.35 x 2\.39 m container",
+        ),
         ({"container": Container(depth=-1.0)}, r"settings\.container\.depth: expected a positive extent"),
         (
             {"container": Container(width=float("nan"))},
@@ -119,7 +122,9 @@ def test_settings_from_json_gives_left_out_keys_their_defaults() -> None:
 
 def test_settings_from_json_turns_a_refused_combination_into_a_path_error() -> None:
     data = {"sizes": "four", "container": {"depth": 0.2}}
-    with pytest.raises(InvalidScene, match=r"a\.json: \$\.metadata\.settings: boxes of size set 'four' do not fit"):
+    with pytest.raises(
+        InvalidScene, match=r"a\.json: \$\.metadata\.settings: boxes of size set 'four' \(smallest edges"
+    ):
         settings_from_json(data, source="a.json", path="$.metadata.settings", error=InvalidScene)
 
 

@@ -19,6 +19,7 @@ from unstack.errors import UnstackError
 from unstack.learning.choices import LEARNERS, SPLITS
 from unstack.learning.features import FEATURE_SETS
 from unstack.learning.training_data import ISET_DRAWS, dataset_examples
+from unstack.parameters import MAX_JOBS
 
 __all__ = ["evaluate", "load_support_model", "metrics_view", "probabilities", "scene_supports", "train"]
 
@@ -139,7 +140,7 @@ def _files_in(folder: str) -> list[Path]:
               show_default=True, help=FEATURES_HELP)  # fmt: skip
 @click.option("--offset", type=float, default=1.0, show_default=True, help="d: interest-point offset (m).")
 @click.option("--sigma", type=float, default=0.5, show_default=True, help="Width of the DBAF's Gaussian (m).")
-@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Parallel processes.")
+@click.option("--jobs", type=click.IntRange(1, MAX_JOBS), default=1, show_default=True, help="Parallel processes.")
 @click.option("--json", "as_json", is_flag=True, help="Print the training report as JSON.")
 def train(
     data_dirs: tuple[str, ...],
@@ -233,7 +234,7 @@ def train(
 @click.option("--pose-noise", type=constrained(dataset_examples, "pose_noise"), default=0.0, show_default=True,
               help="Score on boxes as a detector reports them: errors of this many metres (0 to 0.1).")  # fmt: skip
 @click.option("--seed", type=click.IntRange(min=0), default=1, show_default=True, help="Seed of the ISets.")
-@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True, help="Parallel processes.")
+@click.option("--jobs", type=click.IntRange(1, MAX_JOBS), default=1, show_default=True, help="Parallel processes.")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
 @click.option("--reliability", type=click.Path(dir_okay=False), default=None, help="Write a reliability diagram PNG.")
 def evaluate(

@@ -8,6 +8,7 @@ import click
 
 from unstack.cli.options import setting
 from unstack.errors import InvalidArgument, UnstackError
+from unstack.parameters import MAX_CONFIGS, MAX_JOBS
 from unstack.sim.settings import FAMILIES, SIZE_SETS, check_setting
 
 __all__ = ["parse_box_range", "simulate"]
@@ -32,7 +33,8 @@ def parse_box_range(text: str) -> tuple[int, int]:
 
 
 @click.command()
-@click.option("--configs", type=int, default=10, show_default=True, help="Configurations in the data set.")
+@click.option("--configs", type=click.IntRange(1, MAX_CONFIGS), default=10, show_default=True,
+              help="Configurations in the data set.")  # fmt: skip
 @click.option("--family", type=click.Choice(list(FAMILIES)), default="dropped", show_default=True,
               help="Pile family: " + "; ".join(f"{name}: {text}" for name, text in FAMILIES.items())
               + ". --boxes, --sizes, --depth and --width override the family's values.")  # fmt: skip
@@ -41,7 +43,8 @@ def parse_box_range(text: str) -> tuple[int, int]:
               help="Box size set (default: the family's).")  # fmt: skip
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Seed of the data set.")
 @click.option("--out", "out", required=True, type=click.Path(), help="Folder of the data set (created; resumable).")
-@click.option("--jobs", type=int, default=1, show_default=True, help="Worker processes on this machine.")
+@click.option("--jobs", type=click.IntRange(1, MAX_JOBS), default=1, show_default=True,
+              help="Worker processes on this machine.")  # fmt: skip
 @click.option("--scheduler", default=None, help="Address of a dask.distributed scheduler to run the tasks on.")
 @click.option("--depth", type=setting("Container.depth", float), default=None,
               help="Container section depth along x (m; default: the family's).")  # fmt: skip

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from unstack.experiments.dispatch import run_unordered
-from unstack.parameters import COUNT, MISSED_SHARE, OPTIONAL_COUNT, SEED, OneOf, validate_params
+from unstack.parameters import COUNT, JOBS, MISSED_SHARE, OPTIONAL_COUNT, SEED, OneOf, validate_params
 from unstack.scene import Scene
 from unstack.sim.belief import FILLS
 
@@ -83,7 +83,7 @@ def _calibrate_pile(path: Path, number: int, options: dict[str, Any]) -> tuple[i
 
 @validate_params({
     "piles": COUNT, "detector_misses": MISSED_SHARE, "worlds": OPTIONAL_COUNT, "max_picks": OPTIONAL_COUNT,
-    "seed": SEED, "n_jobs": COUNT, "fill": OneOf(FILLS), "view": OneOf(VIEWS),
+    "seed": SEED, "n_jobs": JOBS, "fill": OneOf(FILLS), "view": OneOf(VIEWS),
 })  # fmt: skip
 def belief_calibration(
     data_dir: str | os.PathLike[str],

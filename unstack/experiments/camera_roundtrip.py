@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from unstack.experiments.dispatch import run_unordered
-from unstack.parameters import COUNT, validate_params
+from unstack.parameters import COUNT, JOBS, validate_params
 
 __all__ = ["camera_roundtrip", "yaw_error_deg"]
 
@@ -94,7 +94,7 @@ def _roundtrip_pile(path: Path, number: int, model: Any, samples: int) -> tuple[
                     "masks": len(ids), "choices": choices}  # fmt: skip
 
 
-@validate_params({"piles": COUNT, "samples": COUNT, "n_jobs": COUNT})
+@validate_params({"piles": COUNT, "samples": COUNT, "n_jobs": JOBS})
 def camera_roundtrip(
     data_dir: str | os.PathLike[str],
     model: Any,

@@ -175,6 +175,7 @@ from unstack.experiments.dispatch import run_unordered
 from unstack.parameters import (
     COUNT,
     DETECTOR_NOISE,
+    JOBS,
     MISSED_SHARE,
     OPTIONAL_COUNT,
     OPTIONAL_SHARE,
@@ -685,7 +686,7 @@ def _pile_metrics(run: dict[str, Any]) -> dict[str, float]:
 
 @validate_params({
     "piles": COUNT, "detector_noise": DETECTOR_NOISE, "detector_misses": MISSED_SHARE, "reach": OneOf(REACH_RULES),
-    "max_picks": OPTIONAL_COUNT, "samples": COUNT, "seed": SEED, "n_jobs": COUNT, "occupancy": OPTIONAL_SHARE,
+    "max_picks": OPTIONAL_COUNT, "samples": COUNT, "seed": SEED, "n_jobs": JOBS, "occupancy": OPTIONAL_SHARE,
 })  # fmt: skip
 def container_experiment(
     data_dir: str | os.PathLike[str],

@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from unstack.experiments.dispatch import run_unordered
-from unstack.parameters import COUNT, OPTIONAL_COUNT, SEED, OneOf, validate_params
+from unstack.parameters import COUNT, JOBS, OPTIONAL_COUNT, SEED, OneOf, validate_params
 from unstack.scene import Scene
 
 __all__ = [
@@ -193,7 +193,7 @@ def _collect_pile(
         "piles": OPTIONAL_COUNT,
         "seed": SEED,
         "max_picks": OPTIONAL_COUNT,
-        "n_jobs": COUNT,
+        "n_jobs": JOBS,
         "behaviour": OneOf(BEHAVIOURS),
     }
 )
@@ -302,7 +302,7 @@ def state_rows(
     }
 
 
-@validate_params({"seed": SEED, "samples": COUNT, "n_jobs": COUNT})
+@validate_params({"seed": SEED, "samples": COUNT, "n_jobs": JOBS})
 def pick_table(
     states: str | os.PathLike[str],
     model: Any,

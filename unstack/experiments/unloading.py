@@ -45,7 +45,7 @@ from typing import Any
 import numpy as np
 
 from unstack.experiments.dispatch import run_unordered
-from unstack.parameters import COUNT, SEED, OneOf, validate_params
+from unstack.parameters import COUNT, JOBS, SEED, OneOf, validate_params
 from unstack.reasoner.costs import COSTS, DEFAULT_COST
 
 __all__ = [
@@ -215,7 +215,7 @@ def _run_pile(
 
 
 @validate_params({
-    "configs": COUNT, "seed": SEED, "cost": OneOf(COSTS), "n_jobs": COUNT,
+    "configs": COUNT, "seed": SEED, "cost": OneOf(COSTS), "n_jobs": JOBS,
 })  # fmt: skip
 def unloading_experiment(
     data_dir: str | os.PathLike[str],

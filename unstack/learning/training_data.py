@@ -28,7 +28,7 @@ import numpy as np
 
 from unstack.errors import UnstackError
 from unstack.learning.features import FeatureSettings, pair_features
-from unstack.parameters import COUNT, DETECTOR_NOISE, ISET_SIZE, validate_params
+from unstack.parameters import COUNT, DETECTOR_NOISE, ISET_SIZE, JOBS, validate_params
 from unstack.scene import Scene, load_scene
 from unstack.understanding.detector import detector_poses
 
@@ -245,7 +245,7 @@ def dataset_fingerprint(folder: str | os.PathLike[str]) -> str:
     return digest.hexdigest()
 
 
-@validate_params({**EXAMPLE_ARGUMENTS, "n_jobs": COUNT})
+@validate_params({**EXAMPLE_ARGUMENTS, "n_jobs": JOBS})
 def dataset_examples(
     folder: str | os.PathLike[str],
     *,

@@ -45,6 +45,7 @@ import numpy as np
 from unstack.atomic import atomic_save_array, atomic_write_text
 from unstack.dataset_folders import DATASET_FORMAT, MANIFEST, TIMINGS, config_name, list_configurations, read_manifest
 from unstack.errors import UnstackError
+from unstack.parameters import MAX_CONFIGS, MAX_JOBS
 from unstack.sim.configuration import SimulatedConfiguration, simulate_configuration
 from unstack.sim.settings import SimulationSettings, json_ready
 
@@ -268,10 +269,13 @@ def simulate_dataset(
     -------
     DatasetSummary
     """
-    if configs < 0:
-        raise UnstackError(f"configs must be a non-negative count, got {configs}")
-    if jobs < 1:
-        raise UnstackError(f"jobs must be at least 1, got {jobs}")
+    if not 1 <= configs <= MAX_CONFIGS:
+        raise UnstackError(f"configs must be from 1 to {MAX_CONFIGS:,}, got {configs}")
+    if not 1 <= jobs <= MAX_JOBS:
+        raise UnstackError(f"jobs must be from 1 to {MAX_JOBS}, got {jobs}")
+    if settings.boxes[0] < 2:
+        low, high = settings.boxes
+        raise UnstackError(f"boxes {low}-{high}: a pile of one box supports nothing; a data set needs at least 2")
     start = time.perf_counter()
     target = Path(folder)
     if target.exists() and not target.is_dir():

@@ -270,7 +270,10 @@ class SimulationSettings:
         if np.any(sizes.min(axis=1) > min(container.depth, container.width)) or np.any(
             sizes.min(axis=1) > container.height
         ):
-            raise InvalidSettings(f"boxes of size set {self.sizes!r} do not fit a {container.depth} m container")
+            raise InvalidSettings(
+                f"boxes of size set {self.sizes!r} (smallest edges {sizes.min(axis=1).min():g} m) do not fit a "
+                f"{container.depth:g} x {container.width:g} x {container.height:g} m container (depth x width x height)"
+            )
         capacity = self.capacity()
         if high > capacity:
             raise InvalidSettings(
