@@ -104,6 +104,8 @@ def check_output_path(path: str | os.PathLike[str], *, inputs: Iterable[str | os
     from unstack.errors import InvalidArgument
     from unstack.jsonio import special_file
 
+    if str(path) == "-":
+        raise InvalidArgument("-: expected a file name for the output (--json prints the document on standard output)")
     target = Path(path)
     if special_file(target) is not None:  # a rename would replace a pipe or a device with a file
         raise InvalidArgument(f"{path}: cannot write there: it is {special_file(target)}, not a regular file")
@@ -120,6 +122,33 @@ def check_output_path(path: str | os.PathLike[str], *, inputs: Iterable[str | os
     if not os.access(folder, os.W_OK):
         raise InvalidArgument(f"{path}: cannot write there: the folder {folder} is not writable")
     return target
+
+
+def check_folder_path(path: str | os.PathLike[str], what: str = "the results") -> Path:
+    """Check, before any work, that ``path`` is a folder or can be made one.
+
+    Raises
+    ------
+    InvalidArgument
+        ``path`` or a folder above it is a file.
+
+    Examples
+    --------
+    >>> check_folder_path("/dev/null/results")
+    Traceback (most recent call last):
+    ...
+    unstack.errors.InvalidArgument: /dev/null/results: expected a folder for the results, but /dev/null is a file
+    """
+    from unstack.errors import InvalidArgument
+
+    folder = Path(path)
+    for place in (folder, *folder.parents):
+        if place.exists() or place.is_symlink():
+            if not place.is_dir():
+                where = "got a file" if place == folder else f"but {place} is a file"
+                raise InvalidArgument(f"{path}: expected a folder for {what}, {where}")
+            break
+    return folder
 
 
 def _same_file(first: Path, second: Path) -> bool:

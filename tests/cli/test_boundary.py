@@ -316,3 +316,31 @@ def test_an_output_on_the_input_file_is_refused_and_the_input_kept(tmp_path: Pat
     result = unstack(command, str(given), "--output", str(tmp_path / "." / given.name))
     one_line_error(result, f"cannot write there: it is the input file {given}")
     assert given.read_text() == source.read_text()
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (
+            ["experiment", "container", "{data}", "--out", "{tmp}/r", "--makers", ","],
+            "--makers: expected decision makers",
+        ),
+        (
+            ["experiment", "container", "{data}", "--out", "{tmp}/r", "--disturbance", "examples/stack5.supports.json"],
+            "stack5.supports.json: $: expected an unstack model file",
+        ),
+        (["experiment", "decisions", "{tmp}/no-data", "--out", "{tmp}/r"], "expected a data set folder"),
+        (["experiment", "real7", "{data}", "--out", "{tmp}/a-file"], "{tmp}/a-file: expected a folder for the results"),
+        (["experiment", "fig5a", "{data}", "--out", "{tmp}/a-file/r"], "but {tmp}/a-file is a file"),
+        (["simulate", "--configs", "1", "--out", "{tmp}/a-file/d"], "but {tmp}/a-file is a file"),
+        (["decide", PILE5, "-o", "-"], "-: expected a file name for the output"),
+        (["render", "examples/scene3.json", "-o", "{tmp}/p.png", "--title", "T" * 201], "--title: expected one line"),
+    ],
+)
+def test_an_experiment_refuses_before_any_work_and_leaves_no_folder(
+    tmp_path: Path, small_dataset: Path, arguments: list[str], message: str
+) -> None:
+    (tmp_path / "a-file").write_text("")
+    result = unstack(*[argument.format(tmp=tmp_path, data=small_dataset) for argument in arguments])
+    one_line_error(result, message.format(tmp=tmp_path))
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["a-file"]

@@ -451,8 +451,14 @@ def container(
 
     require_configurations(data_dir)
     chosen = tuple(name.strip() for name in makers.split(",") if name.strip())
+    if not chosen:
+        raise UnstackError(f"--makers: expected decision makers separated by commas, got {makers!r}")
     model, name = load_model_option(model_path)
     container_policies(model, seed=seed, makers=chosen)  # an unknown maker is one line, before any work
+    if disturbance_path is not None:  # the moves maker reads it in every pile: a bad file is refused now
+        from unstack.learning.disturbance import load_disturbance_model
+
+        load_disturbance_model(disturbance_path)
     folder, result = _run_piles(
         container_experiment, scheduler, out, "container-piles", data_dir=data_dir, model=model, piles=piles,
         makers=chosen, detector_noise=detector_noise, detector_misses=detector_misses, reach=reach,
@@ -673,9 +679,15 @@ def pick_responses(
     undone). Which candidate is then taken: by default drawn (the probe's best, the highest, a
     random one); with --behaviour, a decision maker's pick.
     """
-    from unstack.cli.main import load_model_option
+    from unstack.cli.main import _warn, load_model_option
     from unstack.sim.dataset import scheduler_client
 
+    if disturbance_path is not None:  # read by a moves maker taking the picks; refused now, or said unused
+        from unstack.learning.disturbance import load_disturbance_model
+
+        load_disturbance_model(disturbance_path)
+        if behaviour == "mixed":
+            _warn(f"--disturbance {disturbance_path} is not used: the picks are drawn (--behaviour mixed)")
     model = None if behaviour == "mixed" else load_model_option(model_path)[0]
     with scheduler_client(scheduler) as client, progress_bar("piles") as report:
         summaries = collect_pick_responses(

@@ -43,8 +43,34 @@ data_dir_argument = click.argument("data_dir", type=click.Path(file_okay=False))
 
 
 def out_folder_option(help_text: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
-    """``--out``, the folder an experiment writes its results into; ``help_text`` names them."""
-    return click.option("--out", required=True, type=click.Path(), help=help_text)
+    """``--out``, the folder an experiment writes its results into; ``help_text`` names them.
+
+    Checked when the command line is read (a file there, or above it, is refused before any
+    work); a folder the run makes is removed again when the run fails with nothing in it.
+    """
+    return click.option("--out", required=True, type=click.Path(), help=help_text, callback=_new_results_folder)
+
+
+def _new_results_folder(ctx: click.Context, _: click.Parameter, value: str) -> str:
+    from unstack.atomic import check_folder_path
+
+    folder = check_folder_path(value)
+    if not folder.exists():
+        ctx.meta.setdefault(_NEW_FOLDERS, []).append(folder)
+    return value
+
+
+def _remove_empty_new_folders(ctx: click.Context) -> None:
+    """Remove the results folders this run made when it failed before writing a file in them."""
+    for folder in ctx.meta.pop(_NEW_FOLDERS, []):
+        if folder.is_dir() and not any(path.is_file() for path in folder.rglob("*")):
+            for inner in sorted((path for path in folder.rglob("*") if path.is_dir()), reverse=True):
+                inner.rmdir()
+            folder.rmdir()
+
+
+#: ``ctx.meta`` key of the results folders a run made.
+_NEW_FOLDERS = "unstack.new_results_folders"
 
 
 STATICS_HELP = (
@@ -99,8 +125,10 @@ class _Group(click.Group):
         try:
             return super().invoke(ctx)
         except UnstackError as error:
+            _remove_empty_new_folders(ctx)
             _fail(str(error))
         except OSError as error:
+            _remove_empty_new_folders(ctx)
             _fail(f"{getattr(error, 'filename', None) or ''}: {error.strerror or error}".lstrip(": "))
         return None
 

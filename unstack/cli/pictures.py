@@ -38,6 +38,15 @@ def _load(file: str) -> tuple[Any, Path]:
     return Supports.from_document(document), document.base_dir
 
 
+#: The longest title drawn (characters, one line): a longer one would stretch the picture.
+MAX_TITLE = 200
+
+
+def _check_title(title: str | None) -> None:
+    if title is not None and (len(title) > MAX_TITLE or "\n" in title):
+        raise UnstackError(f"--title: expected one line of at most {MAX_TITLE} characters, got {len(title)}")
+
+
 def _check_suffix(output: str, suffixes: tuple[str, ...]) -> None:
     from unstack.atomic import check_output_path
 
@@ -85,6 +94,7 @@ def render(
     from unstack.pictures.values import check_threshold
 
     _check_suffix(output, (".png", ".svg"))
+    _check_title(title)
     check_threshold(threshold)
     loaded, base_dir = _load(file)
     title = title or Path(file).name
@@ -100,6 +110,7 @@ def render(
         click.echo(f"{output}: support graph of {len(values.objects)} boxes; pick {values.choice}")
         return
     scene = loaded
+    camera = scene_camera(scene)  # the scene's settings are checked before any decision
     colour = colour or "cost"  # a scene always has detected boxes to decide on
     needs_decision = colour == "cost" or arrows or with_plan or decision_file is not None
     values = (
@@ -114,7 +125,7 @@ def render(
         output,
         values=values,
         colour=colour,
-        camera=scene_camera(scene),
+        camera=camera,
         point_labels=point_box_labels(scene, base_dir),
         threshold=threshold,
         arrows=arrows,
@@ -154,6 +165,7 @@ def view(
     import unstack
 
     _check_suffix(output, (".html", ".htm"))
+    _check_title(title)
     loaded, _ = _load(file)
     if isinstance(loaded, unstack.Supports):
         raise UnstackError(f"{file}: a supports file has no geometry to show in 3D; unstack render draws its graph")

@@ -23,7 +23,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from unstack.errors import UnstackError
+from unstack.atomic import check_folder_path
 
 __all__ = ["results_folder", "save_results"]
 
@@ -40,11 +40,9 @@ def results_folder(out: str | os.PathLike[str]) -> Path:
     >>> results_folder(afile)
     Traceback (most recent call last):
     ...
-    unstack.errors.UnstackError: ...afile: expected a folder for the results, got a file
+    unstack.errors.InvalidArgument: ...afile: expected a folder for the results, got a file
     """
-    folder = Path(out)
-    if folder.exists() and not folder.is_dir():
-        raise UnstackError(f"{out}: expected a folder for the results, got a file")
+    folder = check_folder_path(out)
     folder.mkdir(parents=True, exist_ok=True)
     return folder
 

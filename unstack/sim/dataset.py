@@ -42,7 +42,7 @@ from typing import Any
 
 import numpy as np
 
-from unstack.atomic import atomic_save_array, atomic_write_text
+from unstack.atomic import atomic_save_array, atomic_write_text, check_folder_path
 from unstack.dataset_folders import DATASET_FORMAT, MANIFEST, TIMINGS, config_name, list_configurations, read_manifest
 from unstack.errors import UnstackError
 from unstack.parameters import MAX_CONFIGS, MAX_JOBS
@@ -280,6 +280,7 @@ def simulate_dataset(
     target = Path(folder)
     if target.exists() and not target.is_dir():
         raise DatasetConflict(f"{target}: expected a folder for the data set, got a file")
+    check_folder_path(target, "the data set")
     manifest = read_manifest(target) if target.is_dir() else None
     if manifest is not None:
         _check_same_dataset(target, manifest, settings, seed)
