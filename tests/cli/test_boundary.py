@@ -344,3 +344,19 @@ def test_an_experiment_refuses_before_any_work_and_leaves_no_folder(
     result = unstack(*[argument.format(tmp=tmp_path, data=small_dataset) for argument in arguments])
     one_line_error(result, message.format(tmp=tmp_path))
     assert sorted(path.name for path in tmp_path.iterdir()) == ["a-file"]
+
+
+def test_a_run_with_standard_output_closed_fails_instead_of_losing_the_result() -> None:
+    import os
+
+    result = subprocess.run(
+        [sys.executable, "-m", "unstack", "decide", PILE5, "--json"],
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=REPO,
+        preexec_fn=lambda: os.close(1),  # the child starts with no standard output
+        timeout=120,
+    )
+    assert result.returncode == 2 and result.stderr == (
+        "unstack: error: standard output is closed: nothing could be printed; redirect it to a file or to /dev/null\n"
+    )

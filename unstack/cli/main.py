@@ -124,6 +124,8 @@ class _Group(click.Group):
     def invoke(self, ctx: click.Context) -> Any:
         try:
             return super().invoke(ctx)
+        except BrokenPipeError:  # the reader stopped (| head): quiet, as other tools are
+            _quiet_broken_pipe()
         except UnstackError as error:
             _remove_empty_new_folders(ctx)
             _fail(str(error))
@@ -443,12 +445,22 @@ def _warning_line(message: Warning | str, category: type[Warning], *_: object, *
     _warn(str(message))
 
 
+def _quiet_broken_pipe() -> None:
+    """Leave quietly with exit code 1 when the reader of standard output has gone (Python's recipe:
+    standard output is pointed at the null device, so the flush at exit raises nothing)."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
+    sys.exit(1)
+
+
 def main() -> None:
     """Console-script entry point."""
     import warnings
 
     warnings.showwarning = _warning_line
     _WARNED.clear()  # once per run of the command, also when it is run again in one process
+    if sys.stdout is None:  # started with standard output closed (>&-): every result would be lost
+        _fail("standard output is closed: nothing could be printed; redirect it to a file or to /dev/null")
     try:
         status = cli.main(prog_name="unstack", standalone_mode=False)
     except click.exceptions.NoArgsIsHelpError as error:  # bare "unstack": the help, as click shows it
