@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import json
 import math
+import os
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -54,7 +55,7 @@ def _check_outputs(target: Path, report_file: str | None, inputs: list[str | Non
         outputs.append(Path(report_file))
     for output in outputs:
         check_output_path(output, inputs=inputs)
-    resolved = [output.resolve() for output in outputs]
+    resolved = [os.path.realpath(output) for output in outputs]
     if len(set(resolved)) != len(resolved):
         raise UnstackError(f"--report: {report_file} is also where the scene (or its cloud) goes; give another file")
 

@@ -123,7 +123,8 @@ def _require_both_classes_in_every_fold(
             rarest = 0 if len(classes) < 2 else int(counts.min())
             raise InvalidArgument(
                 f"too few examples to cross-validate: the training part of fold {fold + 1} holds {rarest} of a class "
-                f"(at least {calibration_folds} needed; {int(np.sum(y == y.max()))} SUPP of {len(y)} relations in "
+                f"(at least {calibration_folds} needed; {int(np.unique(y, return_counts=True)[1].min())} of the rarer "
+                f"class among {len(y)} relations in "
                 "all); give more piles or more ISets, or fewer folds"
             )
 
