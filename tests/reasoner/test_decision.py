@@ -246,3 +246,14 @@ def test_a_sample_budget_for_a_method_that_counts_every_world_is_refused(method:
     with pytest.raises(InvalidArgument, match=f"samples: method '{method}' samples nothing"):
         decide(supports, method=method, samples=100)
     assert unloading_plan(supports, method=method).order == ["a", "b"]
+
+
+@pytest.mark.parametrize("method", ["exact", "sat"])
+def test_a_time_limit_for_a_method_that_cannot_stop_early_is_refused(method: str) -> None:
+    with pytest.raises(InvalidArgument, match=f"time_limit: method '{method}' counts every world and cannot stop"):
+        decide(Supports(["a", "b"], [[0, 0.2], [0.7, 0]]), method=method, time_limit=0.001)
+
+
+def test_a_progress_that_cannot_be_called_is_refused_before_any_step() -> None:
+    with pytest.raises(InvalidArgument, match="progress must be a callable progress\\(done, total\\), got int"):
+        unloading_plan(Supports(["a", "b"], [[0, 0.2], [0.7, 0]]), progress=42)  # type: ignore[arg-type]

@@ -725,6 +725,7 @@ def container_experiment(
     from unstack.atomic import atomic_write_text
     from unstack.dataset_folders import require_configurations
     from unstack.experiments.decisions import paired_difference
+    from unstack.experiments.outputs import stored_result
 
     container_policies(model, seed=seed, makers=makers)  # unknown makers fail before any work
     if disturbance is not None and not isinstance(disturbance, str | os.PathLike):
@@ -755,12 +756,9 @@ def container_experiment(
     def finished(number: int, path: Path) -> dict[str, Any] | None:
         if folder is None:
             return None
-        try:
-            stored = json.loads((folder / f"{path.stem}.json").read_text())
-        except (OSError, ValueError):
-            return None
-        result: dict[str, Any] | None = stored.get("result") if stored.get("key") == key(number, path) else None
-        return result
+        result = stored_result(folder / f"{path.stem}.json", key(number, path))
+        runs = None if result is None else result.get("runs")
+        return result if isinstance(runs, dict) and all(isinstance(runs.get(maker), dict) for maker in makers) else None
 
     results: list[dict[str, Any] | None] = [finished(number, path) for number, path in enumerate(files)]
     todo = [number for number, result in enumerate(results) if result is None]

@@ -83,3 +83,28 @@ def save_results(
         plot(result, path)
         written.append(path)
     return written
+
+
+def stored_result(path: Path, key: dict[str, Any]) -> dict[str, Any] | None:
+    """The result a checkpoint file holds for ``key``: ``None`` when the file is missing, damaged
+    (not JSON, or not ``{"key": ..., "result": {...}}``) or of another run -- the pile is then run again.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> path = Path(tempfile.mkdtemp()) / "pile.json"
+    >>> _ = path.write_text("null")
+    >>> stored_result(path, {"seed": 0}) is None
+    True
+    >>> _ = path.write_text('{"key": {"seed": 0}, "result": {"runs": {}}}')
+    >>> stored_result(path, {"seed": 0})
+    {'runs': {}}
+    """
+    try:
+        stored = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(stored, dict) or stored.get("key") != key or not isinstance(stored.get("result"), dict):
+        return None
+    result: dict[str, Any] = stored["result"]
+    return result

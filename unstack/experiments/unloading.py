@@ -185,17 +185,13 @@ def _pile_key(path: Path, model: Any, settings: DecisionSettings, closed_loop: b
 
 def _finished_pile(checkpoints: Path | None, key: dict[str, Any]) -> dict[str, Any] | None:
     """The stored result of a pile run with the same key, if any (a damaged file is redone)."""
-    import json
 
     if checkpoints is None:
         return None
-    stored = checkpoints / f"{Path(key['scene']).stem}.json"
-    try:
-        document = json.loads(stored.read_text())
-    except (OSError, ValueError):
-        return None
-    result: dict[str, Any] | None = document.get("result") if document.get("key") == key else None
-    return result
+    from unstack.experiments.outputs import stored_result
+
+    result = stored_result(checkpoints / f"{Path(key['scene']).stem}.json", key)
+    return result if result is not None and isinstance(result.get("runs"), dict) else None
 
 
 def _run_pile(

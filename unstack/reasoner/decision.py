@@ -554,6 +554,11 @@ def decide(
         check_count(max_boxes, "max_boxes")
     if time_limit is not None:
         time_limit = check_budget(time_limit, "time_limit")
+        if method in UNSAMPLED_METHODS:
+            raise InvalidArgument(
+                f"time_limit: method {method!r} counts every world and cannot stop early (use method 'auto', which "
+                "samples what the limit does not allow to count)"
+            )
     if samples is not None:
         samples = check_samples(samples)
         if method in UNSAMPLED_METHODS:

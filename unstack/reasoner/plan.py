@@ -25,6 +25,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from unstack.errors import InvalidArgument
 from unstack.reasoner.costs import DEFAULT_COST
 from unstack.reasoner.decision import UNSAMPLED_METHODS, Decision, decide
 from unstack.reasoner.reuse import WorkCache
@@ -167,6 +168,8 @@ def unloading_plan(
     >>> unloading_plan(Supports(["a", "b"], [[0, 0.2], [0.7, 0]])).order
     ['a', 'b']
     """
+    if progress is not None and not callable(progress):
+        raise InvalidArgument(f"progress must be a callable progress(done, total), got {type(progress).__name__}")
     remaining = list(supports.objects) if isinstance(supports, Supports) else []
     steps: list[PlanStep] = []
     work = WorkCache()
