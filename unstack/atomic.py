@@ -107,8 +107,9 @@ def check_output_path(path: str | os.PathLike[str], *, inputs: Iterable[str | os
     if str(path) == "-":
         raise InvalidArgument("-: expected a file name for the output (--json prints the document on standard output)")
     target = Path(path)
-    if special_file(target) is not None:  # a rename would replace a pipe or a device with a file
-        raise InvalidArgument(f"{path}: cannot write there: it is {special_file(target)}, not a regular file")
+    kind = special_file(target)
+    if kind is not None:  # a rename would replace a pipe or a device with a file
+        raise InvalidArgument(f"{path}: cannot write there: it is {kind}, not a regular file")
     for given in inputs:
         if given is not None and str(given) != "-" and _same_file(target, Path(given)):
             raise InvalidArgument(f"{path}: cannot write there: it is the input file {given}")

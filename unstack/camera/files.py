@@ -93,7 +93,7 @@ def load_intrinsics(path: str | os.PathLike[str]) -> Intrinsics:
     values = {}
     for name in INTRINSICS_KEYS:
         if name not in data:
-            raise InvalidFile(source, "$", f"missing required key {name!r} (expected fx, fy, cx, cy, width, height)")
+            raise InvalidFile(source, "$", f"missing required key {name!r} (expected {', '.join(INTRINSICS_KEYS)})")
         value = data[name]
         if isinstance(value, bool) or not isinstance(value, int | float) or not np.isfinite(value) or value <= 0:
             raise InvalidFile(source, f"$.{name}", f"expected a positive number of pixels, got {value!r}")
@@ -119,7 +119,7 @@ def load_intrinsics(path: str | os.PathLike[str]) -> Intrinsics:
             )
     ignored = sorted(str(key) for key in data if key not in INTRINSICS_KEYS and str(key).lower() not in DISTORTION_KEYS)
     if ignored:
-        warnings.warn(f"{source}: keys passed over (a pinhole camera needs only fx, fy, cx, cy, width, height): "
+        warnings.warn(f"{source}: keys passed over (a pinhole camera needs only {', '.join(INTRINSICS_KEYS)}): "
                       f"{', '.join(ignored)}", stacklevel=2)  # fmt: skip
     return Intrinsics(
         values["fx"], values["fy"], values["cx"], values["cy"], int(values["width"]), int(values["height"])

@@ -112,9 +112,11 @@ def _examples(
 def _files_in(folder: str) -> list[Path]:
     """The files of a data set in its folder: the manifest and the configurations' scenes and
     clouds (none when it is no folder: the folder is checked later)."""
+    from unstack.dataset_folders import MANIFEST
+
     if not Path(folder).is_dir():
         return []
-    return [path for path in Path(folder).iterdir() if path.name.startswith("config-") or path.name == "manifest.json"]
+    return [path for path in Path(folder).iterdir() if path.name.startswith("config-") or path.name == MANIFEST]
 
 
 @click.command()

@@ -185,7 +185,6 @@ def _pile_key(path: Path, model: Any, settings: DecisionSettings, closed_loop: b
 
 def _finished_pile(checkpoints: Path | None, key: dict[str, Any]) -> dict[str, Any] | None:
     """The stored result of a pile run with the same key, if any (a damaged file is redone)."""
-
     if checkpoints is None:
         return None
     from unstack.experiments.outputs import stored_result
