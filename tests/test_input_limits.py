@@ -99,3 +99,34 @@ def test_the_cli_refuses_a_document_above_the_limit_with_exit_2(tmp_path: Path) 
     for command in ("decide", "validate"):
         result = unstack_cli(command, str(huge))
         assert_one_line_error(result, "at most 64.0 MiB")
+
+
+@pytest.mark.parametrize(
+    ("limit", "lines"),
+    [(10_000, 25), (200, 1)],
+    ids=["indented-when-it-fits", "one-line-when-indented-is-too-large"],
+)
+def test_written_documents_stay_within_what_unstack_reads_back(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, limit: int, lines: int
+) -> None:
+    supports = unstack.Supports(["a", "b", "c"], [[0, 0.25, 0.5], [0.125, 0, 0.75], [0.5, 0.5, 0]])
+    monkeypatch.setattr(jsonio, "MAX_DOCUMENT_BYTES", limit)
+    supports.save(tmp_path / "s.json")
+    text = (tmp_path / "s.json").read_text()
+    assert len(text) <= limit and len(text.splitlines()) == lines
+    assert unstack.load(tmp_path / "s.json").probabilities.tolist() == supports.probabilities.tolist()
+
+
+def test_a_document_too_large_even_on_one_line_is_not_written(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    points = np.zeros((50, 3))
+    cloud_scene = unstack.Scene([scene.Box("a", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2])], points, ["a"])
+    monkeypatch.setattr(jsonio, "MAX_DOCUMENT_BYTES", 200)
+    with pytest.raises(
+        unstack.errors.InvalidArgument,
+        match=r"big.json: the JSON would be 0.0 MiB even without indentation, more than the 0.0 MiB unstack reads "
+        r"back; nothing was written; save the cloud to a .npy file beside it \(points_file\)",
+    ):
+        cloud_scene.save(tmp_path / "big.json")
+    assert list(tmp_path.iterdir()) == []
+    cloud_scene.save(tmp_path / "small.json", points_file="small.npy")
+    assert unstack.load(tmp_path / "small.json").points.shape == (50, 3)

@@ -33,6 +33,7 @@ __all__ = [
     "MAX_DEPTH",
     "MAX_DOCUMENT_BYTES",
     "Document",
+    "document_text",
     "format_json_path",
     "load_schema",
     "read_document",
@@ -150,6 +151,49 @@ def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
 def _mib(size: int) -> str:
     """A byte count in MiB for a message."""
     return f"{size / 2**20:,.1f} MiB"
+
+
+def document_text(document: dict[str, Any], target: str = "the document", advice: str = "") -> str:
+    """The JSON text of ``document`` as unstack writes it: indented, or on one line when the
+    indented text would be larger than unstack reads back (:data:`MAX_DOCUMENT_BYTES`).
+
+    Parameters
+    ----------
+    document : dict
+        A JSON-serialisable document.
+    target : str
+        Where the text goes, for the message.
+    advice : str
+        What to do instead, ending the message when the text is too large.
+
+    Returns
+    -------
+    str
+        The text, ending in a newline.
+
+    Raises
+    ------
+    InvalidArgument
+        Even on one line the text is larger than :data:`MAX_DOCUMENT_BYTES`: a file nobody could
+        read back is not written.
+
+    Examples
+    --------
+    >>> document_text({"format": "unstack.supports/1", "objects": ["a"]})
+    '{\\n  "format": "unstack.supports/1",\\n  "objects": [\\n    "a"\\n  ]\\n}\\n'
+    """
+    text = json.dumps(document, indent=2) + "\n"
+    if len(text) <= MAX_DOCUMENT_BYTES:  # characters: the JSON is ASCII
+        return text
+    text = json.dumps(document, separators=(",", ":")) + "\n"
+    if len(text) <= MAX_DOCUMENT_BYTES:
+        return text
+    from unstack.errors import InvalidArgument
+
+    raise InvalidArgument(
+        f"{target}: the JSON would be {_mib(len(text))} even without indentation, more than the "
+        f"{_mib(MAX_DOCUMENT_BYTES)} unstack reads back; nothing was written{'; ' + advice if advice else ''}"
+    )
 
 
 def read_document(path: str | os.PathLike[str]) -> Document:

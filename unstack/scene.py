@@ -15,7 +15,6 @@ Examples
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -347,11 +346,15 @@ class Scene:
 
     def save(self, path: str | os.PathLike[str], *, points_file: str | None = None) -> None:
         """Write the scene atomically; with ``points_file`` the cloud goes to that ``.npy`` beside it."""
+        from unstack.jsonio import document_text
+
         target = Path(path)
+        advice = "" if points_file else "save the cloud to a .npy file beside it (points_file)"
+        text = document_text(self.to_dict(points_file), str(target), advice)
         if points_file is not None:
             cloud_path = target.parent / points_file
             atomic_save_array(cloud_path, self.points)
-        atomic_write_text(target, json.dumps(self.to_dict(points_file), indent=2) + "\n")
+        atomic_write_text(target, text)
 
     @classmethod
     def from_document(cls, document: Document) -> Scene:

@@ -13,7 +13,6 @@ Examples
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -204,7 +203,9 @@ class Supports:
 
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write the ``unstack.supports/1`` file atomically."""
-        atomic_write_text(path, json.dumps(self.to_dict(), indent=2) + "\n")
+        from unstack.jsonio import document_text
+
+        atomic_write_text(path, document_text(self.to_dict(), str(path)))
 
     @classmethod
     def from_document(cls, document: Document) -> Supports:

@@ -286,6 +286,7 @@ def evaluate(
 def probabilities(scene_file: str, model_path: str | None, output: str | None, statics: bool) -> None:
     """Support probabilities of a scene's detected boxes, as unstack.supports/1 JSON."""
     from unstack.atomic import atomic_write_text, check_output_path
+    from unstack.jsonio import document_text
     from unstack.scene import load_scene
 
     if output:
@@ -293,7 +294,7 @@ def probabilities(scene_file: str, model_path: str | None, output: str | None, s
     supports = scene_supports(load_scene(scene_file), model_path, statics)
     for line in supports.metadata.get("warnings", []):
         click.echo(f"unstack: warning: {line}", err=True)
-    text = json.dumps(supports.to_dict(), indent=2) + "\n"
+    text = document_text(supports.to_dict(), output or "standard output")
     if output:
         atomic_write_text(output, text)
     else:

@@ -13,7 +13,6 @@ from __future__ import annotations
 import contextlib
 import functools
 import importlib
-import json
 import os
 import sys
 import time
@@ -144,25 +143,25 @@ def _check_output(path: str | None, source: str) -> None:
         check_output_path(path, inputs=[source])
 
 
-def _write_output(path: str | None, document: dict[str, Any]) -> None:
-    if path is None:
-        return
-    from unstack.atomic import atomic_write_text
-
-    atomic_write_text(path, json.dumps(document, indent=2) + "\n")
-
-
 def _deliver(
     document: dict[str, Any], output: str | None, as_json: bool, view: str, *shown: Any, warnings: tuple[str, ...] = ()
 ) -> None:
     """Write ``--output``, print the warnings, then the JSON or the view of :mod:`unstack.cli.render` named ``view``.
 
-    The view's module (rich tables) is imported only when the view is printed.
+    The JSON is indented unless that would make it larger than unstack reads back
+    (:func:`unstack.jsonio.document_text`). The view's module (rich tables) is imported only when
+    the view is printed.
     """
-    _write_output(output, document)
+    from unstack.jsonio import document_text
+
+    text = document_text(document, output or "--json") if output is not None or as_json else ""
+    if output is not None:
+        from unstack.atomic import atomic_write_text
+
+        atomic_write_text(output, text)
     _print_warnings(warnings)
     if as_json:
-        click.echo(json.dumps(document, indent=2))
+        click.echo(text, nl=False)
         return
     from rich.console import Console
 
