@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 import threading
 from pathlib import Path
 
@@ -14,6 +16,7 @@ from unstack.atomic import (
     atomic_write,
     atomic_write_text,
     check_output_path,
+    folder_writer,
     process_umask,
 )
 from unstack.errors import InvalidArgument
@@ -95,3 +98,27 @@ def test_an_output_that_is_a_pipe_or_a_symlink_loop_is_refused(tmp_path: Path, k
         (tmp_path / "other.json").symlink_to(target)
     with pytest.raises(InvalidArgument, match=r"cannot write there: it is a (pipe|symlink loop)"):
         check_output_path(target)
+
+
+def test_a_folder_writer_excludes_a_second_writer_and_leaves_no_lock(tmp_path: Path) -> None:
+    held = r"another unstack run \(pid \d+\) is writing results in this folder"
+    second = folder_writer(tmp_path, "results")
+    with folder_writer(tmp_path, "results"), pytest.raises(InvalidArgument, match=held), second:
+        pass
+    assert list(tmp_path.iterdir()) == []
+    with folder_writer(tmp_path, "results"):  # free again once the block ended
+        pass
+
+
+def test_the_lock_of_a_killed_writer_does_not_hold(tmp_path: Path) -> None:
+    holder = (
+        "import os, sys; from unstack.atomic import folder_writer\n"
+        f"with folder_writer({str(tmp_path)!r}, 'results'):\n"
+        "    print('held', flush=True); os.kill(os.getpid(), 9)"
+    )
+    killed = subprocess.run([sys.executable, "-c", holder], capture_output=True, text=True, timeout=60)
+    assert killed.stdout == "held\n" and killed.returncode == -9
+    assert [path.name for path in tmp_path.iterdir()] == [".unstack-writer.lock"]
+    with folder_writer(tmp_path, "results"):
+        pass
+    assert list(tmp_path.iterdir()) == []

@@ -37,8 +37,12 @@ __all__ = [
     "atomic_write_bytes",
     "atomic_write_text",
     "check_output_path",
+    "folder_writer",
     "process_umask",
 ]
+
+#: The lock file a run writing a folder holds (:func:`folder_writer`); removed when the run ends.
+LOCK_NAME = ".unstack-writer.lock"
 
 
 def process_umask() -> int:
@@ -296,3 +300,72 @@ def atomic_save_figure(figure: Any, path: str | os.PathLike[str], *, dpi: int = 
     suffix = Path(path).suffix.lstrip(".").lower() or "png"
     with atomic_path(path) as temporary:
         figure.savefig(temporary, dpi=dpi, format=suffix, **savefig)
+
+
+@contextlib.contextmanager
+def folder_writer(folder: str | os.PathLike[str], what: str, error: type[Exception] | None = None) -> Iterator[Path]:
+    """Hold ``folder``'s writer lock while the block runs: a second unstack run writing the
+    same folder at the same time is refused instead of redoing the work and mixing its files.
+
+    The lock is an advisory ``flock`` on :data:`LOCK_NAME` in the folder (made if missing),
+    released by the system when the process ends however it ends, so a killed run leaves no lock
+    that holds; the file is removed when the block ends. Where the system has no ``flock``
+    (Windows), nothing is locked.
+
+    Parameters
+    ----------
+    folder : path-like
+        The folder the run writes.
+    what : str
+        What the run writes there, for the message ("a data set").
+    error : exception type, optional
+        Raised when another run holds the lock (default :class:`~unstack.errors.InvalidArgument`).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> with folder_writer(folder, "a data set"):
+    ...     with folder_writer(folder, "a data set"):
+    ...         pass
+    Traceback (most recent call last):
+    ...
+    unstack.errors.InvalidArgument: ...: another unstack run (pid ...) is writing a data set in this folder; ...
+    >>> list(folder.iterdir())
+    []
+    """
+    from unstack.errors import InvalidArgument
+
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - no POSIX locks on this system
+        yield Path(folder)
+        return
+    target = Path(folder)
+    path = target / LOCK_NAME
+    while True:
+        try:
+            handle = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as failure:
+            raise InvalidArgument(f"{target}: cannot write there: {failure.strerror}") from None
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            holder = os.read(handle, 32).decode("ascii", "replace").strip()
+            os.close(handle)
+            pid = f" (pid {holder})" if holder.isdigit() else ""
+            raise (error or InvalidArgument)(
+                f"{target}: another unstack run{pid} is writing {what} in this folder; wait for it to end"
+            ) from None
+        with contextlib.suppress(OSError):
+            if os.stat(path).st_ino == os.fstat(handle).st_ino:
+                break  # the file locked is still the one named: the lock holds
+        os.close(handle)  # the holder before us removed it meanwhile: lock the new one
+    try:
+        os.ftruncate(handle, 0)
+        os.write(handle, str(os.getpid()).encode("ascii"))
+        yield target
+    finally:
+        with contextlib.suppress(OSError):
+            path.unlink()
+        os.close(handle)

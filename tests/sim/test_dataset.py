@@ -124,3 +124,16 @@ def test_kill_minus_nine_loses_only_configurations_in_flight(tmp_path: Path) -> 
     uninterrupted = tmp_path / "whole"
     subprocess.run([*command[:-3], str(uninterrupted), "--jobs", "1"], check=True, capture_output=True)
     assert digests(folder) == digests(uninterrupted)
+
+
+def test_a_second_run_on_a_folder_being_written_is_refused(tmp_path: Path) -> None:
+    from unstack.atomic import folder_writer
+
+    with (
+        folder_writer(tmp_path, "a data set"),
+        pytest.raises(
+            DatasetConflict, match=rf"another unstack run \(pid {os.getpid()}\) is writing a data set in this folder"
+        ),
+    ):
+        simulate_dataset(tmp_path, small_settings(), configs=1, seed=21)
+    assert list_configurations(tmp_path) == [] and read_manifest(tmp_path) is None

@@ -725,7 +725,7 @@ def container_experiment(
     from unstack.atomic import atomic_write_text
     from unstack.dataset_folders import require_configurations
     from unstack.experiments.decisions import paired_difference
-    from unstack.experiments.outputs import stored_result
+    from unstack.experiments.outputs import checkpoint_folder, stored_result
 
     container_policies(model, seed=seed, makers=makers)  # unknown makers fail before any work
     if disturbance is not None and not isinstance(disturbance, str | os.PathLike):
@@ -737,9 +737,6 @@ def container_experiment(
         disturbance_digest = hashlib.sha256(disturbance_path.read_bytes()).hexdigest()
     files = require_configurations(data_dir)[:piles]
     model_digest = hashlib.sha256(json.dumps(model.metadata, sort_keys=True, default=str).encode()).hexdigest()
-    folder = None if checkpoints is None else Path(checkpoints)
-    if folder is not None:
-        folder.mkdir(parents=True, exist_ok=True)
     settings = {"detector_noise": detector_noise, "detector_misses": detector_misses, "reach": reach,
                 "max_picks": max_picks, "samples": samples, "occupancy": occupancy}  # fmt: skip
 
@@ -760,20 +757,23 @@ def container_experiment(
         runs = None if result is None else result.get("runs")
         return result if isinstance(runs, dict) and all(isinstance(runs.get(maker), dict) for maker in makers) else None
 
-    results: list[dict[str, Any] | None] = [finished(number, path) for number, path in enumerate(files)]
-    todo = [number for number, result in enumerate(results) if result is None]
-    if progress is not None:
-        progress(len(files) - len(todo), len(files))
-    options = {**settings, "disturbance": None if disturbance is None else str(disturbance)}
-    arguments = [(files[number], number, model, makers, {**options, "seed": seed + number}) for number in todo]
-    running: Iterator[tuple[int, dict[str, Any]]] = run_unordered(_run_pile, arguments, n_jobs=n_jobs, client=client)
-    for number, pile in running:
-        results[number] = pile
-        if folder is not None:
-            stored = {"key": key(number, files[number]), "result": pile}
-            atomic_write_text(folder / f"{files[number].stem}.json", json.dumps(stored) + "\n")
+    with checkpoint_folder(checkpoints) as folder:
+        results: list[dict[str, Any] | None] = [finished(number, path) for number, path in enumerate(files)]
+        todo = [number for number, result in enumerate(results) if result is None]
         if progress is not None:
-            progress(sum(result is not None for result in results), len(files))
+            progress(len(files) - len(todo), len(files))
+        options = {**settings, "disturbance": None if disturbance is None else str(disturbance)}
+        arguments = [(files[number], number, model, makers, {**options, "seed": seed + number}) for number in todo]
+        running: Iterator[tuple[int, dict[str, Any]]] = run_unordered(
+            _run_pile, arguments, n_jobs=n_jobs, client=client
+        )
+        for number, pile in running:
+            results[number] = pile
+            if folder is not None:
+                stored = {"key": key(number, files[number]), "result": pile}
+                atomic_write_text(folder / f"{files[number].stem}.json", json.dumps(stored) + "\n")
+            if progress is not None:
+                progress(sum(result is not None for result in results), len(files))
     done = [result for result in results if result is not None]
     metrics = {maker: [_pile_metrics(pile["runs"][maker]) for pile in done] for maker in makers}
     summary = {}

@@ -17,15 +17,16 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
-from unstack.atomic import check_folder_path
+from unstack.atomic import check_folder_path, folder_writer
 
-__all__ = ["results_folder", "save_results"]
+__all__ = ["checkpoint_folder", "results_folder", "save_results"]
 
 
 def results_folder(out: str | os.PathLike[str]) -> Path:
@@ -45,6 +46,28 @@ def results_folder(out: str | os.PathLike[str]) -> Path:
     folder = check_folder_path(out)
     folder.mkdir(parents=True, exist_ok=True)
     return folder
+
+
+@contextlib.contextmanager
+def checkpoint_folder(checkpoints: str | os.PathLike[str] | None) -> Iterator[Path | None]:
+    """The folder an experiment keeps each pile's result in, made if missing and held while the
+    block runs (:func:`unstack.atomic.folder_writer`): a second run on it at the same time is
+    refused instead of doing every pile again. ``None`` (no checkpoints) gives ``None``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with checkpoint_folder(Path(tempfile.mkdtemp()) / "piles") as folder:
+    ...     folder.name, folder.is_dir()
+    ('piles', True)
+    """
+    if checkpoints is None:
+        yield None
+        return
+    folder = Path(checkpoints)
+    folder.mkdir(parents=True, exist_ok=True)
+    with folder_writer(folder, "an experiment's piles"):
+        yield folder
 
 
 def save_results(

@@ -247,29 +247,28 @@ def unloading_experiment(
 
     from unstack.atomic import atomic_write_text
     from unstack.dataset_folders import require_configurations
+    from unstack.experiments.outputs import checkpoint_folder
 
     if samples is None and time_limit is None:
         samples = UNLOAD_SAMPLES
     settings = DecisionSettings(seed=seed, samples=samples, time_limit=time_limit, cost=cost, statics=statics)
     files = require_configurations(data_dir)[:configs]
-    folder = None if checkpoints is None else Path(checkpoints)
-    if folder is not None:
-        folder.mkdir(parents=True, exist_ok=True)
     per_pile_settings = [dataclasses.replace(settings, seed=seed + number) for number in range(len(files))]
     keys = [_pile_key(path, model, per_pile_settings[number], closed_loop) for number, path in enumerate(files)]
-    piles: list[dict[str, Any] | None] = [_finished_pile(folder, key) for key in keys]
-    todo = [number for number, pile in enumerate(piles) if pile is None]
-    if progress is not None:
-        progress(len(files) - len(todo), len(files))
-    arguments = [(files[number], number, model, per_pile_settings[number], closed_loop) for number in todo]
-    results = run_unordered(_run_pile, arguments, n_jobs=n_jobs, client=client)
-    for number, pile in results:
-        piles[number] = pile
-        if folder is not None:
-            stored = {"key": keys[number], "result": pile}
-            atomic_write_text(folder / f"{files[number].stem}.json", json.dumps(stored) + "\n")
+    with checkpoint_folder(checkpoints) as folder:
+        piles: list[dict[str, Any] | None] = [_finished_pile(folder, key) for key in keys]
+        todo = [number for number, pile in enumerate(piles) if pile is None]
         if progress is not None:
-            progress(sum(pile is not None for pile in piles), len(files))
+            progress(len(files) - len(todo), len(files))
+        arguments = [(files[number], number, model, per_pile_settings[number], closed_loop) for number in todo]
+        results = run_unordered(_run_pile, arguments, n_jobs=n_jobs, client=client)
+        for number, pile in results:
+            piles[number] = pile
+            if folder is not None:
+                stored = {"key": keys[number], "result": pile}
+                atomic_write_text(folder / f"{files[number].stem}.json", json.dumps(stored) + "\n")
+            if progress is not None:
+                progress(sum(pile is not None for pile in piles), len(files))
     done: list[dict[str, Any]] = [pile for pile in piles if pile is not None]
     makers = UNLOADING_MAKERS + (CLOSED_LOOP_MAKERS if closed_loop else ())
     summary = {}

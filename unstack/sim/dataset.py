@@ -14,6 +14,9 @@ at most the configurations in flight are lost. The configurations run in worker
 processes (``jobs``) or on a dask.distributed cluster (``scheduler``); each one is seeded
 from the data set's seed and its index only, so the files are bit-identical however they
 were made.
+A run holds the folder while it writes (:func:`unstack.atomic.folder_writer`): a second run on
+the same folder at the same time is refused in one line instead of simulating every
+configuration again.
 
 Examples
 --------
@@ -42,7 +45,7 @@ from typing import Any
 
 import numpy as np
 
-from unstack.atomic import atomic_save_array, atomic_write_text, check_folder_path
+from unstack.atomic import atomic_save_array, atomic_write_text, check_folder_path, folder_writer
 from unstack.dataset_folders import DATASET_FORMAT, MANIFEST, TIMINGS, config_name, list_configurations, read_manifest
 from unstack.errors import UnstackError
 from unstack.parameters import MAX_CONFIGS, MAX_JOBS
@@ -286,24 +289,42 @@ def simulate_dataset(
         _check_same_dataset(target, manifest, settings, seed)
     client = connect_scheduler(scheduler) if scheduler else None
     target.mkdir(parents=True, exist_ok=True)
+    try:
+        with folder_writer(target, "a data set", DatasetConflict):
+            return _fill_dataset(target, settings, configs, seed, jobs, client, progress, start)
+    finally:
+        if client is not None:
+            client.close()
+
+
+def _fill_dataset(
+    target: Path,
+    settings: SimulationSettings,
+    configs: int,
+    seed: int,
+    jobs: int,
+    client: Any,
+    progress: Callable[[int, int], None] | None,
+    start: float,
+) -> DatasetSummary:
+    """:func:`simulate_dataset`'s work in a folder it holds: the configurations still missing."""
+    manifest = read_manifest(target)
+    if manifest is not None:  # again, now that no other run writes the folder
+        _check_same_dataset(target, manifest, settings, seed)
     _clean_temporaries(target)
     _write_manifest(target, settings, seed, configs)
     done = {int(path.stem.split("-")[1]) for path in list_configurations(target)}
     todo = [index for index in range(configs) if index not in done]
     skipped = configs - len(todo)
     made = 0
-    try:
-        results = _run_dask(todo, settings, seed, client) if client else _run_local(todo, settings, seed, jobs)
+    results = _run_dask(todo, settings, seed, client) if client else _run_local(todo, settings, seed, jobs)
+    if progress is not None:
+        progress(skipped, configs)
+    for result in results:
+        _save_configuration(target, result)
+        made += 1
         if progress is not None:
-            progress(skipped, configs)
-        for result in results:
-            _save_configuration(target, result)
-            made += 1
-            if progress is not None:
-                progress(skipped + made, configs)
-    finally:
-        if client is not None:
-            client.close()
+            progress(skipped + made, configs)
     manifest = read_manifest(target) or {}
     manifest["statistics"] = _statistics(target)
     atomic_write_text(target / MANIFEST, json.dumps(json_ready(manifest), indent=2) + "\n")
