@@ -282,3 +282,11 @@ def test_decide_says_why_for_the_pick_and_the_runner_up(tmp_path: Path) -> None:
     assert result.returncode == 0, result.stderr
     assert "pick top: expected to move 0.10 boxes (it rests on bottom: P 0.90)" in result.stdout
     assert "runner-up bottom: expected to move 0.90 boxes (bottom holds up top: P 0.90)" in result.stdout
+
+
+def test_a_plan_says_up_front_that_its_time_limit_is_per_step() -> None:
+    result = unstack("plan", PILE5, "--time-limit", "20", "--seed", "0", "--json")
+    assert result.returncode == 0, result.stderr
+    assert "unstack: note: --time-limit applies to each of the 5 steps: the plan may sample for 1.7 min in all" in (
+        result.stderr.splitlines()
+    )

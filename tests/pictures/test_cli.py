@@ -83,6 +83,7 @@ def test_view_writes_one_self_contained_page(tmp_path: Path) -> None:
         (["examples/pile31.supports.json", "-o", "{tmp}/x.html"], "no geometry to show in 3D"),
         ([PILE5, "-o", "{tmp}/x.png"], "x.png: expected a .html or .htm output file"),
         ([PILE5, "-o", "{tmp}/x.html", "--max-points", "-1"], "--max-points"),
+        ([PILE5, "-o", "{tmp}/x.html", "--max-points", "5000000"], "5000000 is not in the range 0<=x<=1000000"),
         (["nothing.json", "-o", "{tmp}/x.html"], "nothing.json: $: no such file"),
     ],
 )

@@ -67,6 +67,8 @@ def test_the_page_needs_no_network(tmp_path: Path, wall: Scene, wall_decision: D
 def test_bad_input(tmp_path: Path, wall: Scene) -> None:
     with pytest.raises(InvalidArgument, match="max_points must be a non-negative count, got -1"):
         write_view(wall, tmp_path / "x.html", max_points=-1)
+    with pytest.raises(InvalidArgument, match=r"max_points must be at most 1,000,000 \(a page of about 60 MB"):
+        write_view(wall, tmp_path / "x.html", max_points=5_000_000)
     with pytest.raises(InvalidArgument, match="the decision's boxes do not match"):
         write_view(wall, tmp_path / "x.html", values=DecisionValues(["zz"], [1.0]))
     assert not list(tmp_path.iterdir())

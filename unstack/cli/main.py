@@ -287,6 +287,18 @@ def _first_call(loaded: Any) -> Iterator[None]:
             yield
 
 
+#: A run the command line announces up front when its budget allows longer (seconds).
+LONG_RUN = 60.0
+
+
+def _duration(seconds: float) -> str:
+    """``seconds`` in the largest unit that keeps it readable (``2.5 h``)."""
+    for unit, size in (("days", 86_400.0), ("h", 3_600.0), ("min", 60.0)):
+        if seconds >= size:
+            return f"{seconds / size:,.1f} {unit}"
+    return f"{seconds:.0f} s"
+
+
 def _print_warnings(warnings: tuple[str, ...]) -> None:
     for warning in warnings:
         _warn(warning)
@@ -327,7 +339,9 @@ def decide(file: str, as_json: bool, output: str | None, timing: bool, model: st
 
     _check_output(output, file)
     loaded = _load_input(file, model, reasoning["statics"])
-    with _first_call(loaded):
+    from unstack.cli.progress import still_working
+
+    with _first_call(loaded), still_working("deciding"):
         decision = unstack.decide(loaded, model=model, **reasoning)
     _deliver(decision.to_dict(timing=timing), output, as_json, "decision_view", decision, warnings=decision.warnings)
 
@@ -347,7 +361,11 @@ def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str, 
     from unstack.api import payoff
 
     _check_output(output, file)
-    table = payoff(_load_input(file, model), model, cost=cost)
+    from unstack.cli.progress import still_working
+
+    loaded = _load_input(file, model)
+    with still_working("listing the worlds"):
+        table = payoff(loaded, model, cost=cost)
     _deliver(table.to_dict(), output, as_json, "payoff_view", table, limit, warnings=table.warnings)
 
 
@@ -372,6 +390,13 @@ def plan(file: str, as_json: bool, output: str | None, model: str | None, **reas
 
     _check_output(output, file)
     supports = _load_input(file, model, reasoning["statics"])
+    steps = len(supports.detected if isinstance(supports, unstack.Scene) else supports.objects)
+    if reasoning["time_limit"] is not None and steps * reasoning["time_limit"] > LONG_RUN:
+        click.echo(
+            f"unstack: note: --time-limit applies to each of the {steps} steps: the plan may sample for "
+            f"{_duration(steps * reasoning['time_limit'])} in all",
+            err=True,
+        )
     with _first_call(supports), progress_bar("planning: steps") as report:
         result = unstack.plan(supports, model=model, progress=report, **reasoning)
     _deliver(result.to_dict(), output, as_json, "plan_view", result, warnings=result.warnings)

@@ -12,9 +12,11 @@ from typing import Any
 import click
 
 from unstack.cli.main import _warn, model_option
+from unstack.cli.progress import still_working
 from unstack.errors import UnstackError
 from unstack.picture_inputs import decision_values, scene_camera
 from unstack.pictures.render import COLOURINGS
+from unstack.pictures.view import MAX_VIEW_POINTS
 
 __all__ = ["render", "view"]
 
@@ -101,7 +103,8 @@ def render(
     if isinstance(loaded, unstack.Supports):
         if colour in ("truth", "none"):
             raise UnstackError(f"{file}: a supports file has no ground truth or geometry; it is coloured by cost")
-        values = decision_values(loaded, decision_file, with_plan=with_plan, model=model, seed=seed)
+        with still_working("deciding"):
+            values = decision_values(loaded, decision_file, with_plan=with_plan, model=model, seed=seed)
         for warning in values.warnings:
             _warn(warning)
         from unstack.pictures.graph import render_support_graph
@@ -113,25 +116,29 @@ def render(
     camera = scene_camera(scene)  # the scene's settings are checked before any decision
     colour = colour or "cost"  # a scene always has detected boxes to decide on
     needs_decision = colour == "cost" or arrows or with_plan or decision_file is not None
-    values = (
-        decision_values(scene, decision_file, with_plan=with_plan, model=model, seed=seed) if needs_decision else None
-    )
+    with still_working("deciding"):
+        values = (
+            decision_values(scene, decision_file, with_plan=with_plan, model=model, seed=seed)
+            if needs_decision
+            else None
+        )
     for warning in values.warnings if values is not None else ():
         _warn(warning)
     from unstack.pictures.render import render_scene
 
-    render_scene(
-        scene,
-        output,
-        values=values,
-        colour=colour,
-        camera=camera,
-        point_labels=point_box_labels(scene, base_dir),
-        threshold=threshold,
-        arrows=arrows,
-        title=title,
-        dpi=dpi,
-    )
+    with still_working("drawing"):
+        render_scene(
+            scene,
+            output,
+            values=values,
+            colour=colour,
+            camera=camera,
+            point_labels=point_box_labels(scene, base_dir),
+            threshold=threshold,
+            arrows=arrows,
+            title=title,
+            dpi=dpi,
+        )
     pick = f"; pick {values.choice}" if values is not None else ""
     click.echo(f"{output}: {len(scene.boxes)} boxes, {len(scene.detected)} detected{pick}")
 
@@ -144,8 +151,9 @@ def render(
 @model_option
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of sampled decisions and of the cloud subset.")  # fmt: skip
-@click.option("--max-points", type=click.IntRange(min=0), default=20_000, show_default=True,
-              help="Cloud points shown (a random subset).")  # fmt: skip
+@click.option("--max-points", type=click.IntRange(min=0, max=MAX_VIEW_POINTS), default=20_000, show_default=True,
+              help=f"Cloud points shown (a random subset; at most {MAX_VIEW_POINTS:,}: a page of about 60 MB).",
+              )  # fmt: skip
 @click.option("--title", default=None, help="Title of the page (default: the file name).")
 def view(
     file: str,
@@ -169,11 +177,15 @@ def view(
     loaded, _ = _load(file)
     if isinstance(loaded, unstack.Supports):
         raise UnstackError(f"{file}: a supports file has no geometry to show in 3D; unstack render draws its graph")
-    values = decision_values(loaded, decision_file, with_plan=with_plan, model=model, seed=seed)
+    with still_working("deciding"):
+        values = decision_values(loaded, decision_file, with_plan=with_plan, model=model, seed=seed)
     for warning in values.warnings:
         _warn(warning)
     from unstack.pictures.view import write_view
 
-    size = write_view(loaded, output, values=values, max_points=max_points, seed=seed, title=title or Path(file).name)
+    with still_working("writing the page"):
+        size = write_view(
+            loaded, output, values=values, max_points=max_points, seed=seed, title=title or Path(file).name
+        )
     pick = f"; pick {values.choice}" if values is not None else ""
     click.echo(f"{output}: {len(loaded.boxes)} boxes, {len(loaded.detected)} detected{pick}; {size / 1e6:.1f} MB")

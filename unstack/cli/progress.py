@@ -3,31 +3,55 @@
 from __future__ import annotations
 
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
 from rich.console import Console
 
-__all__ = ["LOG_EVERY", "progress_bar"]
+__all__ = ["LOG_EVERY", "progress_bar", "still_working"]
 
 #: Seconds between two progress lines in a pipe or a log.
 LOG_EVERY = 30.0
 
 
-def _log_lines(description: str, every: float = LOG_EVERY) -> Callable[[int, int], None]:
-    """``report(done, total)`` that prints a line to stderr when ``every`` seconds have passed
-    since the start or the last line."""
-    start = last = time.monotonic()
+@contextmanager
+def _log_lines(description: str, every: float = LOG_EVERY) -> Iterator[Callable[[int, int], None]]:
+    """Yield ``report(done, total)``; while the block runs, a line on stderr every ``every``
+    seconds saying the latest count reported (none before the first report: ``description after
+    N s``), so that work inside one long step says it is alive too; work done sooner writes nothing.
+    """
+    start = time.monotonic()
+    latest: list[tuple[int, int]] = []
+    stop = threading.Event()
+
+    def tick() -> None:
+        while not stop.wait(every):
+            where = f" {latest[0][0]:,} of {latest[0][1]:,}" if latest else ""
+            try:
+                print(f"{description}{where} after {time.monotonic() - start:.0f} s", file=sys.stderr, flush=True)
+            except (OSError, ValueError):  # stderr closed or gone: nothing more to say
+                return
 
     def report(done: int, total: int) -> None:
-        nonlocal last
-        now = time.monotonic()
-        if now - last >= every:
-            last = now
-            print(f"{description} {done:,} of {total:,} after {now - start:.0f} s", file=sys.stderr, flush=True)
+        latest[:] = [(done, total)]
 
-    return report
+    thread = threading.Thread(target=tick, name="unstack-progress-lines", daemon=True)
+    thread.start()
+    try:
+        yield report
+    finally:
+        stop.set()
+        thread.join()
+
+
+@contextmanager
+def still_working(description: str, every: float = LOG_EVERY) -> Iterator[None]:
+    """Work without steps (one decision, one picture) says it is alive: a line on stderr every
+    :data:`LOG_EVERY` seconds (``deciding: still working after 30 s``), nothing for quick work."""
+    with _log_lines(f"{description}: still working", every):
+        yield
 
 
 @contextmanager
@@ -35,14 +59,15 @@ def progress_bar(description: str) -> Iterator[Callable[[int, int], None]]:
     """Yield ``report(done, total)``; the bar (with ETA) disappears when the block ends.
 
     Drawn only when standard error is a terminal; in a pipe or a log, long work says where it
-    is in a plain line at most every :data:`LOG_EVERY` seconds (``planning: steps 12 of 200
-    after 41 s``), and work done sooner writes nothing.
+    is in a plain line every :data:`LOG_EVERY` seconds (``planning: steps 12 of 200 after 41
+    s``), within a long step too, and work done sooner writes nothing.
     """
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
 
     console = Console(stderr=True)
     if not console.is_terminal:
-        yield _log_lines(description)
+        with _log_lines(description) as report:
+            yield report
         return
     with Progress(
         f"[progress.description]{description}",

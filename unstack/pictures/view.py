@@ -39,7 +39,11 @@ from unstack.geometry import BOX_FACES, box_corners, points_in_box
 from unstack.pictures.values import DecisionValues
 from unstack.scene import Box, Scene
 
-__all__ = ["build_view", "hover_text", "write_view"]
+__all__ = ["MAX_VIEW_POINTS", "build_view", "hover_text", "write_view"]
+
+#: Most cloud points a page shows: about 60 MB of page, which a browser still opens (5 million
+#: points made a page of 292 MB).
+MAX_VIEW_POINTS = 1_000_000
 
 HIGHLIGHT = "#e6007e"
 #: Cloud points farther than this (m) outside the boxes' bounding box are left out.
@@ -117,7 +121,8 @@ def build_view(
     values : DecisionValues, optional
         The decision: EC colours, the pick, hover text; ``values.order`` adds the slider.
     max_points : int
-        At most this many cloud points are shown (a seeded random subset).
+        At most this many cloud points are shown (a seeded random subset; at most
+        :data:`MAX_VIEW_POINTS`).
     seed : int
         Seed of that subset.
     title : str, optional
@@ -129,8 +134,13 @@ def build_view(
     import plotly.graph_objects as go
     from plotly.colors import sample_colorscale
 
-    if max_points < 0:
-        raise InvalidArgument(f"max_points must be a non-negative count, got {max_points}")
+    if isinstance(max_points, bool) or not isinstance(max_points, int | np.integer) or max_points < 0:
+        raise InvalidArgument(f"max_points must be a non-negative count, got {max_points!r}")
+    if max_points > MAX_VIEW_POINTS:
+        raise InvalidArgument(
+            f"max_points must be at most {MAX_VIEW_POINTS:,} (a page of about 60 MB; more will not open well "
+            f"in a browser), got {max_points:,}"
+        )
     if not scene.boxes:
         raise InvalidArgument(f"{scene.source}: the scene has no boxes to show")
     if values is not None:
