@@ -400,6 +400,7 @@ def decide(
             near_tie_margin=near_tie_margin,
         )
         decision = _free_highest(decision, scene_or_supports, free_cost, near_tie_margin)
+        decision = _doubting_free_cost(decision, supports, free_cost)
     if veto_scene is not None:
         from unstack.height_veto import FREE_COST
         from unstack.physics_veto import physics_veto as vetoed
@@ -438,6 +439,18 @@ def _free_highest(
     if free_cost is None:
         free_cost = 0.0 if near_tie_margin == 0 else FREE_COST
     return free_highest(decision, given, free_cost=free_cost)
+
+
+def _doubting_free_cost(decision: Decision, supports: Supports, free_cost: float | None) -> Decision:
+    """The decision warning when a free cost given is above every expected cost the boxes can have."""
+    import dataclasses
+
+    from unstack.reasoner.costs import margin_beyond_every_cost
+
+    doubt = margin_beyond_every_cost(supports, decision.cost, "free_cost", free_cost)
+    if doubt is None:
+        return decision
+    return dataclasses.replace(decision, warnings=(*decision.warnings, supports.named(doubt)))
 
 
 def _described(decision: Decision, given: Scene | Supports, supports: Supports) -> Decision:
@@ -516,5 +529,7 @@ def plan(
         time_limit=time_limit,
         progress=progress,
         near_tie_margin=near_tie_margin,
-        choose_step=lambda decision: _free_highest(decision, scene_or_supports, free_cost, near_tie_margin),
+        choose_step=lambda decision: _doubting_free_cost(
+            _free_highest(decision, scene_or_supports, free_cost, near_tie_margin), supports, free_cost
+        ),
     )

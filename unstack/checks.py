@@ -25,6 +25,7 @@ if TYPE_CHECKING:
     from unstack.jsonio import Document
 
 __all__ = [
+    "LIGHT_BOX",
     "MAX_BOX_EDGE",
     "MAX_COORDINATE",
     "MIN_BOX_EDGE",
@@ -38,6 +39,7 @@ __all__ = [
     "check_probability_matrix",
     "check_quaternion_xyzw",
     "check_vector",
+    "light_boxes",
 ]
 
 #: A quaternion whose norm is within this of 1 is normalised; further away it is an error.
@@ -52,6 +54,27 @@ MAX_BOX_EDGE = 5.0
 MAX_COORDINATE = 100.0
 #: Two boxes sharing more than this share of the smaller one's volume are refused.
 REFUSED_OVERLAP = 0.5
+#: A box lighter than this (kg) is warned about: no carton weighs less, so the masses are
+#: likely in another unit (the heaviest accepted, 10,000 kg, is in the schemas).
+LIGHT_BOX = 0.01
+
+
+def light_boxes(ids: Sequence[str], masses: Any) -> str | None:
+    """A warning naming the boxes lighter than :data:`LIGHT_BOX` (``None`` when there are none);
+    the caller puts the source before it.
+
+    Examples
+    --------
+    >>> light_boxes(["a", "b", "c"], [12.0, 1e-9, 3e-9])
+    "boxes 'b' (1e-09 kg), 'c' (3e-09 kg) weigh less than 0.01 kg, lighter than a carton; masses in kg?"
+    """
+    light = [(box_id, float(mass)) for box_id, mass in zip(ids, masses, strict=True) if float(mass) < LIGHT_BOX]
+    if not light:
+        return None
+    named = ", ".join(f"{box_id!r} ({mass:.3g} kg)" for box_id, mass in light[:5])
+    more = f" and {len(light) - 5} more" if len(light) > 5 else ""
+    boxes, weigh = ("boxes", "weigh") if len(light) > 1 else ("box", "weighs")
+    return f"{boxes} {named}{more} {weigh} less than {LIGHT_BOX:g} kg, lighter than a carton; masses in kg?"
 
 
 def _matrix(value: Any, n_objects: int, source: str, path: str, error: type[InvalidFile]) -> np.ndarray:

@@ -125,3 +125,10 @@ def test_a_sampled_plan_says_what_its_error_and_probability_columns_mean() -> No
     text = plan_text(result)
     assert "± s.e.: its standard error" in text
     assert "P(minimum): the probability that the pick truly has the lowest EC at its step" in text
+
+
+def test_expected_costs_too_small_for_four_decimals_keep_three_significant_digits() -> None:
+    grams = Supports(["top", "bottom"], [[0.0, 0.1], [0.9, 0.0]], masses=[2e-6, 3e-6])
+    text = text_of(unstack.decide(grams, cost="mass"))
+    assert "3e-07" in text and "1.8e-06" in text and "0.0000" not in text
+    assert "0.1000" in text_of(unstack.decide(grams, cost="count"))

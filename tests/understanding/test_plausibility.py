@@ -121,3 +121,12 @@ def test_a_box_smaller_than_a_carton_is_warned_about_and_a_small_carton_is_not()
     assert warnings == [
         "<array>: box 'parcel' is 4.7 x 2.7 x 3.5 cm, smaller than a carton; are its size and the cloud in metres?"
     ]
+
+
+def test_a_box_lighter_than_a_carton_is_warned_about_and_a_light_carton_is_not() -> None:
+    feather = Box("feather", [0.4, 0.3, 0.3], [1.0, 0.0, 0.15], mass=1e-9)
+    light = Box("light", [0.4, 0.3, 0.3], [1.0, 0.5, 0.15], mass=0.2)
+    warnings = scene_warnings(Scene([feather, light], [[1.0, 0.0, 0.3], [1.0, 0.5, 0.3]], ["feather", "light"]))
+    assert warnings == [
+        "<array>: box 'feather' (1e-09 kg) weighs less than 0.01 kg, lighter than a carton; masses in kg?"
+    ]

@@ -26,7 +26,9 @@ def _id(box: str) -> Text:
 
 
 def _number(value: float) -> str:
-    return f"{value:.4f}"
+    """An expected cost or its error: four decimals, or three significant digits for a value
+    too small to show in four (masses of grams, or a unit error, stay readable)."""
+    return f"{value:.4f}" if value == 0 or abs(value) >= 1e-3 else f"{value:.3g}"
 
 
 #: Above this many boxes the support matrix is left to the JSON output.
@@ -50,7 +52,7 @@ def decision_view(decision: Decision) -> Group:
     for rank, i in enumerate(order, start=1):
         box = decision.objects[i]
         mark = "<- unload first" if box == decision.choice else ("tie" if box in decision.ties else "")
-        error = [] if not sampled else [f"{decision.expected_cost_errors[i]:.4f}"]  # type: ignore[index]
+        error = [] if not sampled else [_number(float(decision.expected_cost_errors[i]))]  # type: ignore[index]
         costs.add_row(str(rank), _id(box), _number(float(decision.expected_costs[i])), *error, mark)
     matrix: Table | Text
     if len(decision.objects) <= MATRIX_MAX_BOXES:
@@ -177,7 +179,7 @@ def payoff_view(table: PayoffMatrix, limit: int) -> Group:
         )
     expected = table.expected_costs()
     view.add_section()
-    view.add_row("EC", "", "", *(f"{c:.4f}" for c in expected))
+    view.add_row("EC", "", "", *(_number(float(c)) for c in expected))
     shown = (
         f"showing the {len(order)} most probable of {len(worlds):,} consistent worlds"
         if len(order) < len(worlds)
@@ -198,8 +200,8 @@ def plan_view(result: Plan) -> Group:
     for column in columns:
         table.add_column(column, justify="right" if column != "unload" else "left")
     for number, step in enumerate(result.steps, start=1):
-        errors = (f"{step.expected_cost_error:.4f}", f"{step.decision.choice_probability:.3f}") if sampled else ()
-        table.add_row(str(number), _id(step.choice), f"{step.expected_cost:.4f}", *errors, str(len(step.remaining)))
+        errors = (_number(step.expected_cost_error), f"{step.decision.choice_probability:.3f}") if sampled else ()
+        table.add_row(str(number), _id(step.choice), _number(step.expected_cost), *errors, str(len(step.remaining)))
     if not result.steps:
         return Group(table)
     note = f"EC: the expected cost of the pick among the boxes in place, {cost_in_words(result.steps[0].decision.cost)}"

@@ -25,7 +25,16 @@ import numpy as np
 from unstack.errors import UnstackError
 from unstack.supports import Supports
 
-__all__ = ["COSTS", "DEFAULT_COST", "PAYOFF_COSTS", "cost_weights", "expected_costs", "own_costs"]
+__all__ = [
+    "COSTS",
+    "DEFAULT_COST",
+    "PAYOFF_COSTS",
+    "cost_weights",
+    "expected_costs",
+    "largest_expected_cost",
+    "margin_beyond_every_cost",
+    "own_costs",
+]
 
 #: The cost models: what unloading a box first costs for each box it supports.
 COSTS = ("load", "count", "mass")
@@ -73,3 +82,42 @@ def expected_costs(marginals: np.ndarray, weights: np.ndarray, own: np.ndarray |
     """``EC(A_j) = own[j] + sum_Y weights[Y] * marginals[j, Y]`` (Eqs. 11 and 13)."""
     result: np.ndarray = marginals @ weights
     return result if own is None else result + own
+
+
+def largest_expected_cost(supports: Supports, cost: str) -> float:
+    """The largest expected cost any box of ``supports`` can have: its own cost with every
+    other box held up.
+
+    Examples
+    --------
+    >>> supports = Supports(["a", "b", "c"], [[0, 0.5, 0], [0, 0, 0.5], [0, 0, 0]], masses=[10.0, 2.0, 1.0])
+    >>> largest_expected_cost(supports, "count"), largest_expected_cost(supports, "mass")
+    (2.0, 12.0)
+    """
+    weights = cost_weights(supports, cost)
+    return float(np.max(own_costs(supports, cost) + weights.sum() - weights))
+
+
+def margin_beyond_every_cost(supports: Supports, cost: str, name: str, margin: float | None) -> str | None:
+    """A warning when a margin on expected costs (``near_tie_margin``, ``free_cost``) is larger
+    than any expected cost the boxes can have -- every box is then tied, or free, whatever holds
+    what up: a typing error, or the reasoning switched off -- else ``None``.
+
+    Examples
+    --------
+    >>> supports = Supports(["a", "b"], [[0, 0.5], [0, 0]])
+    >>> print(margin_beyond_every_cost(supports, "count", "free_cost", 1e300))  # doctest: +ELLIPSIS
+    free_cost 1e+300 is above any expected cost these boxes can have (1 for the count cost): every box counts ...
+    >>> margin_beyond_every_cost(supports, "count", "free_cost", 0.5) is None
+    True
+    """
+    if margin is None or supports.n_objects < 2:
+        return None
+    bound = largest_expected_cost(supports, cost)
+    if margin <= bound:
+        return None
+    what = "is a near tie" if name == "near_tie_margin" else "counts as free"
+    return (
+        f"{name} {margin:g} is above any expected cost these boxes can have ({bound:.3g} for the {cost} cost): "
+        f"every box {what} whatever it holds up, and the highest is taken"
+    )

@@ -44,7 +44,14 @@ from unstack.errors import InvalidArgument, TooLarge
 from unstack.reasoner.arguments import check_budget, check_choice, check_count, check_margin, check_samples, check_seed
 from unstack.reasoner.components import support_components
 from unstack.reasoner.confidence import choice_probability
-from unstack.reasoner.costs import COSTS, DEFAULT_COST, cost_weights, expected_costs, own_costs
+from unstack.reasoner.costs import (
+    COSTS,
+    DEFAULT_COST,
+    cost_weights,
+    expected_costs,
+    margin_beyond_every_cost,
+    own_costs,
+)
 from unstack.reasoner.marginals import EXACT_MAX_BOXES
 from unstack.reasoner.pruning import Evidence, hard_evidence
 from unstack.reasoner.reasons import REASON_COSTS, pick_reasons
@@ -600,6 +607,7 @@ def decide(
     choice, ties = choose(supports.objects, costs, heights=supports.heights, margin=margin)
     largest = int(np.argmax([len(group) for group in groups]))
     sampling = _sampling_summary(results, seed)
+    sampling_warning = (sampling["warning"],) if sampling and "warning" in sampling else ()
     return Decision(
         objects=supports.objects,
         choice=choice,
@@ -619,11 +627,21 @@ def decide(
         ties=ties,
         evidence=evidence,
         seconds=time.perf_counter() - start,
-        warnings=supports.warnings + ((sampling["warning"],) if sampling and "warning" in sampling else ()),
+        warnings=supports.warnings + _input_doubts(supports, cost, near_tie_margin) + sampling_warning,
         sampling_seconds=sum(result.sampled.seconds for result in results if result.sampled is not None),
         near_tie_margin=margin,
         reasons=tuple(pick_reasons(supports, marginals, costs)) if cost in REASON_COSTS else (),
     )
+
+
+def _input_doubts(supports: Supports, cost: str, near_tie_margin: float | None) -> tuple[str, ...]:
+    """What is doubtful in the arguments given with ``supports``: boxes lighter than a carton
+    for the mass cost, a near-tie margin above every expected cost."""
+    from unstack.checks import light_boxes
+
+    light = light_boxes(supports.objects, supports.masses) if cost == "mass" and supports.masses is not None else None
+    doubts = (light, margin_beyond_every_cost(supports, cost, "near_tie_margin", near_tie_margin))
+    return tuple(supports.named(doubt) for doubt in doubts if doubt is not None)
 
 
 def _near_tie_margin(supports: Supports, margin: float | None) -> float:

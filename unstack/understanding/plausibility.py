@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from unstack.checks import MAX_BOX_EDGE, MAX_COORDINATE, MIN_BOX_EDGE, REFUSED_OVERLAP
+from unstack.checks import MAX_BOX_EDGE, MAX_COORDINATE, MIN_BOX_EDGE, REFUSED_OVERLAP, light_boxes
 from unstack.geometry import (
     bounding_boxes,
     box_corners,
@@ -155,6 +155,10 @@ def scene_warnings(scene: Scene) -> list[str]:
                 f"{source}: box {box_id!r} floats: its bottom is {height:.2f} m above the floor with no box or "
                 "point of the cloud under it"
             )
+    weighed = [box for box in scene.boxes if box.mass is not None]
+    light = light_boxes([box.id for box in weighed], [box.mass for box in weighed])
+    if light is not None:
+        warnings.append(f"{source}: {light}")
     if len(scene.points) == 0:
         warnings.append(f"{source}: the point cloud is empty; undetected load and cloud features cannot be seen")
     else:
