@@ -7,27 +7,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from PIL import Image
 
-from tests.camera.conftest import INTRINSICS, render_tops
 from tests.conftest import unstack
 
 pytestmark = pytest.mark.slow  # subprocesses
-
-
-@pytest.fixture
-def camera_files(tmp_path: Path) -> list[str]:
-    cartons = [(0.0, 0.0, 0.0, 0.4, 0.3, 0.3), (0.65, 0.1, 20.0, 0.6, 0.4, 0.4)]
-    depth, masks, pose = render_tops(cartons, tilt_deg=9.0)
-    Image.fromarray(np.round(depth * 1000).astype(np.uint16)).save(tmp_path / "depth.png")
-    (tmp_path / "k.json").write_text(json.dumps(INTRINSICS.__dict__))
-    (tmp_path / "pose.json").write_text(json.dumps({"cam2root": pose.tolist()}))
-    arguments = ["--depth", str(tmp_path / "depth.png"), "--intrinsics", str(tmp_path / "k.json"),
-                 "--pose", str(tmp_path / "pose.json")]  # fmt: skip
-    for k, mask in enumerate(masks):
-        Image.fromarray(mask.astype(np.uint8) * 255).save(tmp_path / f"mask-b{k:02d}.png")
-        arguments.append(str(tmp_path / f"mask-b{k:02d}.png"))
-    return arguments
 
 
 def test_the_scene_is_written_and_decided(camera_files: list[str], tmp_path: Path) -> None:
@@ -41,26 +24,6 @@ def test_the_scene_is_written_and_decided(camera_files: list[str], tmp_path: Pat
     decided = unstack("decide", str(out), "--seed", "0", "--json")
     assert decided.returncode == 0, decided.stderr
     assert json.loads(decided.stdout)["choice"] in ("b00", "b01")
-
-
-@pytest.mark.parametrize(
-    ("extra", "message"),
-    [
-        (["--sizes", "0.4x0.3"], "--sizes: expected three edges"),
-        (["--ids", "a"], "--ids names 1 boxes but 2 masks"),
-        (["--depth-units", "m"], "declared in m but the median reading is"),
-        (["--ids", "a,"], "--ids: expected 2 non-empty box ids separated by commas, got 'a,'"),
-        (["--sizes", ""], "--sizes: expected sizes like 0.4x0.3x0.3 separated by commas, got ''"),
-        (["--door", "0,0,1"], "within 15 degrees of the vertical"),
-    ],
-)
-def test_bad_input_is_one_line_and_no_file(
-    camera_files: list[str], tmp_path: Path, extra: list[str], message: str
-) -> None:
-    out = tmp_path / "scene.json"
-    run = unstack("scene", *camera_files, *extra, "--out", str(out))
-    assert run.returncode == 2 and message in run.stderr and len(run.stderr.strip().splitlines()) == 1
-    assert not out.exists()
 
 
 def test_a_cloud_and_detections_make_a_scene(tmp_path: Path) -> None:

@@ -52,35 +52,6 @@ def test_simulate_a_staged_family_of_boxes_set_down_by_hand(tmp_path: Path) -> N
     assert unstack("validate", str(folder / "config-0000.json")).returncode == 0
 
 
-@pytest.mark.parametrize(
-    ("arguments", "message"),
-    [
-        (["--sizes", "paper3"], "'paper3' is not one of 'paper2', 'four', 'mixed'"),
-        (["--boxes", "40-30"], "box range 40-30 is reversed"),
-        (["--boxes", "many"], "--boxes: expected COUNT or LOW-HIGH (for example 30-40), got 'many'"),
-        (["--boxes", "500-600"], "600 boxes of size set 'paper2' do not fit"),
-        (["--configs", "-3"], "Invalid value for '--configs': -3 is not in the range 1<=x<=100000"),
-        (
-            ["--configs", "1000000000000"],
-            "Invalid value for '--configs': 1000000000000 is not in the range 1<=x<=100000",
-        ),
-        (["--jobs", "0"], "Invalid value for '--jobs': 0 is not in the range 1<=x<=256"),
-        (["--boxes", "1"], "boxes 1-1: a pile of one box supports nothing"),
-        (["--resolution", "big"], "--resolution: expected WIDTHxHEIGHT in pixels"),
-        (["--width", "0"], "Invalid value for '--width': expected a positive extent of at most 100 m, got 0.0"),
-        (["--boxes", "9", "--sizes", "four", "--depth", "0.6", "--width", "0.8"], "do not fit a 0.6 x 0.8 x 2.39 m"),
-        (["--scheduler", "tcp://127.0.0.1:9"], "dask scheduler tcp://127.0.0.1:9 does not answer within 5 s"),
-        (["--scheduler", "nowhere"], "scheduler: expected an address like tcp://HOST:PORT, got 'nowhere'"),
-    ],
-)
-def test_simulate_bad_input_is_one_line(tmp_path: Path, arguments: list[str], message: str) -> None:
-    result = unstack("simulate", "--configs", "1", "--out", str(tmp_path / "out"), *arguments)
-    assert result.returncode == 2
-    assert result.stderr.startswith("unstack: error: ")
-    assert message in result.stderr and result.stderr.count("\n") == 1, result.stderr
-    assert not (tmp_path / "out").exists()
-
-
 def test_simulate_refuses_to_mix_data_sets(dataset: Path) -> None:
     result = unstack("simulate", "--configs", "2", *SMALL, "--seed", "5", "--out", str(dataset))
     assert result.returncode == 2

@@ -53,17 +53,24 @@ def other_decision(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.mark.parametrize(
     ("arguments", "message"),
     [
-        (["examples/missing.json", "-o", "{tmp}/x.png"], "missing.json: $: no such file"),
-        ([PILE5, "-o", "{tmp}/x.pdf"], "x.pdf: expected a .png or .svg output file"),
-        ([PILE5, "-o", "{tmp}/x.png", "--threshold", "1.5"], "threshold must be a probability in [0, 1], got 1.5"),
-        ([PILE5, "-o", "{tmp}/x.png", "--decision", "{decision}"], "the decision's boxes do not match"),
-        ([PILE5, "-o", "{tmp}/x.png", "--decision", "examples/stack5.supports.json"], "expected unstack.decision/1"),
-        ([PILE5, "-o", "{tmp}/no/x.png"], "cannot write there"),
-        (["examples/pile31.supports.json", "-o", "{tmp}/x.png", "--colour", "truth"], "no ground truth or geometry"),
+        (["render", "examples/missing.json", "-o", "{tmp}/x.png"], "missing.json: $: no such file"),
+        (["render", PILE5, "-o", "{tmp}/x.pdf"], "x.pdf: expected a .png or .svg output file"),
+        (["render", PILE5, "-o", "{tmp}/x.png", "--threshold", "1.5"], "threshold must be a probability in [0, 1]"),
+        (["render", PILE5, "-o", "{tmp}/x.png", "--decision", "{decision}"], "the decision's boxes do not match"),
+        (["render", PILE5, "-o", "{tmp}/x.png", "--decision", "examples/stack5.supports.json"], "unstack.decision/1"),
+        (["render", PILE5, "-o", "{tmp}/no/x.png"], "cannot write there"),
+        (["render", "examples/pile31.supports.json", "-o", "{tmp}/x.png", "--colour", "truth"], "no ground truth"),
+        (["view", "examples/pile31.supports.json", "-o", "{tmp}/x.html"], "no geometry to show in 3D"),
+        (["view", PILE5, "-o", "{tmp}/x.png"], "x.png: expected a .html or .htm output file"),
+        (["view", PILE5, "-o", "{tmp}/x.html", "--max-points", "-1"], "--max-points"),
+        (["view", PILE5, "-o", "{tmp}/x.html", "--max-points", "5000000"], "5000000 is not in the range 0<=x<=1000000"),
+        (["view", "nothing.json", "-o", "{tmp}/x.html"], "nothing.json: $: no such file"),
     ],
 )
-def test_render_bad_input_is_one_line(tmp_path: Path, other_decision: Path, arguments: list[str], message: str) -> None:
-    result = unstack("render", *[a.format(tmp=tmp_path, decision=other_decision) for a in arguments])
+def test_bad_picture_input_is_one_line(
+    tmp_path: Path, other_decision: Path, arguments: list[str], message: str
+) -> None:
+    result = unstack(*[a.format(tmp=tmp_path, decision=other_decision) for a in arguments])
     assert_one_line_error(result, message, nothing_written_in=tmp_path)
     assert result.stderr.startswith("unstack: error: "), result.stderr
 
@@ -75,18 +82,3 @@ def test_view_writes_one_self_contained_page(tmp_path: Path) -> None:
     assert " MB" in result.stdout and "pick " in result.stdout
     page = target.read_text()
     assert "picks taken: " in page and "cloud (3,000 of " in page
-
-
-@pytest.mark.parametrize(
-    ("arguments", "message"),
-    [
-        (["examples/pile31.supports.json", "-o", "{tmp}/x.html"], "no geometry to show in 3D"),
-        ([PILE5, "-o", "{tmp}/x.png"], "x.png: expected a .html or .htm output file"),
-        ([PILE5, "-o", "{tmp}/x.html", "--max-points", "-1"], "--max-points"),
-        ([PILE5, "-o", "{tmp}/x.html", "--max-points", "5000000"], "5000000 is not in the range 0<=x<=1000000"),
-        (["nothing.json", "-o", "{tmp}/x.html"], "nothing.json: $: no such file"),
-    ],
-)
-def test_view_bad_input_is_one_line(tmp_path: Path, arguments: list[str], message: str) -> None:
-    result = unstack("view", *[a.format(tmp=tmp_path) for a in arguments])
-    assert_one_line_error(result, message, nothing_written_in=tmp_path)

@@ -1,0 +1,75 @@
+"""Every command's answer to a bad command line: exit code 2, one line on stderr that starts
+``unstack: error:`` and says what was expected, and nothing written.
+
+One table for all the commands, so that each refusal is held to the same rule; ``{tmp}`` is the
+test's folder, ``{camera}`` a camera's files as ``unstack scene`` takes them
+(``tests/cli/conftest.py``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import PILE5, unstack
+
+pytestmark = pytest.mark.slow  # runs the CLI in subprocesses
+
+SIMULATE = ["simulate", "--configs", "1", "--out", "{tmp}/out"]
+SCENE = ["scene", "{camera}", "--out", "{tmp}/scene.json"]
+
+REFUSALS = [
+    (["decide", PILE5, "--samples", "0"], "--samples"),
+    (["decide", PILE5, "--samples", "1000000000"], "samples must be at most 100,000,000"),
+    (["decide", PILE5, "--time-limit", "0"], "--time-limit"),
+    (["decide", PILE5, "--time-limit", "nan"], "--time-limit"),
+    (["decide", PILE5, "--time-limit", "inf"], "--time-limit"),
+    (["decide", PILE5, "--time-limit", "-1"], "--time-limit"),
+    (["decide", PILE5, "--method", "fast"], "--method"),
+    (["decide", PILE5, "--seed", "-1"], "--seed"),
+    (["decide", PILE5, "--near-ties", "nan"], "--near-ties"),
+    (["decide", PILE5, "--near-ties", "-0.1"], "--near-ties"),
+    (["decide", PILE5, "--near-ties", "inf"], "--near-ties"),
+    (["decide", PILE5, "--free-cost", "-0.5"], "--free-cost"),
+    (["decide", PILE5, "--free-cost", "nan"], "--free-cost"),
+    (["decide", "missing.json"], "missing.json: $: no such file"),
+    (["decide", "examples"], "examples: $: expected a JSON file, got a directory"),
+    (["decide", PILE5, "--output", "{tmp}/no/such/dir/out.json"], "no/such/dir/out.json: cannot write there"),
+    (["validate", "examples/scene3.json", "missing.json"], "missing.json: $: no such file"),
+    ([*SCENE, "--sizes", "0.4x0.3"], "--sizes: expected three edges"),
+    ([*SCENE, "--ids", "a"], "--ids names 1 boxes but 2 masks"),
+    ([*SCENE, "--depth-units", "m"], "declared in m but the median reading is"),
+    ([*SCENE, "--ids", "a,"], "--ids: expected 2 non-empty box ids separated by commas, got 'a,'"),
+    ([*SCENE, "--sizes", ""], "--sizes: expected sizes like 0.4x0.3x0.3 separated by commas, got ''"),
+    ([*SCENE, "--door", "0,0,1"], "within 15 degrees of the vertical"),
+    ([*SIMULATE, "--sizes", "paper3"], "'paper3' is not one of 'paper2', 'four', 'mixed'"),
+    ([*SIMULATE, "--boxes", "40-30"], "box range 40-30 is reversed"),
+    ([*SIMULATE, "--boxes", "many"], "--boxes: expected COUNT or LOW-HIGH (for example 30-40), got 'many'"),
+    ([*SIMULATE, "--boxes", "500-600"], "600 boxes of size set 'paper2' do not fit"),
+    ([*SIMULATE, "--configs", "-3"], "Invalid value for '--configs': -3 is not in the range 1<=x<=100000"),
+    ([*SIMULATE, "--configs", "10000000000"], "'--configs': 10000000000 is not in the range 1<=x<=100000"),
+    ([*SIMULATE, "--jobs", "0"], "Invalid value for '--jobs': 0 is not in the range 1<=x<=256"),
+    ([*SIMULATE, "--boxes", "1"], "boxes 1-1: a pile of one box supports nothing"),
+    ([*SIMULATE, "--resolution", "big"], "--resolution: expected WIDTHxHEIGHT in pixels"),
+    ([*SIMULATE, "--width", "0"], "'--width': expected a positive extent of at most 100 m, got 0.0"),
+    ([*SIMULATE, "--boxes", "9", "--sizes", "four", "--depth", "0.6", "--width", "0.8"], "do not fit a 0.6 x 0.8"),
+    ([*SIMULATE, "--scheduler", "tcp://127.0.0.1:9"], "dask scheduler tcp://127.0.0.1:9 does not answer within 5 s"),
+    ([*SIMULATE, "--scheduler", "nowhere"], "scheduler: expected an address like tcp://HOST:PORT, got 'nowhere'"),
+]
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"), REFUSALS, ids=[f"{row[0][0]} {' '.join(row[0][-2:])}" for row in REFUSALS]
+)
+def test_a_bad_command_line_is_refused_in_one_line_with_nothing_written(
+    request: pytest.FixtureRequest, tmp_path: Path, arguments: list[str], message: str
+) -> None:
+    camera = request.getfixturevalue("camera_files") if "{camera}" in arguments else []
+    expanded = [part for argument in arguments for part in (camera if argument == "{camera}" else [argument])]
+    before = sorted(tmp_path.rglob("*"))
+    result = unstack(*[argument.format(tmp=tmp_path) for argument in expanded])
+    assert result.returncode == 2, result.stderr
+    assert result.stderr.startswith("unstack: error: ") and result.stderr.count("\n") == 1, result.stderr
+    assert message in result.stderr and "Traceback" not in result.stderr
+    assert sorted(tmp_path.rglob("*")) == before
