@@ -19,20 +19,18 @@ pytestmark = pytest.mark.slow  # runs the CLI in subprocesses
 SIMULATE = ["simulate", "--configs", "1", "--out", "{tmp}/out"]
 SCENE = ["scene", "{camera}", "--out", "{tmp}/scene.json"]
 
+#: Values of decide's options that are refused with the option named.
+NAMED_BAD_VALUES = {
+    "--samples": ("0",),
+    "--time-limit": ("0", "nan", "inf", "-1"),
+    "--method": ("fast",),
+    "--seed": ("-1",),
+    "--near-ties": ("nan", "-0.1", "inf"),
+    "--free-cost": ("-0.5", "nan"),
+}
 REFUSALS = [
-    (["decide", PILE5, "--samples", "0"], "--samples"),
+    *((["decide", PILE5, option, value], option) for option, values in NAMED_BAD_VALUES.items() for value in values),
     (["decide", PILE5, "--samples", "1000000000"], "samples must be at most 100,000,000"),
-    (["decide", PILE5, "--time-limit", "0"], "--time-limit"),
-    (["decide", PILE5, "--time-limit", "nan"], "--time-limit"),
-    (["decide", PILE5, "--time-limit", "inf"], "--time-limit"),
-    (["decide", PILE5, "--time-limit", "-1"], "--time-limit"),
-    (["decide", PILE5, "--method", "fast"], "--method"),
-    (["decide", PILE5, "--seed", "-1"], "--seed"),
-    (["decide", PILE5, "--near-ties", "nan"], "--near-ties"),
-    (["decide", PILE5, "--near-ties", "-0.1"], "--near-ties"),
-    (["decide", PILE5, "--near-ties", "inf"], "--near-ties"),
-    (["decide", PILE5, "--free-cost", "-0.5"], "--free-cost"),
-    (["decide", PILE5, "--free-cost", "nan"], "--free-cost"),
     (["decide", "missing.json"], "missing.json: $: no such file"),
     (["decide", "examples"], "examples: $: expected a JSON file, got a directory"),
     (["decide", PILE5, "--output", "{tmp}/no/such/dir/out.json"], "no/such/dir/out.json: cannot write there"),
