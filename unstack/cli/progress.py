@@ -1,4 +1,5 @@
-"""A rich progress bar for long commands, on stderr (stdout is for results and JSON)."""
+"""Progress of long commands on stderr (stdout is for results and JSON): a rich bar on a
+terminal, plain lines in a pipe or a log; rich is imported only for the bar."""
 
 from __future__ import annotations
 
@@ -7,8 +8,6 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-
-from rich.console import Console
 
 __all__ = ["LOG_EVERY", "progress_bar", "still_working"]
 
@@ -62,6 +61,7 @@ def progress_bar(description: str) -> Iterator[Callable[[int, int], None]]:
     is in a plain line every :data:`LOG_EVERY` seconds (``planning: steps 12 of 200 after 41
     s``), within a long step too, and work done sooner writes nothing.
     """
+    from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
 
     console = Console(stderr=True)
