@@ -76,3 +76,21 @@ def test_render_draws_the_learned_probabilities(tmp_path: Path) -> None:
     result = unstack("render", "examples/pile5.scene.json", "-o", str(arrows), "--probabilities")
     assert result.returncode == 0, result.stderr
     assert arrows.read_bytes()[:4] == b"\x89PNG" and arrows.read_bytes() != plain.read_bytes()
+
+
+def test_ctrl_c_ends_a_run_with_one_line_and_exit_code_130(tmp_path: Path) -> None:
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    folder = tmp_path / "interrupted"
+    command = [sys.executable, "-m", "unstack", "simulate", "--configs", "50", *SMALL, "--out", str(folder)]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not (folder / "config-0000.json").exists() and time.monotonic() < deadline and process.poll() is None:
+        time.sleep(0.05)
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=120)
+    assert process.returncode == 130, stderr
+    assert stderr.strip().splitlines()[-1] == "unstack: aborted"

@@ -477,6 +477,10 @@ def _quiet_broken_pipe() -> None:
     sys.exit(1)
 
 
+#: The exit code of a run stopped with Ctrl-C (128 + SIGINT, as the shell reports it).
+INTERRUPTED = 130
+
+
 def main() -> None:
     """Console-script entry point."""
     import warnings
@@ -495,9 +499,9 @@ def main() -> None:
         _fail(f"{where}: {error.format_message()} (see {where} --help)")
     except click.ClickException as error:
         _fail(error.format_message())
-    except click.Abort:
+    except click.Abort as error:  # Ctrl-C (the shell's 128 + SIGINT) or the end of standard input
         click.echo("unstack: aborted", err=True)
-        sys.exit(1)
+        sys.exit(INTERRUPTED if isinstance(error.__cause__, KeyboardInterrupt) else 1)
     if isinstance(status, int) and status:
         sys.exit(status)
 

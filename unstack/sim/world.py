@@ -103,6 +103,7 @@ def _direct_client(pybullet: ModuleType, bullet_client: Any) -> Any:
     client = bullet_client.__new__(bullet_client)
     client._shapes = {}
     client._pid = os.getpid()
+    client._client = -1  # not connected yet: a Ctrl-C inside connect leaves nothing for __del__ to close
     client._client = pybullet.connect(pybullet.DIRECT)
     return client
 
