@@ -78,3 +78,28 @@ def test_intrinsics_with_zero_distortion_and_other_keys_are_read_with_a_warning(
             _intrinsics(tmp_path, D=[0, 0, 0, 0, 0], distortion_model="plumb_bob", camera_name="front")
         )
     assert intrinsics.fx == 600.0
+
+
+def test_depth_readings_no_camera_gives_are_no_readings_with_a_warning(tmp_path: Path) -> None:
+    depth = np.full((4, 5), 1.5)
+    depth[2, 3] = 1e300  # one outlier, as multipath or a reflection gives
+    np.save(tmp_path / "d.npy", depth)
+    with pytest.warns(
+        UserWarning, match=r"d.npy: 1 readings beyond 20 m .* row 2, column 3: 1e\+300 m\) are taken as no"
+    ):
+        read = load_depth(tmp_path / "d.npy")
+    assert read[2, 3] == 0.0 and np.count_nonzero(read) == 19
+
+
+@pytest.mark.parametrize(
+    ("mask", "message"),
+    [
+        (np.zeros((4, 5, 0), dtype=np.uint8), r"expected a single-channel mask image, got shape \(4, 5, 0\)"),
+        (np.full((4, 5), "x"), r"expected a mask of numbers \(0 outside the box\), got values of <U1"),
+        (np.ones((4, 5), dtype=complex), r"expected a mask of numbers .* got values of complex128"),
+    ],
+)
+def test_a_mask_array_of_no_channel_or_no_numbers_is_refused(tmp_path: Path, mask: np.ndarray, message: str) -> None:
+    np.save(tmp_path / "m.npy", mask)
+    with pytest.raises(InvalidFile, match=message):
+        load_mask(tmp_path / "m.npy")

@@ -89,6 +89,13 @@ def intrinsics(**change: Any) -> dict[str, Any]:
         ),
         ("intrinsics", intrinsics(width=10**9), r"\$\.width: expected at most 16384 pixels, got 1e\+09"),
         ("intrinsics", intrinsics(fx=-1), r"\$\.fx: expected a positive number of pixels, got -1"),
+        (
+            "intrinsics",
+            intrinsics(fx=10**400),
+            r"\$\.fx: expected a positive number of pixels, got an integer of about",
+        ),
+        ("pose", [["1", "0", "0", "0"], *np.eye(4)[1:].tolist()], r"\$\[0\]\[0\]: expected a finite number, got '1'"),
+        ("pose", [[True, 0, 0, 0], *np.eye(4)[1:].tolist()], r"\$\[0\]\[0\]: expected a finite number, got True"),
         ("intrinsics", intrinsics(cy=None), r"\$: missing required key 'cy'"),
         ("intrinsics", intrinsics(k1=0.01), r"\$\.k1: expected no lens distortion"),
         ("intrinsics", intrinsics(D=[0.1, 0.0, 0.0, 0.0, 0.0]), r"\$\.D: expected no lens distortion"),

@@ -94,10 +94,10 @@ def load_intrinsics(path: str | os.PathLike[str]) -> Intrinsics:
     for name in INTRINSICS_KEYS:
         if name not in data:
             raise InvalidFile(source, "$", f"missing required key {name!r} (expected {', '.join(INTRINSICS_KEYS)})")
-        value = data[name]
-        if isinstance(value, bool) or not isinstance(value, int | float) or not np.isfinite(value) or value <= 0:
-            raise InvalidFile(source, f"$.{name}", f"expected a positive number of pixels, got {value!r}")
-        values[name] = float(value)
+        value = _real(data[name])
+        if value is None or value <= 0:
+            raise InvalidFile(source, f"$.{name}", f"expected a positive number of pixels, got {_shown(data[name])}")
+        values[name] = value
     if values["width"] != int(values["width"]) or values["height"] != int(values["height"]):
         raise InvalidFile(source, "$.width", "expected whole numbers of pixels for width and height")
     for focal, centre, side in (("fx", "cx", "width"), ("fy", "cy", "height")):
@@ -154,15 +154,17 @@ def load_pose(path: str | os.PathLike[str]) -> np.ndarray:
             raise InvalidFile(source, "$", "expected a 4 x 4 matrix, or an object with exactly one matrix")
         json_path = f"$.{matrices[0]}"
         data = data[matrices[0]]
-    try:
-        pose = np.array(data, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise InvalidFile(source, json_path, "expected a 4 x 4 matrix of numbers") from None
-    if pose.shape != (4, 4):
-        raise InvalidFile(source, json_path, f"expected a 4 x 4 matrix of finite numbers, got shape {pose.shape}")
-    if not np.all(np.isfinite(pose)):
-        row, column = (int(index) for index in np.argwhere(~np.isfinite(pose))[0])
-        raise InvalidFile(source, f"{json_path}[{row}][{column}]", f"expected a finite number, got {pose[row, column]}")
+    rows = data if isinstance(data, list) else []
+    if len(rows) != 4 or not all(isinstance(row, list) and len(row) == 4 for row in rows):
+        shape = np.shape(data) if isinstance(data, list) and data and isinstance(data[0], list) else "not a matrix"
+        raise InvalidFile(source, json_path, f"expected a 4 x 4 matrix of finite numbers, got {shape}")
+    for row, entries in enumerate(rows):
+        for column, entry in enumerate(entries):
+            if _real(entry) is None:
+                raise InvalidFile(
+                    source, f"{json_path}[{row}][{column}]", f"expected a finite number, got {_shown(entry)}"
+                )
+    pose = np.array([[_real(entry) for entry in entries] for entries in rows], dtype=np.float64)
     rotation = pose[:3, :3]
     if not np.allclose(pose[3], [0.0, 0.0, 0.0, 1.0]):
         raise InvalidFile(source, f"{json_path}[3]", "expected the last row 0 0 0 1")
@@ -171,6 +173,25 @@ def load_pose(path: str | os.PathLike[str]) -> np.ndarray:
     ):
         raise InvalidFile(source, json_path, "expected a rotation in the upper 3 x 3 block (orthonormal, det 1)")
     return pose
+
+
+def _real(value: Any) -> float | None:
+    """``value`` as a finite float, or ``None`` when it is not one (a bool, a string, NaN, an
+    integer too large for a float)."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return None
+    try:
+        number = float(value)
+    except OverflowError:
+        return None
+    return number if math.isfinite(number) else None
+
+
+def _shown(value: Any) -> str:
+    """``value`` for a message: an integer too long to print by its size."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 64:
+        return f"an integer of about {int(value.bit_length() * math.log10(2)) + 1} digits"
+    return repr(value)
 
 
 def _read_image(file: Path) -> np.ndarray:
@@ -230,6 +251,16 @@ def load_depth(path: str | os.PathLike[str], *, units: str | None = None) -> np.
         raise InvalidFile(
             source, "$", f"declared in mm but every reading is at most {MAX_DEPTH_M:g} mm: are the values metres?"
         )
+    far = metres > MAX_DEPTH_M
+    if far.any():  # a few outliers (multipath, a reflection) in an image of plausible depths: no reading there
+        rows, columns = np.nonzero(far)
+        warnings.warn(
+            f"{source}: {int(far.sum()):,} readings beyond {MAX_DEPTH_M:g} m (no depth camera reads so far; the "
+            f"first at row {rows[0]}, column {columns[0]}: {float(metres[rows[0], columns[0]]):g} m) are taken as "
+            "no reading",
+            stacklevel=2,
+        )
+        metres[far] = 0.0
     return metres
 
 
@@ -244,7 +275,9 @@ def load_mask(path: str | os.PathLike[str], shape: tuple[int, int] | None = None
         raw = np.load(file, allow_pickle=False) if file.suffix.lower() == ".npy" else _read_image(file)
     except Exception as error:  # noqa: BLE001 - any reader failure is the file's fault
         raise InvalidFile(source, "$", f"cannot read the mask: {error}") from None
-    if raw.ndim == 3:
+    if not (np.issubdtype(raw.dtype, np.integer) or np.issubdtype(raw.dtype, np.floating) or raw.dtype == bool):
+        raise InvalidFile(source, "$", f"expected a mask of numbers (0 outside the box), got values of {raw.dtype}")
+    if raw.ndim == 3 and raw.shape[-1] >= 1:
         raw = raw[..., :3].max(axis=-1)  # a colour mask: any non-black pixel
     if raw.ndim != 2:
         raise InvalidFile(source, "$", f"expected a single-channel mask image, got shape {raw.shape}")
