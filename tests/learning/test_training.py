@@ -53,3 +53,23 @@ def test_one_data_set_has_no_split_figures(fixed_rng: np.random.Generator) -> No
         groups=examples.configuration,
     )  # fmt: skip
     assert holdout_by_data_set(examples, holdout) == {}
+
+
+@pytest.mark.parametrize(
+    ("piles", "validation_size", "message"),
+    [
+        (2, 0.3, r"2 configurations leave 1 to cross-validate on after the validation share 0.3 takes 1"),
+        (1, 0.0, r"1 configuration leaves 1 to cross-validate on; at least 2 are needed"),
+    ],
+)
+def test_splitting_by_configuration_needs_two_configurations_to_cross_validate(
+    fixed_rng: np.random.Generator, piles: int, validation_size: float, message: str
+) -> None:
+    from unstack.errors import InvalidArgument
+    from unstack.learning.features import FeatureSettings
+    from unstack.learning.training import train_support_model
+
+    with pytest.raises(InvalidArgument, match=message):
+        train_support_model(
+            pooled(fixed_rng, (piles,)), FeatureSettings(), split_by="configuration", validation_size=validation_size
+        )

@@ -170,6 +170,8 @@ def train_support_model(
     if not 0.0 <= validation_size < 1.0:
         raise ValueError(f"validation_size must lie in [0, 1), got {validation_size}")
     groups = examples.configuration if split_by == "configuration" else None
+    if groups is not None:
+        _require_configurations_to_split(groups, validation_size)
     template = SupportClassifier(learner=learner, cv=cv, n_jobs=n_jobs, random_state=seed)
     holdout = (
         evaluate_holdout(template, examples.features, examples.labels, groups=groups, validation_size=validation_size)
@@ -191,6 +193,24 @@ def train_support_model(
         validation=validation,
     )
     return TrainingRun(model, holdout, useless_model_warnings(classifier, examples))
+
+
+def _require_configurations_to_split(groups: Any, validation_size: float) -> None:
+    """Raise before any work where splitting by configuration leaves fewer than two
+    configurations to cross-validate on (the validation share takes ``ceil(share * n)``)."""
+    import math
+
+    from unstack.errors import InvalidArgument
+
+    total = len(np.unique(groups))
+    training = total - (math.ceil(validation_size * total) if validation_size > 0 else 0)
+    if training < 2:
+        held = f" after the validation share {validation_size:g} takes {total - training}" if validation_size else ""
+        raise InvalidArgument(
+            f"split by configuration: {total} configuration{'s' if total != 1 else ''} leave{'s' if total == 1 else ''} "
+            f"{training} to cross-validate on{held}; at least 2 "
+            "are needed (give more piles, a smaller validation share, or split by pairs)"
+        )
 
 
 #: Fewer relations of either class than this make a model too thin to trust.
