@@ -207,7 +207,7 @@ def _require_configurations_to_split(groups: Any, validation_size: float) -> Non
     if training < 2:
         held = f" after the validation share {validation_size:g} takes {total - training}" if validation_size else ""
         raise InvalidArgument(
-            f"split by configuration: {total} configuration{'s' if total != 1 else ''} leave{'s' if total == 1 else ''} "
+            f"split by configuration: {total} {'configuration leaves' if total == 1 else 'configurations leave'} "
             f"{training} to cross-validate on{held}; at least 2 "
             "are needed (give more piles, a smaller validation share, or split by pairs)"
         )
