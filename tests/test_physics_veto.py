@@ -166,8 +166,39 @@ def test_a_deeper_container_is_read_from_the_scene_and_a_wrong_one_refused() -> 
     decided = unstack.decide(deep, seed=0, physics_veto=True)
     assert decided.choice == "top" and decided.physics_veto is not None and not decided.physics_veto["vetoed"]
     wrong = dataclasses.replace(shallow, metadata={"container": {"depth": -1.0, "width": 2.35, "height": 2.39}})
-    with pytest.raises(UnstackError, match=r"deep.json: \$\.metadata\.container\[0\]: expected a positive number"):
+    with pytest.raises(UnstackError, match=r"deep.json: \$\.metadata\.container\.depth: expected a positive extent"):
         unstack.decide(wrong, seed=0, physics_veto=True)
+
+
+@pytest.mark.parametrize(
+    ("container", "message"),
+    [
+        (
+            {"depth": 2000.0, "width": 2.35, "height": 2.39},
+            r"\.container\.depth: expected a positive extent of at most 100",
+        ),
+        ({"depth": 2.0, "width": 2.35, "height": 0.3}, r"\.container: a container of 2 x 2.35 x 0.3 m is smaller than"),
+    ],
+)
+def test_a_container_in_another_unit_or_smaller_than_a_carton_is_refused(container: dict, message: str) -> None:
+    box = Box("low", [0.4, 0.4, 0.3], [0.5, 0.0, 0.15])
+    scene = Scene([box], np.zeros((0, 3)), ["low"], metadata={"container": container}, source="odd.json")
+    with pytest.raises(UnstackError, match=r"odd.json: \$\.metadata" + message):
+        unstack.decide(scene, seed=0, physics_veto=True)
+
+
+def test_a_pallet_smaller_than_the_simulators_section_is_decided_with_its_own_extent() -> None:
+    boxes = [Box("low", [0.4, 0.3, 0.3], [0.5, 0.0, 0.15]), Box("top", [0.4, 0.3, 0.3], [0.5, 0.0, 0.45])]
+    pallet = {"container": {"depth": 1.2, "width": 1.0, "height": 2.0}}
+    decided = unstack.decide(Scene(boxes, np.zeros((0, 3)), ["low", "top"], metadata=pallet), seed=0, physics_veto=True)
+    assert decided.choice == "top" and decided.physics_veto is not None
+
+
+def test_a_scene_metres_out_of_the_door_is_refused_as_another_frame() -> None:
+    boxes = [Box("low", [0.4, 0.4, 0.3], [-3.9, 0.0, 0.15]), Box("top", [0.4, 0.4, 0.3], [-3.9, 0.0, 0.45])]
+    scene = Scene(boxes, np.zeros((0, 3)), ["low", "top"], source="before.json")
+    with pytest.raises(InvalidArgument, match=r"before.json: box 'low' lies outside .* \(x from -2 m before the door"):
+        unstack.decide(scene, seed=0, physics_veto=True)
 
 
 WITHOUT_PYBULLET = """

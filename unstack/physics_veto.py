@@ -22,8 +22,8 @@ the container about its middle, the floor at z = 0): the container's walls stand
 worlds (:func:`world_settings`: a simulated scene's own, the scene's ``metadata.container``, else
 the simulator's 2 m section). A detected box that reaches into them is slid inside for the belief
 worlds and the decision warns (a camera's fit of a box seen in part guesses its unseen extent);
-one beyond them by more than its own longest side is refused (boxes may spill out of the door:
-x < 0).
+one beyond them by more than its own longest side is refused (boxes may spill out of the door,
+up to :data:`DOOR_SPILL` before it).
 
 Examples
 --------
@@ -37,6 +37,7 @@ True
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
@@ -69,6 +70,9 @@ PHYSICS_FILL = "faces"
 #: (a box seen in part is placed from the part seen, its unseen extent a guess) and the
 #: decision warns, and beyond by more than its own longest side it is refused.
 WALL_SLACK = 0.02
+#: Boxes that fell out of the door lie on the floor before it (the simulator's apron reaches 1.5 m),
+#: at most this far (metres); a box further out than its own size beyond it is a scene in another frame.
+DOOR_SPILL = 2.0
 
 
 def _expected_moved(
@@ -132,7 +136,6 @@ def world_settings(scene: Scene) -> Any:
     >>> world_settings(scene).container.depth
     12.0
     """
-    from unstack.checks import check_vector
     from unstack.sim.belief import belief_settings
     from unstack.sim.settings import Container
 
@@ -145,10 +148,32 @@ def world_settings(scene: Scene) -> Any:
         from unstack.errors import InvalidScene
 
         raise InvalidScene(scene.source, "$.metadata.container", f"expected an object with {', '.join(keys)}")
-    extent = check_vector(
-        [given[key] for key in keys], 3, positive=True, source=scene.source, path="$.metadata.container"
+    from unstack.errors import InvalidScene, UnstackError
+    from unstack.sim.settings import MAX_EXTENT
+
+    extent = []
+    for key in keys:
+        value = given[key]
+        number = float(value) if isinstance(value, int | float) and not isinstance(value, bool) else math.nan
+        if not 0.0 < number <= MAX_EXTENT:
+            raise InvalidScene(
+                scene.source,
+                f"$.metadata.container.{key}",
+                f"expected a positive extent of at most {MAX_EXTENT:g} m (metres?), got {value!r}",
+            )
+        extent.append(number)
+    container = Container(*extent)
+    # the pile the simulator would drop is not this scene's: two boxes, and a size set that fits, keep its checks away
+    for sizes in (settings.sizes, "cartons"):
+        try:
+            return dataclasses.replace(settings, container=container, boxes=(2, 2), sizes=sizes)
+        except UnstackError:
+            continue
+    raise InvalidScene(
+        scene.source,
+        "$.metadata.container",
+        f"a container of {' x '.join(f'{v:g}' for v in extent)} m is smaller than a carton's edges (metres?)",
     )
-    return dataclasses.replace(settings, container=Container(*(float(value) for value in extent)))
 
 
 def _inside_container(scene: Scene, settings: Any) -> tuple[Scene, dict[str, float]]:
@@ -159,7 +184,7 @@ def _inside_container(scene: Scene, settings: Any) -> tuple[Scene, dict[str, flo
 
     container = settings.container
     # boxes may spill out of the door (x < 0) onto the floor before it, nowhere else
-    low = np.array([-np.inf, -container.width / 2.0, 0.0])
+    low = np.array([-DOOR_SPILL, -container.width / 2.0, 0.0])
     high = np.array([container.depth, container.width / 2.0, container.height])
     boxes = {box.id: box for box in scene.boxes}
     slid: dict[str, float] = {}
@@ -172,8 +197,8 @@ def _inside_container(scene: Scene, settings: Any) -> tuple[Scene, dict[str, flo
         box = scene.box(box_id)
         if np.any((below > 0) & (above > 0)) or distance > float(np.max(box.size)):
             raise InvalidArgument(
-                f"{scene.source}: box {box_id!r} lies outside the container the physics veto builds (x up to "
-                f"{container.depth:g} m from the door, y within {container.width / 2:g} m of the middle, z 0 to "
+                f"{scene.source}: box {box_id!r} lies outside the container the physics veto builds (x from "
+                f"{-DOOR_SPILL:g} m before the door to {container.depth:g} m, y within {container.width / 2:g} m of the middle, z 0 to "
                 f"{container.height:g} m) by {distance:.2f} m, more than its own size: a pose error, a scene in "
                 "another frame, or another container (give its inner extent in the scene's metadata.container: "
                 "depth, width, height)"
