@@ -198,10 +198,10 @@ def _inside_container(scene: Scene, settings: Any) -> tuple[Scene, dict[str, flo
         if np.any((below > 0) & (above > 0)) or distance > float(np.max(box.size)):
             raise InvalidArgument(
                 f"{scene.source}: box {box_id!r} lies outside the container the physics veto builds (x from "
-                f"{-DOOR_SPILL:g} m before the door to {container.depth:g} m, y within {container.width / 2:g} m of the middle, z 0 to "
-                f"{container.height:g} m) by {distance:.2f} m, more than its own size: a pose error, a scene in "
-                "another frame, or another container (give its inner extent in the scene's metadata.container: "
-                "depth, width, height)"
+                f"{-DOOR_SPILL:g} m before the door to {container.depth:g} m, y within {container.width / 2:g} m of "
+                f"the middle, z 0 to {container.height:g} m) by {distance:.2f} m, more than its own size: a pose "
+                "error, a scene in another frame, or another container (give its inner extent in the scene's "
+                "metadata.container: depth, width, height)"
             )
         boxes[box_id] = dataclasses.replace(box, position=np.asarray(box.position) + shift)
         slid[box_id] = distance
