@@ -362,6 +362,8 @@ def decide(
 
     if free_cost is not None:
         free_cost = check_margin(free_cost, "free_cost")
+    if not isinstance(physics_veto, bool):
+        raise InvalidArgument(f"physics_veto must be True or False, got {physics_veto!r}")
     veto_scene = _physics_veto_scene(scene_or_supports, cost) if physics_veto else None
     supports = _supports(scene_or_supports, model, statics)
     if cost == "moves":

@@ -14,6 +14,7 @@ array([[0. , 0.7],
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -40,8 +41,11 @@ __all__ = [
     "check_quaternion_xyzw",
     "check_vector",
     "light_boxes",
+    "number_text",
 ]
 
+#: An integer of more bits than this is beyond the largest float (about 1.8e308).
+FLOAT_BITS = 1024
 #: A quaternion whose norm is within this of 1 is normalised; further away it is an error.
 QUATERNION_NORM_TOLERANCE = 1e-3
 
@@ -57,6 +61,19 @@ REFUSED_OVERLAP = 0.5
 #: A box lighter than this (kg) is warned about: no carton weighs less, so the masses are
 #: likely in another unit (the heaviest accepted, 10,000 kg, is in the schemas).
 LIGHT_BOX = 0.01
+
+
+def number_text(value: Any) -> str:
+    """``value`` for a message: an integer too long to print (or to make a float of) by its size.
+
+    Examples
+    --------
+    >>> number_text(10**400), number_text(0.5)
+    ('an integer of about 401 digits', '0.5')
+    """
+    if isinstance(value, int | np.integer) and not isinstance(value, bool) and int(value).bit_length() > 64:
+        return f"an integer of about {int(int(value).bit_length() * math.log10(2)) + 1} digits"
+    return repr(value)
 
 
 def light_boxes(ids: Sequence[str], masses: Any) -> str | None:
@@ -224,6 +241,8 @@ def check_vector(
             raise error(source, f"{path}[{index}]", f"expected a number, got {item!r}")
         if isinstance(item, np.complexfloating):
             raise error(source, f"{path}[{index}]", f"expected a real number, got {item!r}")
+        if isinstance(item, int) and item.bit_length() > FLOAT_BITS:
+            raise error(source, f"{path}[{index}]", f"expected a finite number, got {number_text(item)}")
     vector = np.array(array, dtype=np.float64)
     for index, item in enumerate(vector):
         if not np.isfinite(item):

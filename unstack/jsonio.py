@@ -234,8 +234,14 @@ def read_document(path: str | os.PathLike[str]) -> Document:
             raise InvalidFile(source, "$", f"cannot read standard input: {error}") from None
     else:
         file = Path(path)
-        refuse_special_file(file)
-        if file.is_dir():
+        if "\0" in source:
+            raise InvalidFile(source.replace("\0", "\\0"), "$", "expected a file name, got one with a NUL character")
+        try:
+            refuse_special_file(file)
+            is_dir = file.is_dir()
+        except OSError as error:  # a name longer than the system allows, say
+            raise InvalidFile(source, "$", f"cannot read the file: {error.strerror}") from None
+        if is_dir:
             raise InvalidFile(source, "$", "expected a JSON file, got a directory")
         try:
             size = file.stat().st_size

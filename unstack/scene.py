@@ -16,7 +16,7 @@ Examples
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -267,6 +267,8 @@ class Scene:
         *,
         points_path: str = "$.points",
     ) -> None:
+        if isinstance(boxes, str | bytes) or not isinstance(boxes, Iterable):
+            raise InvalidScene(source, "$.boxes", f"expected a list of boxes, got {type(boxes).__name__}")
         boxes = tuple(boxes)
         if not boxes:
             raise InvalidScene(source, "$.boxes", "expected at least one box, got an empty list")

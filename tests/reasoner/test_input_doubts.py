@@ -1,5 +1,6 @@
-"""Arguments a decision takes but cannot have meant are warned about: masses lighter than a carton,
-margins above every expected cost the boxes can have."""
+"""Arguments a decision takes but cannot have meant are warned about (masses lighter than a carton,
+margins above every expected cost the boxes can have), and those no call could use are refused
+before any work with the library's own error, never a bare exception from deep inside."""
 
 from __future__ import annotations
 
@@ -60,3 +61,46 @@ def test_masses_lighter_than_a_carton_are_warned_about_with_the_mass_cost_only(c
         "pile.json: box 'bottom' (1e-09 kg) weighs less than 0.01 kg, lighter than a carton; masses in kg?",
     )
     assert decide(feathers, cost="count").warnings == ()
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (
+            lambda s: unstack.plan(s, progress=lambda: None),
+            r"progress must take two arguments, progress\(done, total\)",
+        ),
+        (lambda s: unstack.decide(s, physics_veto="yes"), r"physics_veto must be True or False, got 'yes'"),
+        (
+            lambda s: unstack.decide(s, time_limit=10**400),
+            r"time_limit must be a finite number of seconds, got an integer",
+        ),
+        (
+            lambda s: unstack.decide(s, near_tie_margin=10**400),
+            r"near_tie_margin must be .* got an integer of about 401",
+        ),
+    ],
+    ids=["progress-arity", "physics-veto-type", "huge-time-limit", "huge-margin"],
+)
+def test_arguments_no_call_could_use_are_refused_before_any_work(chain: Supports, call: object, message: str) -> None:
+    from unstack.errors import InvalidArgument
+
+    with pytest.raises(InvalidArgument, match=message):
+        call(chain)  # type: ignore[operator]
+
+
+@pytest.mark.parametrize("name", ["x" * 5000, "a\0b"], ids=["too-long", "nul"])
+def test_a_file_name_the_system_refuses_is_one_invalid_file_error(name: str) -> None:
+    from unstack.errors import InvalidFile
+
+    with pytest.raises(
+        InvalidFile, match=r"\$: (cannot read the file: File name too long|expected a file name, got one)"
+    ):
+        unstack.load(name)
+
+
+def test_a_scene_of_no_list_of_boxes_is_refused_with_its_path() -> None:
+    from unstack.errors import InvalidScene
+
+    with pytest.raises(InvalidScene, match=r"\$\.boxes: expected a list of boxes, got NoneType"):
+        unstack.Scene(None, [], ["a"])  # type: ignore[arg-type]

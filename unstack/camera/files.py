@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from unstack.checks import number_text
 from unstack.errors import InvalidFile
 from unstack.jsonio import refuse_special_file
 
@@ -96,7 +97,9 @@ def load_intrinsics(path: str | os.PathLike[str]) -> Intrinsics:
             raise InvalidFile(source, "$", f"missing required key {name!r} (expected {', '.join(INTRINSICS_KEYS)})")
         value = _real(data[name])
         if value is None or value <= 0:
-            raise InvalidFile(source, f"$.{name}", f"expected a positive number of pixels, got {_shown(data[name])}")
+            raise InvalidFile(
+                source, f"$.{name}", f"expected a positive number of pixels, got {number_text(data[name])}"
+            )
         values[name] = value
     if values["width"] != int(values["width"]) or values["height"] != int(values["height"]):
         raise InvalidFile(source, "$.width", "expected whole numbers of pixels for width and height")
@@ -162,7 +165,7 @@ def load_pose(path: str | os.PathLike[str]) -> np.ndarray:
         for column, entry in enumerate(entries):
             if _real(entry) is None:
                 raise InvalidFile(
-                    source, f"{json_path}[{row}][{column}]", f"expected a finite number, got {_shown(entry)}"
+                    source, f"{json_path}[{row}][{column}]", f"expected a finite number, got {number_text(entry)}"
                 )
     pose = np.array([[_real(entry) for entry in entries] for entries in rows], dtype=np.float64)
     rotation = pose[:3, :3]
@@ -185,13 +188,6 @@ def _real(value: Any) -> float | None:
     except OverflowError:
         return None
     return number if math.isfinite(number) else None
-
-
-def _shown(value: Any) -> str:
-    """``value`` for a message: an integer too long to print by its size."""
-    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 64:
-        return f"an integer of about {int(value.bit_length() * math.log10(2)) + 1} digits"
-    return repr(value)
 
 
 def _read_image(file: Path) -> np.ndarray:

@@ -47,7 +47,12 @@ def _real_number(value: Any, name: str, unit: str) -> float:
     """``value`` as a float when it is a real number (not a bool); else the error naming ``unit``."""
     if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
         raise InvalidArgument(f"{name} must be a number of {unit}, got {value!r}")
-    return float(value)
+    try:
+        return float(value)
+    except OverflowError:  # an integer beyond the largest float
+        from unstack.checks import number_text
+
+        raise InvalidArgument(f"{name} must be a finite number of {unit}, got {number_text(value)}") from None
 
 
 def check_budget(value: Any, name: str) -> float:

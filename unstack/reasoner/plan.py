@@ -123,6 +123,24 @@ class Plan:
         }
 
 
+def _check_progress(progress: Any) -> None:
+    """Raise before any work when ``progress`` cannot be called as ``progress(done, total)``."""
+    if progress is None:
+        return
+    if not callable(progress):
+        raise InvalidArgument(f"progress must be a callable progress(done, total), got {type(progress).__name__}")
+    import inspect
+
+    try:
+        signature = inspect.signature(progress)
+    except (TypeError, ValueError):  # a callable without a signature to read (some builtins): trusted
+        return
+    try:
+        signature.bind(0, 0)
+    except TypeError as error:
+        raise InvalidArgument(f"progress must take two arguments, progress(done, total): {error}") from None
+
+
 def unloading_plan(
     supports: Supports,
     *,
@@ -168,8 +186,7 @@ def unloading_plan(
     >>> unloading_plan(Supports(["a", "b"], [[0, 0.2], [0.7, 0]])).order
     ['a', 'b']
     """
-    if progress is not None and not callable(progress):
-        raise InvalidArgument(f"progress must be a callable progress(done, total), got {type(progress).__name__}")
+    _check_progress(progress)
     remaining = list(supports.objects) if isinstance(supports, Supports) else []
     steps: list[PlanStep] = []
     work = WorkCache()
