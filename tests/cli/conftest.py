@@ -25,3 +25,16 @@ def camera_files(tmp_path: Path) -> list[str]:
         Image.fromarray(mask.astype(np.uint8) * 255).save(tmp_path / f"mask-b{k:02d}.png")
         arguments.append(str(tmp_path / f"mask-b{k:02d}.png"))
     return arguments
+
+
+@pytest.fixture
+def cloud_and_detections(tmp_path: Path) -> list[str]:
+    """A floor's cloud (``.npy``) and two detected boxes on it: ``--cloud FILE --detections FILE``."""
+    rng = np.random.default_rng(0)
+    floor = np.column_stack([rng.uniform(-1, 1, 4000), rng.uniform(-1, 1, 4000), np.zeros(4000)])
+    np.save(tmp_path / "cloud.npy", floor)
+    (tmp_path / "boxes.json").write_text(json.dumps({"boxes": [
+        {"id": "low", "center": [0, 0, 0.15], "size": [0.4, 0.3, 0.3], "yaw_deg": 10},
+        {"id": "high", "center": [0, 0, 0.45], "size": [0.4, 0.3, 0.3], "yaw_deg": 10},
+    ]}))  # fmt: skip
+    return ["--cloud", str(tmp_path / "cloud.npy"), "--detections", str(tmp_path / "boxes.json")]

@@ -2,8 +2,8 @@
 ``unstack: error:`` and says what was expected, and nothing written.
 
 One table for all the commands, so that each refusal is held to the same rule; ``{tmp}`` is the
-test's folder, ``{camera}`` a camera's files as ``unstack scene`` takes them
-(``tests/cli/conftest.py``).
+test's folder, ``{camera}`` a camera's files as ``unstack scene`` takes them and ``{detected}`` a
+cloud with a detector's boxes (``tests/cli/conftest.py``).
 """
 
 from __future__ import annotations
@@ -18,6 +18,9 @@ pytestmark = pytest.mark.slow  # runs the CLI in subprocesses
 
 SIMULATE = ["simulate", "--configs", "1", "--out", "{tmp}/out"]
 SCENE = ["scene", "{camera}", "--out", "{tmp}/scene.json"]
+DETECTED = ["scene", "{detected}", "--out", "{tmp}/scene.json"]
+#: Placeholders of the table and the fixtures that give their arguments.
+FILES = {"{camera}": "camera_files", "{detected}": "cloud_and_detections"}
 
 #: Values of decide's options that are refused with the option named.
 NAMED_BAD_VALUES = {
@@ -41,6 +44,9 @@ REFUSALS = [
     ([*SCENE, "--ids", "a,"], "--ids: expected 2 non-empty box ids separated by commas, got 'a,'"),
     ([*SCENE, "--sizes", ""], "--sizes: expected sizes like 0.4x0.3x0.3 separated by commas, got ''"),
     ([*SCENE, "--door", "0,0,1"], "within 15 degrees of the vertical"),
+    ([*SCENE, "--sizes", "0.01x0.01x0.01"], "--sizes: expected three edges of 0.02-5 m per size, got '0.01x0.01x0.01'"),
+    ([*DETECTED, "--sizes", "0.4x0.3x0.3", "--ids", "a,b"], "--sizes and --ids apply to mask files and a depth image"),
+    ([*DETECTED, "--depth-units", "mm"], "--depth-units apply to mask files and a depth image"),
     ([*SIMULATE, "--sizes", "paper3"], "'paper3' is not one of 'paper2', 'four', 'mixed'"),
     ([*SIMULATE, "--boxes", "40-30"], "box range 40-30 is reversed"),
     ([*SIMULATE, "--boxes", "many"], "--boxes: expected COUNT or LOW-HIGH (for example 30-40), got 'many'"),
@@ -63,8 +69,8 @@ REFUSALS = [
 def test_a_bad_command_line_is_refused_in_one_line_with_nothing_written(
     request: pytest.FixtureRequest, tmp_path: Path, arguments: list[str], message: str
 ) -> None:
-    camera = request.getfixturevalue("camera_files") if "{camera}" in arguments else []
-    expanded = [part for argument in arguments for part in (camera if argument == "{camera}" else [argument])]
+    given = {name: request.getfixturevalue(fixture) for name, fixture in FILES.items() if name in arguments}
+    expanded = [part for argument in arguments for part in given.get(argument, [argument])]
     before = sorted(tmp_path.rglob("*"))
     result = unstack(*[argument.format(tmp=tmp_path) for argument in expanded])
     assert result.returncode == 2, result.stderr

@@ -26,17 +26,9 @@ def test_the_scene_is_written_and_decided(camera_files: list[str], tmp_path: Pat
     assert json.loads(decided.stdout)["choice"] in ("b00", "b01")
 
 
-def test_a_cloud_and_detections_make_a_scene(tmp_path: Path) -> None:
-    rng = np.random.default_rng(0)
-    floor = np.column_stack([rng.uniform(-1, 1, 4000), rng.uniform(-1, 1, 4000), np.zeros(4000)])
-    np.save(tmp_path / "cloud.npy", floor)
-    (tmp_path / "boxes.json").write_text(json.dumps({"boxes": [
-        {"id": "low", "center": [0, 0, 0.15], "size": [0.4, 0.3, 0.3], "yaw_deg": 10},
-        {"id": "high", "center": [0, 0, 0.45], "size": [0.4, 0.3, 0.3], "yaw_deg": 10},
-    ]}))  # fmt: skip
+def test_a_cloud_and_detections_make_a_scene(cloud_and_detections: list[str], tmp_path: Path) -> None:
     out = tmp_path / "scene.json"
-    run = unstack("scene", "--cloud", str(tmp_path / "cloud.npy"), "--detections", str(tmp_path / "boxes.json"),
-                  "--out", str(out))  # fmt: skip
+    run = unstack("scene", *cloud_and_detections, "--out", str(out))
     assert run.returncode == 0, run.stderr
     assert json.loads(out.read_text())["detected"] == ["low", "high"]
 
@@ -90,3 +82,11 @@ def test_a_report_on_the_scene_or_an_input_is_refused_before_any_work(
 def test_a_mask_given_twice_is_named(camera_files: list[str], tmp_path: Path) -> None:
     run = unstack("scene", *camera_files, camera_files[-1], "--out", str(tmp_path / "scene.json"))
     assert run.returncode == 2 and f"{camera_files[-1]}: the same mask file is given twice" in run.stderr
+
+
+def test_a_mask_file_that_names_no_box_is_refused(camera_files: list[str], tmp_path: Path) -> None:
+    unnamed = tmp_path / "mask-.png"
+    unnamed.write_bytes(Path(camera_files[-1]).read_bytes())
+    run = unstack("scene", *camera_files[:-1], str(unnamed), "--out", str(tmp_path / "scene.json"))
+    assert run.returncode == 2 and f"{unnamed}: the file name gives an empty box id" in run.stderr
+    assert not (tmp_path / "scene.json").exists()

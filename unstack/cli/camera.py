@@ -17,6 +17,7 @@ from pathlib import Path
 
 import click
 
+from unstack.checks import MAX_BOX_EDGE, MIN_BOX_EDGE
 from unstack.errors import InvalidFile, UnstackError
 
 __all__ = ["scene"]
@@ -32,8 +33,10 @@ def _sizes(text: str | None) -> list[tuple[float, float, float]] | None:
             edges = tuple(float(value) for value in item.lower().split("x"))
         except ValueError:
             raise UnstackError(f"--sizes: expected sizes like 0.4x0.3x0.3 separated by commas, got {item!r}") from None
-        if len(edges) != 3 or not all(0.01 <= edge <= 3.0 for edge in edges):
-            raise UnstackError(f"--sizes: expected three edges of 0.01-3 m per size, got {item!r}")
+        if len(edges) != 3 or not all(MIN_BOX_EDGE <= edge <= MAX_BOX_EDGE for edge in edges):
+            raise UnstackError(
+                f"--sizes: expected three edges of {MIN_BOX_EDGE:g}-{MAX_BOX_EDGE:g} m per size, got {item!r}"
+            )
         sizes.append((edges[0], edges[1], edges[2]))
     return sizes
 
@@ -89,7 +92,8 @@ def _door(text: str | None) -> list[float] | None:
         values = []
     if len(values) != 3 or not any(values) or not all(math.isfinite(value) for value in values):
         raise UnstackError(f"--door: expected a direction x,y,z in the pose's frame, got {text!r}")
-    return values
+    largest = max(abs(value) for value in values)  # a direction: its scale does not matter, and 1e300 overflows
+    return [value / largest for value in values]
 
 
 @click.command()
@@ -143,6 +147,14 @@ def scene(
     if detections_file is not None:  # boxes a detector found: the cloud, or the depth image's points, gives gravity
         if mask_files:
             raise UnstackError("give masks or --detections, not both")
+        unused = [name for name, value in (("--sizes", sizes), ("--ids", ids)) if value is not None]
+        if cloud_file is not None and depth_units is not None:
+            unused.append("--depth-units")
+        if unused:
+            raise UnstackError(
+                f"{' and '.join(unused)} apply to mask files and a depth image; the detections give each box's id "
+                "and size, and a cloud is in metres"
+            )
         from unstack.camera import depth_points, load_cloud, load_detections, scene_from_cloud
 
         if cloud_file is not None:
@@ -171,6 +183,11 @@ def scene(
             raise UnstackError(f"--ids names {len(names)} boxes but {len(mask_files)} masks were given")
         if ids is not None and not all(names):
             raise UnstackError(f"--ids: expected {len(mask_files)} non-empty box ids separated by commas, got {ids!r}")
+        unnamed = [path for path, name in zip(mask_files, names, strict=True) if not name]
+        if unnamed:
+            raise UnstackError(
+                f"{unnamed[0]}: the file name gives an empty box id; rename it (mask-ID.png) or give --ids"
+            )
         repeated = sorted({path for path in mask_files if mask_files.count(path) > 1})
         if repeated:
             raise UnstackError(f"{repeated[0]}: the same mask file is given twice")
