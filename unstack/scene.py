@@ -16,6 +16,7 @@ Examples
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -151,11 +152,17 @@ class Box:
 
 
 def load_points(
-    path: str | os.PathLike[str], *, source: str = "<file>", json_path: str = "$.points_file"
+    path: str | os.PathLike[str],
+    *,
+    source: str = "<file>",
+    json_path: str = "$.points_file",
+    drop_non_finite: bool = False,
 ) -> np.ndarray:
     """Read a point cloud from ``.npy`` (N x 3 numbers) or ``.ply`` (vertex x, y, z).
 
-    ``.npy`` files are read with ``allow_pickle=False``: loading never runs code.
+    ``.npy`` files are read with ``allow_pickle=False``: loading never runs code. With
+    ``drop_non_finite`` the points holding NaN or infinity (a camera's organised cloud marks
+    pixels without a reading so) are left out with a warning; else they are refused.
 
     Raises
     ------
@@ -186,7 +193,10 @@ def load_points(
         elif file.suffix.lower() == ".ply":
             from plyfile import PlyData
 
-            vertices = PlyData.read(str(file))["vertex"]
+            ply = PlyData.read(str(file))
+            if "vertex" not in ply or not {"x", "y", "z"} <= set(ply["vertex"].data.dtype.names or ()):
+                raise InvalidScene(source, json_path, f"expected a vertex element with x, y, z in {file.name!r}")
+            vertices = ply["vertex"]
             array = np.column_stack([vertices["x"], vertices["y"], vertices["z"]])
         else:
             raise InvalidScene(source, json_path, f"expected a .npy or .ply file, got {file.name!r}")
@@ -198,7 +208,25 @@ def load_points(
         raise InvalidScene(
             source, json_path, f"expected at most {MAX_POINTS:,} points, {file.name!r} has {len(array):,}"
         )
+    if drop_non_finite:
+        array = finite_points(array, source)
     return check_points(array, source=source, path=json_path)
+
+
+def finite_points(cloud: Any, source: str) -> np.ndarray:
+    """The points of ``cloud`` whose coordinates are all finite, warning how many were left out
+    (a camera's organised cloud marks pixels without a reading with NaN); ``cloud`` as given when
+    it is not an N x 3 array of floats (:func:`~unstack.checks.check_points` then says why)."""
+    array = np.asarray(cloud)
+    if array.ndim != 2 or array.shape[-1:] != (3,) or not np.issubdtype(array.dtype, np.floating):
+        return array
+    finite = np.all(np.isfinite(array), axis=1)
+    if not finite.all():
+        warnings.warn(
+            f"{source}: {int((~finite).sum()):,} of {len(array):,} points without a finite reading (NaN) left out",
+            stacklevel=3,
+        )
+    return array[finite]
 
 
 def _refuse_large_npy(file: Path, source: str, json_path: str) -> None:

@@ -112,3 +112,22 @@ def test_keys_a_box_is_not_read_from_are_left_out_with_a_warning(tmp_path: Path)
     with pytest.warns(UserWarning, match=r"detection keys passed over .*: label, score"):
         [read] = load_detections(tmp_path / "boxes.json")
     assert sorted(read) == ["center", "id", "size"]
+
+
+@pytest.mark.parametrize("suffix", [".npy", ".ply", ".pcd"])
+def test_points_without_a_reading_are_left_out_with_a_warning_in_every_format(tmp_path: Path, suffix: str) -> None:
+    cloud = np.random.default_rng(4).uniform(0.0, 1.0, (10, 3))
+    cloud[[2, 7]] = np.nan  # an organised cloud's pixels without a reading
+    path = tmp_path / f"cloud{suffix}"
+    if suffix == ".npy":
+        np.save(path, cloud)
+    elif suffix == ".ply":
+        from plyfile import PlyData, PlyElement
+
+        vertices = np.array([tuple(point) for point in cloud], dtype=[("x", "f8"), ("y", "f8"), ("z", "f8")])
+        PlyData([PlyElement.describe(vertices, "vertex")]).write(str(path))
+    else:
+        _write_pcd(path, cloud, "ascii")
+    with pytest.warns(UserWarning, match=r"2 of 10 points without a finite reading \(NaN\) left out"):
+        read = load_cloud(path)
+    assert read.shape == (8, 3) and np.allclose(read, cloud[np.isfinite(cloud).all(axis=1)])

@@ -111,13 +111,14 @@ def _load_pcd(file: Path) -> np.ndarray:
 
 
 def load_cloud(path: str | os.PathLike[str]) -> np.ndarray:
-    """A point cloud as (N, 3) float64 metres from ``.npy``, ``.ply`` or ``.pcd``; non-finite points dropped."""
+    """A point cloud as (N, 3) float64 metres from ``.npy``, ``.ply`` or ``.pcd``; points without a
+    finite reading (NaN) are left out with a warning, in every format."""
     from unstack.checks import check_points
-    from unstack.scene import MAX_CLOUD_FILE_BYTES, MAX_POINTS, load_points
+    from unstack.scene import MAX_CLOUD_FILE_BYTES, MAX_POINTS, finite_points, load_points
 
     file = Path(path)
     if file.suffix.lower() != ".pcd":
-        cloud = np.asarray(load_points(file, source=str(file), json_path="$"))
+        cloud = np.asarray(load_points(file, source=str(file), json_path="$", drop_non_finite=True))
         return cloud
     refuse_special_file(file)
     if not file.is_file():
@@ -132,7 +133,7 @@ def load_cloud(path: str | os.PathLike[str]) -> np.ndarray:
     cloud = _load_pcd(file)
     if len(cloud) > MAX_POINTS:
         raise InvalidFile(str(file), "$", f"expected at most {MAX_POINTS:,} points, got {len(cloud):,}")
-    return check_points(cloud[np.all(np.isfinite(cloud), axis=1)], source=str(file), path="$")
+    return check_points(finite_points(cloud, str(file)), source=str(file), path="$")
 
 
 def load_detections(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
