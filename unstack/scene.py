@@ -15,6 +15,7 @@ Examples
 
 from __future__ import annotations
 
+import math
 import os
 import warnings
 from collections.abc import Iterable, Sequence
@@ -26,6 +27,7 @@ import numpy as np
 
 from unstack.atomic import atomic_save_array, atomic_write_text
 from unstack.checks import (
+    FLOAT_BITS,
     MAX_BOX_EDGE,
     MAX_COORDINATE,
     MIN_BOX_EDGE,
@@ -35,6 +37,7 @@ from unstack.checks import (
     check_points,
     check_quaternion_xyzw,
     check_vector,
+    number_text,
 )
 from unstack.errors import InvalidScene
 from unstack.frozen import set_frozen_fields
@@ -52,7 +55,14 @@ MAX_CLOUD_FILE_BYTES = 256 * 2**20
 
 def _check_mass(mass: float | None, source: str, path: str) -> float | None:
     """A box's mass as a positive float, or None when not given."""
-    return None if mass is None else float(check_vector([mass], 1, positive=True, source=source, path=path)[0])
+    if mass is None:
+        return None
+    if isinstance(mass, bool) or not isinstance(mass, int | float | np.integer | np.floating):
+        raise InvalidScene(source, path, f"expected a positive number of kg, got {mass!r}")
+    number = float(mass) if not isinstance(mass, int) or mass.bit_length() <= FLOAT_BITS else math.inf
+    if not (math.isfinite(number) and number > 0):
+        raise InvalidScene(source, path, f"expected a positive, finite number of kg, got {number_text(mass)}")
+    return number
 
 
 def _check_edges(size: np.ndarray, source: str, path: str) -> np.ndarray:

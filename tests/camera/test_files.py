@@ -103,3 +103,10 @@ def test_a_mask_array_of_no_channel_or_no_numbers_is_refused(tmp_path: Path, mas
     np.save(tmp_path / "m.npy", mask)
     with pytest.raises(InvalidFile, match=message):
         load_mask(tmp_path / "m.npy")
+
+
+def test_a_depth_file_that_is_no_npy_array_is_refused_without_numpys_pickle_advice(tmp_path: Path) -> None:
+    (tmp_path / "d.npy").write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(64))
+    with pytest.raises(InvalidFile, match=r"d.npy: \$: expected a depth image as a .npy array of numbers") as refused:
+        load_depth(tmp_path / "d.npy")
+    assert "pickle" not in str(refused.value)

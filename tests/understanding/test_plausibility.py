@@ -130,3 +130,9 @@ def test_a_box_lighter_than_a_carton_is_warned_about_and_a_light_carton_is_not()
     assert warnings == [
         "<array>: box 'feather' (1e-09 kg) weighs less than 0.01 kg, lighter than a carton; masses in kg?"
     ]
+
+
+@pytest.mark.parametrize(("mass", "shown"), [(-1, "-1"), (10**400, "an integer of about 401 digits"), (0.0, "0.0")])
+def test_a_mass_no_box_has_is_refused_at_its_path(mass: object, shown: str) -> None:
+    with pytest.raises(InvalidScene, match=rf"\$\.mass: expected a positive, finite number of kg, got {shown}"):
+        Box("a", [0.4, 0.3, 0.3], [1.0, 0.0, 0.15], mass=mass)  # type: ignore[arg-type]

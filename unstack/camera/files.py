@@ -190,6 +190,18 @@ def _real(value: Any) -> float | None:
     return number if math.isfinite(number) else None
 
 
+def _load_npy(file: Path, source: str, what: str) -> np.ndarray:
+    """A ``.npy`` array, never unpickled: a file that is not one (or holds objects) is refused in
+    our words (numpy's would suggest allowing pickle, which runs code)."""
+    try:
+        array: np.ndarray = np.load(file, allow_pickle=False)
+    except ValueError:
+        raise InvalidFile(
+            source, "$", f"expected a {what} as a .npy array of numbers, {file.name!r} is not one"
+        ) from None
+    return array
+
+
 def _read_image(file: Path) -> np.ndarray:
     from PIL import Image
 
@@ -215,7 +227,7 @@ def load_depth(path: str | os.PathLike[str], *, units: str | None = None) -> np.
     suffix = file.suffix.lower()
     try:
         if suffix == ".npy":
-            raw = np.load(file, allow_pickle=False)
+            raw = _load_npy(file, source, "depth image")
         elif suffix == ".png":
             raw = _read_image(file)
         else:
@@ -268,7 +280,9 @@ def load_mask(path: str | os.PathLike[str], shape: tuple[int, int] | None = None
     if not file.is_file():
         raise InvalidFile(source, "$", "the mask does not exist")
     try:
-        raw = np.load(file, allow_pickle=False) if file.suffix.lower() == ".npy" else _read_image(file)
+        raw = _load_npy(file, source, "mask") if file.suffix.lower() == ".npy" else _read_image(file)
+    except InvalidFile:
+        raise
     except Exception as error:  # noqa: BLE001 - any reader failure is the file's fault
         raise InvalidFile(source, "$", f"cannot read the mask: {error}") from None
     if not (np.issubdtype(raw.dtype, np.integer) or np.issubdtype(raw.dtype, np.floating) or raw.dtype == bool):

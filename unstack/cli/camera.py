@@ -65,11 +65,14 @@ def _check_outputs(target: Path, report_file: str | None, inputs: list[str | Non
 
 @contextlib.contextmanager
 def _naming(inputs: str) -> Iterator[None]:
-    """Name ``inputs`` in an error of the scene's building that names no file (gravity, the fits)."""
+    """Name ``inputs`` in an error of the scene's building that names no file (gravity, the fits, the
+    checks of the scene built, whose source is a placeholder such as ``<cloud>``)."""
     try:
         yield
-    except InvalidFile:
-        raise
+    except InvalidFile as error:
+        if not error.source.startswith("<"):
+            raise  # names its file already
+        raise UnstackError(f"{inputs}: the scene built from them, {error.json_path}: {error.message}") from None
     except UnstackError as error:
         raise UnstackError(f"{inputs}: {error}") from None
 
