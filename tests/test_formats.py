@@ -291,3 +291,17 @@ def test_a_complex_point_cloud_is_refused(tmp_path: Path) -> None:
     path = write(tmp_path, document)
     with pytest.raises(InvalidFile, match=r"\$\.points_file: expected real numbers, got dtype complex128"):
         load_scene(path)
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        (b'{"tilt_deg": 9.0, "boxes": []}', r"missing required key 'format' .*: not an unstack document"),
+        (b"PK\x03\x04\xbd\xff binary", r"expected a JSON document \(UTF-8 text\), got a binary file"),
+    ],
+    ids=["no-format-tag", "binary"],
+)
+def test_a_file_that_is_no_unstack_document_says_so(tmp_path: Path, content: bytes, message: str) -> None:
+    (tmp_path / "other.json").write_bytes(content)
+    with pytest.raises(InvalidFile, match=message):
+        unstack.validate(tmp_path / "other.json")

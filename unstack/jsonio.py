@@ -252,7 +252,11 @@ def read_document(path: str | os.PathLike[str]) -> Document:
             text = file.read_text(encoding="utf-8")
         except FileNotFoundError:
             raise InvalidFile(source, "$", "no such file") from None
-        except (OSError, UnicodeDecodeError) as error:
+        except UnicodeDecodeError:
+            raise InvalidFile(
+                source, "$", "expected a JSON document (UTF-8 text), got a binary file (a model .skops, an array .npy?)"
+            ) from None
+        except OSError as error:
             raise InvalidFile(source, "$", f"cannot read the file: {error}") from None
         base_dir = file.resolve().parent
     try:
@@ -417,7 +421,12 @@ def validate_document(
     accepted = list(expected) if expected is not None else list(FORMATS)
     tag = document.data.get("format")
     if tag is None:
-        raise UnknownFormat(document.source, "$", f"missing required key 'format' (expected {', '.join(accepted)})")
+        raise UnknownFormat(
+            document.source,
+            "$",
+            f"missing required key 'format' (expected {', '.join(accepted)}): not an unstack document (a fit "
+            "report, an experiment's results or a checkpoint carries no format tag and is not checked)",
+        )
     if not isinstance(tag, str):
         raise UnknownFormat(
             document.source, "$.format", f"expected a format tag string ({' or '.join(accepted)}), got {_short(tag)}"
