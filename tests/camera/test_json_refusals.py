@@ -96,6 +96,11 @@ def intrinsics(**change: Any) -> dict[str, Any]:
         ),
         ("pose", [["1", "0", "0", "0"], *np.eye(4)[1:].tolist()], r"\$\[0\]\[0\]: expected a finite number, got '1'"),
         ("pose", [[True, 0, 0, 0], *np.eye(4)[1:].tolist()], r"\$\[0\]\[0\]: expected a finite number, got True"),
+        (
+            "pose",
+            [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 1500], [0, 0, 0, 1]],
+            r"\$\[2\]\[3\]: expected a translation within",
+        ),
         ("intrinsics", intrinsics(cy=None), r"\$: missing required key 'cy'"),
         ("intrinsics", intrinsics(k1=0.01), r"\$\.k1: expected no lens distortion"),
         ("intrinsics", intrinsics(D=[0.1, 0.0, 0.0, 0.0, 0.0]), r"\$\.D: expected no lens distortion"),

@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from unstack.checks import number_text
+from unstack.checks import MAX_COORDINATE, number_text
 from unstack.errors import InvalidFile
 from unstack.jsonio import refuse_special_file
 
@@ -169,6 +169,13 @@ def load_pose(path: str | os.PathLike[str]) -> np.ndarray:
                 )
     pose = np.array([[_real(entry) for entry in entries] for entries in rows], dtype=np.float64)
     rotation = pose[:3, :3]
+    far = np.flatnonzero(np.abs(pose[:3, 3]) > MAX_COORDINATE)
+    if far.size:
+        row = int(far[0])
+        raise InvalidFile(
+            source, f"{json_path}[{row}][3]", f"expected a translation within {MAX_COORDINATE:g} m (metres?), "
+            f"got {pose[row, 3]:g}"
+        )  # fmt: skip
     if not np.allclose(pose[3], [0.0, 0.0, 0.0, 1.0]):
         raise InvalidFile(source, f"{json_path}[3]", "expected the last row 0 0 0 1")
     if not np.allclose(rotation.T @ rotation, np.eye(3), atol=1e-3) or not np.isclose(
