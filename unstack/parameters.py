@@ -111,8 +111,14 @@ class Interval:
 
 
 def _shown(number: float) -> str:
-    """``12``, ``0.9``, ``100,000,000``: a bound or a value as a message shows it."""
-    if float(number).is_integer() and abs(number) >= 10_000:
+    """``12``, ``0.9``, ``100,000,000``, ``1e+300``: a bound or a value as a message shows it.
+
+    Examples
+    --------
+    >>> _shown(100_000_000), _shown(0.9), _shown(1e300)
+    ('100,000,000', '0.9', '1e+300')
+    """
+    if float(number).is_integer() and 10_000 <= abs(number) < 1e15:
         return f"{int(number):,}"
     return str(int(number)) if isinstance(number, int) else f"{number:g}"
 
