@@ -198,10 +198,13 @@ def train(
         data_dirs, examples, vary_clouds=vary_clouds, pose_noise=pose_noise, seed=seed, r=r,
         isets_per_configuration=isets, isets_from=draw,
     )  # fmt: skip
-    run = train_support_model(
-        examples, settings, learner=learner, cv=cv, validation_size=validation_size, split_by=split_by, seed=seed,
-        n_jobs=jobs, provenance=provenance,
-    )  # fmt: skip
+    from unstack.cli.progress import still_working
+
+    with still_working("cross-validating"):
+        run = train_support_model(
+            examples, settings, learner=learner, cv=cv, validation_size=validation_size, split_by=split_by,
+            seed=seed, n_jobs=jobs, provenance=provenance,
+        )  # fmt: skip
     model = run.model
     save_model(model, output)
     for warning in run.warnings:

@@ -398,6 +398,7 @@ def plan(file: str, as_json: bool, output: str | None, model: str | None, **reas
             err=True,
         )
     with _first_call(supports), progress_bar("planning: steps") as report:
+        report(0, steps)  # the count is known before the first step ends
         result = unstack.plan(supports, model=model, progress=report, **reasoning)
     _deliver(result.to_dict(), output, as_json, "plan_view", result, warnings=result.warnings)
 
