@@ -86,7 +86,13 @@ def test_ctrl_c_ends_a_run_with_one_line_and_exit_code_130(tmp_path: Path) -> No
 
     folder = tmp_path / "interrupted"
     command = [sys.executable, "-m", "unstack", "simulate", "--configs", "50", *SMALL, "--out", str(folder)]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+    def as_from_a_shell() -> None:  # a test runner's worker may ignore SIGINT, and a child inherits that
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+    process = subprocess.Popen(
+        command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=as_from_a_shell
+    )
     deadline = time.monotonic() + 120
     while not (folder / "config-0000.json").exists() and time.monotonic() < deadline and process.poll() is None:
         time.sleep(0.05)
