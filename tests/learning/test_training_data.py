@@ -77,3 +77,22 @@ def test_neighbour_isets_hold_more_support_relations(small_dataset: Path) -> Non
 def test_bad_iset_draws(kwargs: dict[str, str], message: str, rng: np.random.Generator) -> None:
     with pytest.raises(UnstackError, match=message):
         sample_isets(["a", "b", "c"], r=2, isets=1, rng=rng, **kwargs)
+
+
+def test_more_isets_than_a_pile_has_distinct_ones_are_warned_about(small_dataset: Path) -> None:
+    with pytest.warns(
+        UserWarning, match=r"of the 800 ISets drawn repeat an earlier one of their pile .* split by pairs"
+    ):
+        examples = dataset_examples(small_dataset, r=2, isets=100, seed=0)
+    from unstack.learning.training_data import repeated_isets
+
+    drawn, repeated = repeated_isets(examples)
+    assert drawn == 800 and repeated > 80
+
+
+def test_a_few_isets_of_a_large_pile_are_not_warned_about(small_dataset: Path) -> None:
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        dataset_examples(small_dataset, r=2, isets=1, seed=0)

@@ -283,4 +283,37 @@ def dataset_examples(
         parts.append(part)
         if progress is not None:
             progress(len(parts), len(files))
-    return SupportExamples.concatenate(parts)
+    examples = SupportExamples.concatenate(parts)
+    drawn, repeated = repeated_isets(examples)
+    if repeated > REPEATED_ISETS * drawn:
+        warnings.warn(
+            f"{folder}: {repeated:,} of the {drawn:,} ISets drawn repeat an earlier one of their pile (n detected "
+            "boxes have only C(n, k) distinct sets of k): their relations are the same rows again, and a "
+            "split by pairs scores rows it was trained on; ask for fewer ISets or split by configuration",
+            stacklevel=2,
+        )
+    return examples
+
+
+#: A share of ISets repeating one of their pile above which drawing them is warned about.
+REPEATED_ISETS = 0.1
+
+
+def repeated_isets(examples: SupportExamples) -> tuple[int, int]:
+    """How many ISets the examples hold, and how many of them repeat an earlier ISet (the same
+    boxes) of the same pile.
+
+    Examples
+    --------
+    >>> rows = SupportExamples(np.zeros((6, 1)), np.zeros(6, int), np.zeros(6, int), np.array([0, 0, 1, 1, 2, 2]),
+    ...                        [("a", "b"), ("b", "a"), ("b", "a"), ("a", "b"), ("a", "c"), ("c", "a")])
+    >>> repeated_isets(rows)
+    (3, 1)
+    """
+    boxes: dict[tuple[int, int], set[str]] = {}
+    for configuration, iset, pair in zip(
+        examples.configuration.tolist(), examples.iset.tolist(), examples.pairs, strict=True
+    ):
+        boxes.setdefault((configuration, iset), set()).update(pair)
+    seen = {(configuration, frozenset(members)) for (configuration, _), members in boxes.items()}
+    return len(boxes), len(boxes) - len(seen)
