@@ -157,3 +157,24 @@ def test_the_cause_table_gives_shares_that_sum_to_one() -> None:
     table = cause_table([("wall/highest", boxes, "pick", ["on", "far"], ["pick", "on"])])["wall/highest"]
     assert sum(table[f"share_{name.replace(' ', '_')}"] for name in CAUSES) == pytest.approx(1.0)
     assert table["share_undetected"] == 0.5 and table["moved"] == 2
+
+
+def test_two_data_sets_of_one_name_are_refused_before_any_state_is_written(small_dataset: Path, tmp_path: Path) -> None:
+    import shutil
+
+    from unstack.errors import InvalidArgument
+
+    twin = tmp_path / "elsewhere" / small_dataset.name
+    shutil.copytree(small_dataset, twin)
+    with pytest.raises(InvalidArgument, match=rf"two data sets are both named '{small_dataset.name}'"):
+        collect_pick_responses([small_dataset, twin], tmp_path / "states", piles=1, max_picks=1)
+    assert not (tmp_path / "states").exists()
+
+
+def test_a_second_collection_into_a_folder_being_written_is_refused(small_dataset: Path, tmp_path: Path) -> None:
+    from unstack.atomic import folder_writer
+    from unstack.errors import InvalidArgument
+
+    (tmp_path / "states").mkdir()
+    with folder_writer(tmp_path / "states", "states"), pytest.raises(InvalidArgument, match="another unstack run"):
+        collect_pick_responses([small_dataset], tmp_path / "states", piles=1, max_picks=1)

@@ -240,13 +240,38 @@ def collect_pick_responses(
         (and the behaviour, when a decision maker took the picks).
     """
     from unstack.dataset_folders import require_configurations
+    from unstack.errors import InvalidArgument
+    from unstack.experiments.outputs import checkpoint_folder
 
-    folder = Path(out)
-    folder.mkdir(parents=True, exist_ok=True)
+    names = [Path(data_dir).resolve().name for data_dir in data_dirs]
+    named_twice = sorted({name for name in names if names.count(name) > 1})
+    if named_twice:  # each data set's states go to a sub-folder of its name
+        raise InvalidArgument(
+            f"two data sets are both named {named_twice[0]!r}: their states would share one folder under {out}; "
+            "give one of them another folder name (or run them into two collections)"
+        )
     files: list[Path] = []
     for data_dir in data_dirs:
         found = require_configurations(data_dir)
         files += found if piles is None else found[:piles]
+    with checkpoint_folder(out) as held:
+        assert held is not None
+        return _collect_into(held, files, seed, max_picks, behaviour, model, disturbance, n_jobs, client, progress)
+
+
+def _collect_into(
+    folder: Path,
+    files: list[Path],
+    seed: int,
+    max_picks: int | None,
+    behaviour: str,
+    model: Any,
+    disturbance: Any,
+    n_jobs: int,
+    client: Any,
+    progress: Callable[[int, int], None] | None,
+) -> list[dict[str, Any]]:
+    """:func:`collect_pick_responses`'s work in a collection folder it holds."""
     tasks = []
     summaries: list[dict[str, Any] | None] = [None] * len(files)
     for number, path in enumerate(files):
