@@ -56,8 +56,17 @@ def decision_values(
     if decision_file is not None:
         if with_plan:
             raise UnstackError("--plan decides the unloading order itself; it does not combine with --decision")
+        if model is not None:
+            raise UnstackError("--model decides with that model; a stored --decision was decided already")
         values = read_decision_values(decision_file)
+        decided = loaded.detected if isinstance(loaded, Scene) else loaded.objects
         values.check_boxes(loaded.box_ids if isinstance(loaded, Scene) else loaded.objects, loaded.source)
+        if set(values.objects) != set(decided):
+            verb = "detects" if isinstance(loaded, Scene) else "holds"
+            raise UnstackError(
+                f"{values.source}: the decision's boxes are not the boxes {loaded.source} {verb} "
+                f"({len(values.objects)} against {len(decided)}): not this scene's decision"
+            )
         return values
     if with_plan:
         result = unstack.plan(loaded, model=model, seed=seed)

@@ -43,6 +43,19 @@ def test_render_colours_by_ground_truth_without_a_model(tmp_path: Path) -> None:
 
 
 @pytest.fixture(scope="module")
+def every_box_decision(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A decision on pile5's boxes with every box detected, not only the five the scene detects."""
+    folder = tmp_path_factory.mktemp("every")
+    document = json.loads(Path(PILE5).read_text())
+    document["detected"] = [box["id"] for box in document["boxes"]]
+    document["points_file"] = str((Path(PILE5).parent / document["points_file"]).resolve())
+    (folder / "every.json").write_text(json.dumps(document))
+    decision = folder / "decision.json"
+    assert unstack("decide", str(folder / "every.json"), "--json", "-o", str(decision)).returncode == 0
+    return decision
+
+
+@pytest.fixture(scope="module")
 def other_decision(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A decision about other boxes (pile7's) than pile5's."""
     decision = tmp_path_factory.mktemp("other") / "decision.json"
@@ -57,6 +70,8 @@ def other_decision(tmp_path_factory: pytest.TempPathFactory) -> Path:
         (["render", PILE5, "-o", "{tmp}/x.pdf"], "x.pdf: expected a .png or .svg output file"),
         (["render", PILE5, "-o", "{tmp}/x.png", "--threshold", "1.5"], "threshold must be a probability in [0, 1]"),
         (["render", PILE5, "-o", "{tmp}/x.png", "--decision", "{decision}"], "the decision's boxes do not match"),
+        (["render", PILE5, "-o", "{tmp}/x.png", "--decision", "{wider}"], "the decision's boxes are not the boxes"),
+        (["render", PILE5, "-o", "{tmp}/x.png", "--decision", "{wider}", "--model", "paper"], "--model decides with"),
         (["render", PILE5, "-o", "{tmp}/x.png", "--decision", "examples/stack5.supports.json"], "unstack.decision/1"),
         (["render", PILE5, "-o", "{tmp}/no/x.png"], "cannot write there"),
         (["render", "examples/pile31.supports.json", "-o", "{tmp}/x.png", "--colour", "truth"], "no ground truth"),
@@ -68,9 +83,9 @@ def other_decision(tmp_path_factory: pytest.TempPathFactory) -> Path:
     ],
 )
 def test_bad_picture_input_is_one_line(
-    tmp_path: Path, other_decision: Path, arguments: list[str], message: str
+    tmp_path: Path, other_decision: Path, every_box_decision: Path, arguments: list[str], message: str
 ) -> None:
-    result = unstack(*[a.format(tmp=tmp_path, decision=other_decision) for a in arguments])
+    result = unstack(*[a.format(tmp=tmp_path, decision=other_decision, wider=every_box_decision) for a in arguments])
     assert_one_line_error(result, message, nothing_written_in=tmp_path)
     assert result.stderr.startswith("unstack: error: "), result.stderr
 
