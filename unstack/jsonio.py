@@ -34,6 +34,7 @@ __all__ = [
     "MAX_DOCUMENT_BYTES",
     "Document",
     "document_text",
+    "finite_json",
     "format_json_path",
     "load_schema",
     "read_document",
@@ -151,6 +152,24 @@ def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
 def _mib(size: int) -> str:
     """A byte count in MiB for a message."""
     return f"{size / 2**20:,.1f} MiB"
+
+
+def finite_json(value: Any) -> Any:
+    """``value`` with every NaN or infinity replaced by ``None``, so that it is written as strict
+    JSON (``null``), which every reader takes -- unstack's own refuses ``NaN``.
+
+    Examples
+    --------
+    >>> finite_json({"mean": float("nan"), "bins": [0.5, float("inf")], "n": 3})
+    {'mean': None, 'bins': [0.5, None], 'n': 3}
+    """
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {key: finite_json(item) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [finite_json(item) for item in value]
+    return value
 
 
 def document_text(document: dict[str, Any], target: str = "the document", advice: str = "") -> str:

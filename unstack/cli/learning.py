@@ -16,6 +16,7 @@ from unstack.cli.main import STATICS_HELP, data_dir_argument, model_path_option
 from unstack.cli.options import constrained
 from unstack.cli.text import counted
 from unstack.errors import UnstackError
+from unstack.jsonio import finite_json
 from unstack.learning.choices import LEARNERS, SPLITS
 from unstack.learning.features import FEATURE_SETS
 from unstack.learning.training_data import ISET_DRAWS, dataset_examples
@@ -215,7 +216,7 @@ def train(
               "validation": validation, "training": {k: v for k, v in model.metadata["training"].items()
               if k != "simulation_settings"}}  # fmt: skip
     if as_json:
-        click.echo(json.dumps(report, indent=2))
+        click.echo(json.dumps(finite_json(report), indent=2, allow_nan=False))
         return
     best = model.metadata["best_params"]
     params = ", ".join(f"{key.rsplit('__', 1)[-1]} = {value:g}" for key, value in best.items())
@@ -269,7 +270,9 @@ def evaluate(
     if reliability:
         save_reliability_diagram(report, reliability, title=f"{model_file} on {data_dir}")
     if as_json:
-        click.echo(json.dumps({"model": model_file, "data": data_dir, **report}, indent=2))
+        click.echo(
+            json.dumps(finite_json({"model": model_file, "data": data_dir, **report}), indent=2, allow_nan=False)
+        )
         return
     console = Console()
     console.print(metrics_view(report, f"{model_file} on {data_dir}: confusion matrix (Fig. 5 layout)"))

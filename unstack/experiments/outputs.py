@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from unstack.atomic import check_folder_path, folder_writer
+from unstack.jsonio import finite_json
 
 __all__ = ["checkpoint_folder", "results_folder", "save_results"]
 
@@ -99,7 +100,7 @@ def save_results(
     from unstack.atomic import atomic_write_text
 
     document = folder / name
-    atomic_write_text(document, json.dumps(result, indent=2) + "\n")
+    atomic_write_text(document, json.dumps(finite_json(result), indent=2, allow_nan=False) + "\n")
     written = [document]
     if plot is not None:
         path = folder / (picture or Path(name).with_suffix(".png").name)
