@@ -305,3 +305,11 @@ def test_a_file_that_is_no_unstack_document_says_so(tmp_path: Path, content: byt
     (tmp_path / "other.json").write_bytes(content)
     with pytest.raises(InvalidFile, match=message):
         unstack.validate(tmp_path / "other.json")
+
+
+@pytest.mark.parametrize("points_file", ["pts.txt", "scene.json", "cloud.ply"])
+def test_a_scene_is_not_saved_with_a_points_file_it_cannot_write(tmp_path: Path, points_file: str) -> None:
+    scene = Scene([Box("a", [0.4, 0.3, 0.3], [1.0, 0.0, 0.15])], [[1.0, 0.0, 0.3]], ["a"])
+    with pytest.raises(unstack.errors.InvalidArgument, match=r"points_file must name a .npy file beside the scene"):
+        scene.save(tmp_path / "scene.json", points_file=points_file)
+    assert list(tmp_path.iterdir()) == []

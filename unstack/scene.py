@@ -386,9 +386,19 @@ class Scene:
 
     def save(self, path: str | os.PathLike[str], *, points_file: str | None = None) -> None:
         """Write the scene atomically; with ``points_file`` the cloud goes to that ``.npy`` beside it."""
+        from unstack.errors import InvalidArgument
         from unstack.jsonio import document_text
 
         target = Path(path)
+        if points_file is not None:
+            cloud_name = Path(points_file)
+            if cloud_name.suffix.lower() != ".npy" or os.path.realpath(target.parent / cloud_name) == os.path.realpath(
+                target
+            ):
+                raise InvalidArgument(
+                    f"{target}: points_file must name a .npy file beside the scene, not the scene itself; "
+                    f"got {points_file!r}"
+                )
         advice = "" if points_file else "save the cloud to a .npy file beside it (points_file)"
         text = document_text(self.to_dict(points_file), str(target), advice)
         if points_file is not None:
