@@ -38,6 +38,10 @@ REFUSALS = [
     (["decide", "examples"], "examples: $: expected a JSON file, got a directory"),
     (["decide", PILE5, "--output", "{tmp}/no/such/dir/out.json"], "no/such/dir/out.json: cannot write there"),
     (["validate", "examples/scene3.json", "missing.json"], "missing.json: $: no such file"),
+    (
+        ["evaluate", "general", "{tmp}", "--reliability", "{tmp}/rel.txt"],
+        "--reliability: {tmp}/rel.txt: expected a .png",
+    ),
     ([*SCENE, "--sizes", "0.4x0.3"], "--sizes: expected three edges"),
     ([*SCENE, "--ids", "a"], "--ids names 1 boxes but 2 masks"),
     ([*SCENE, "--depth-units", "m"], "declared in m but the median reading is"),
@@ -75,5 +79,5 @@ def test_a_bad_command_line_is_refused_in_one_line_with_nothing_written(
     result = unstack(*[argument.format(tmp=tmp_path) for argument in expanded])
     assert result.returncode == 2, result.stderr
     assert result.stderr.startswith("unstack: error: ") and result.stderr.count("\n") == 1, result.stderr
-    assert message in result.stderr and "Traceback" not in result.stderr
+    assert message.format(tmp=tmp_path) in result.stderr and "Traceback" not in result.stderr
     assert sorted(tmp_path.rglob("*")) == before

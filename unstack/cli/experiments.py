@@ -453,6 +453,9 @@ def container(
     chosen = tuple(name.strip() for name in makers.split(",") if name.strip())
     if not chosen:
         raise UnstackError(f"--makers: expected decision makers separated by commas, got {makers!r}")
+    twice = sorted({name for name in chosen if chosen.count(name) > 1})
+    if twice:
+        raise UnstackError(f"--makers: {twice[0]!r} is named twice")
     model, name = load_model_option(model_path)
     container_policies(model, seed=seed, makers=chosen)  # an unknown maker is one line, before any work
     if disturbance_path is not None:  # the moves maker reads it in every pile: a bad file is refused now

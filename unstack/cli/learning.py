@@ -262,6 +262,12 @@ def evaluate(
 
     if r < 2 or isets < 1 or jobs < 1:
         raise UnstackError("expected --r >= 2, --isets >= 1 and --jobs >= 1")
+    if reliability:  # before the work: a picture matplotlib cannot write fails after it
+        from unstack.atomic import check_output_path
+
+        if Path(reliability).suffix.lower() not in (".png", ".svg"):
+            raise UnstackError(f"--reliability: {reliability}: expected a .png or .svg file")
+        check_output_path(reliability)
     model, _ = load_support_model(model_file)
     examples = _examples(data_dir, r, isets, seed, jobs, model.features, draw, pose_noise=pose_noise)
     probability = model.support_probability(examples.features)
