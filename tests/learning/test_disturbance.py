@@ -99,3 +99,12 @@ def test_a_support_model_file_is_not_a_disturbance_model() -> None:
 def test_rows_of_the_wrong_width_are_refused_in_one_line() -> None:
     with pytest.raises(InvalidModel, match=f"expected rows of {len(PICK_FEATURES)} pick features"):
         load_disturbance_model().expected_moves(np.zeros((2, 3)))
+
+
+def test_held_out_figures_of_states_from_one_pile_are_refused() -> None:
+    from unstack.errors import InvalidArgument
+    from unstack.learning.disturbance import DisturbanceRegressor, held_out_predictions
+
+    features = np.random.default_rng(0).normal(size=(12, 3))
+    with pytest.raises(InvalidArgument, match=r"at least 2 piles, held out one at a time; these come from 1"):
+        held_out_predictions(DisturbanceRegressor(), features, np.zeros(12), np.zeros(12, dtype=int))

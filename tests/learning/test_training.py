@@ -73,3 +73,20 @@ def test_splitting_by_configuration_needs_two_configurations_to_cross_validate(
         train_support_model(
             pooled(fixed_rng, (piles,)), FeatureSettings(), split_by="configuration", validation_size=validation_size
         )
+
+
+@pytest.mark.parametrize("supporting", [0, 1, 3])
+def test_a_class_too_thin_to_learn_from_is_refused_before_any_fit(
+    fixed_rng: np.random.Generator, supporting: int
+) -> None:
+    from dataclasses import replace
+
+    from unstack.errors import InvalidArgument
+    from unstack.learning.features import FeatureSettings
+    from unstack.learning.training import train_support_model
+
+    examples = pooled(fixed_rng, (6,))
+    labels = np.zeros(len(examples.labels), dtype=int)
+    labels[:supporting] = 1
+    with pytest.raises(InvalidArgument, match=rf"{supporting} SUPP and {len(labels) - supporting} other relations"):
+        train_support_model(replace(examples, labels=labels), FeatureSettings())

@@ -197,7 +197,9 @@ class SupportClassifier(ClassifierMixin, BaseEstimator):
             )
         self.classes_ = unique_labels(y)
         if len(self.classes_) < 2:
-            raise ValueError(f"SupportClassifier needs both classes in y, got only 1 class: {self.classes_.tolist()}")
+            raise InvalidArgument(  # a ValueError too, as scikit-learn's estimators raise
+                f"SupportClassifier needs both classes in y, got only 1 class: {self.classes_.tolist()}"
+            )
         group_labels = None if groups is None else np.asarray(groups)
         if group_labels is not None and len(group_labels) != len(y):
             raise ValueError(f"groups has {len(group_labels)} labels for {len(y)} rows")

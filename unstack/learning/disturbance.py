@@ -244,7 +244,14 @@ def held_out_predictions(
     from sklearn.base import clone
     from sklearn.model_selection import GroupKFold
 
+    piles = len(np.unique(groups))
+    if piles < 2:
+        from unstack.errors import InvalidArgument
+
+        raise InvalidArgument(
+            f"held-out figures need states from at least 2 piles, held out one at a time; these come from {piles}"
+        )
     predicted = np.zeros(len(moved))
-    for train, test in GroupKFold(n_splits=min(folds, len(np.unique(groups)))).split(features, moved, groups):
+    for train, test in GroupKFold(n_splits=min(folds, piles)).split(features, moved, groups):
         predicted[test] = clone(regressor).fit(features[train], moved[train]).predict(features[test])
     return predicted

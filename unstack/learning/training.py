@@ -172,6 +172,15 @@ def train_support_model(
     groups = examples.configuration if split_by == "configuration" else None
     if groups is not None:
         _require_configurations_to_split(groups, validation_size)
+    supporting = int(np.sum(examples.labels == 1))
+    others = len(examples.labels) - supporting
+    if min(supporting, others) < MIN_TO_TRAIN:
+        from unstack.errors import InvalidArgument
+
+        raise InvalidArgument(
+            f"{supporting} SUPP and {others} other relations among the {len(examples.labels)} drawn: too few of a "
+            f"class to learn from (at least {MIN_TO_TRAIN} of each); give more piles, more ISets or larger ones (--r)"
+        )
     template = SupportClassifier(learner=learner, cv=cv, n_jobs=n_jobs, random_state=seed)
     holdout = (
         evaluate_holdout(template, examples.features, examples.labels, groups=groups, validation_size=validation_size)
@@ -193,6 +202,10 @@ def train_support_model(
         validation=validation,
     )
     return TrainingRun(model, holdout, useless_model_warnings(classifier, examples))
+
+
+#: Fewer relations of a class than this cannot be split and cross-validated at all.
+MIN_TO_TRAIN = 4
 
 
 def _require_configurations_to_split(groups: Any, validation_size: float) -> None:
