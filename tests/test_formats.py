@@ -313,3 +313,11 @@ def test_a_scene_is_not_saved_with_a_points_file_it_cannot_write(tmp_path: Path,
     with pytest.raises(unstack.errors.InvalidArgument, match=r"points_file must name a .npy file beside the scene"):
         scene.save(tmp_path / "scene.json", points_file=points_file)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_id_longer_than_a_label_can_be_is_refused_at_its_path() -> None:
+    with pytest.raises(InvalidScene, match=r"\$\.id: expected an id of at most 200 characters, got one of 300"):
+        Box("a" * 300, [0.4, 0.3, 0.3], [1.0, 0.0, 0.15])
+    with pytest.raises(InvalidSupports, match=r"\$\.objects\[0\]: expected an id of at most 200 characters"):
+        unstack.Supports(["b" * 201, "c"], [[0, 0.5], [0.5, 0]])
+    assert Box("a" * 200, [0.4, 0.3, 0.3], [1.0, 0.0, 0.15]).id == "a" * 200

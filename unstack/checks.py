@@ -29,6 +29,7 @@ __all__ = [
     "LIGHT_BOX",
     "MAX_BOX_EDGE",
     "MAX_COORDINATE",
+    "MAX_ID_LENGTH",
     "MIN_BOX_EDGE",
     "QUATERNION_NORM_TOLERANCE",
     "REFUSED_OVERLAP",
@@ -43,6 +44,15 @@ __all__ = [
     "light_boxes",
     "number_text",
 ]
+
+#: The longest box id accepted (characters): an id is a label in tables and pictures.
+MAX_ID_LENGTH = 200
+
+
+def long_id(item: str) -> str:
+    """The message for an id longer than :data:`MAX_ID_LENGTH`."""
+    return f"expected an id of at most {MAX_ID_LENGTH} characters, got one of {len(item):,} ({item[:20]!r}...)"
+
 
 #: An integer of more bits than this is beyond the largest float (about 1.8e308).
 FLOAT_BITS = 1024
@@ -192,6 +202,8 @@ def check_ids(
     for index, item in enumerate(value):
         if not isinstance(item, str) or not item:
             raise error(source, f"{path}[{index}]", f"expected a non-empty string id, got {item!r}")
+        if len(item) > MAX_ID_LENGTH:
+            raise error(source, f"{path}[{index}]", long_id(item))
         if item in seen:
             raise error(source, f"{path}[{index}]", f"duplicate id {item!r} (also at index {seen[item]})")
         seen[item] = index

@@ -30,6 +30,7 @@ from unstack.checks import (
     FLOAT_BITS,
     MAX_BOX_EDGE,
     MAX_COORDINATE,
+    MAX_ID_LENGTH,
     MIN_BOX_EDGE,
     REFUSED_OVERLAP,
     check_ids,
@@ -37,6 +38,7 @@ from unstack.checks import (
     check_points,
     check_quaternion_xyzw,
     check_vector,
+    long_id,
     number_text,
 )
 from unstack.errors import InvalidScene
@@ -135,6 +137,8 @@ class Box:
     ) -> None:
         if not isinstance(id, str) or not id:
             raise InvalidScene(source, f"{path}.id", f"expected a non-empty string id, got {id!r}")
+        if len(id) > MAX_ID_LENGTH:
+            raise InvalidScene(source, f"{path}.id", long_id(id))
         set_frozen_fields(  # checked in this order: the first error found is the one raised
             self,
             id=id,
