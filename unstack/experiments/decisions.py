@@ -63,6 +63,7 @@ from typing import Any
 
 import numpy as np
 
+from unstack.errors import UnstackError
 from unstack.learning.training_data import ISET_DRAWS
 from unstack.parameters import COUNT, ISET_SIZE, SEED, OneOf, validate_params
 from unstack.sim.settings import DISPLACEMENT_THRESHOLD
@@ -300,6 +301,8 @@ def evaluate_decisions(
             results.append(iset_outcome(scene, list(ids), model, statics=statics))
             if progress is not None:
                 progress(len(results), isets)
+    if not results:
+        raise UnstackError(f"{data_dir}: no ISet of at least 2 detected boxes (r = {r}); nothing to decide on")
     scores = {maker: decision_scores(results, maker) for maker in DECISION_MAKERS}
     summary = {
         maker: {

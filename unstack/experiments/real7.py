@@ -16,15 +16,19 @@ from __future__ import annotations
 
 import itertools
 import os
+import warnings
 from collections.abc import Callable, Sequence
 from typing import Any
 
+from unstack.errors import UnstackError
 from unstack.experiments.decisions import DECISION_MAKERS, decision_scores, iset_outcome
 from unstack.parameters import OPTIONAL_COUNT, validate_params
 
 __all__ = ["PAPER_FIRST_PICK_RIGHT", "PAPER_REAL7", "real7", "summary_rows"]
 
 PAPER_FIRST_PICK_RIGHT = {3: 0.905, 4: 0.81, 5: 0.62}
+#: The boxes of each pile in the paper's real setting (Section V-A2).
+PAPER_PILE = 7
 PAPER_REAL7: dict[str, Any] = {"first_pick_right": PAPER_FIRST_PICK_RIGHT, "worst_mse": {"unstack": 0.5, "random": 3.5}}
 
 
@@ -45,6 +49,15 @@ def real7(
     files = require_configurations(data_dir)
     scenes = [load_scene(path) for path in files[:piles]]
     total = sum(len(list(itertools.combinations(scene.box_ids, r))) for scene in scenes for r in sizes)
+    if total == 0:
+        raise UnstackError(f"{data_dir}: no pile has {min(sizes)} boxes or more; nothing to decide on")
+    other = [scene for scene in scenes if len(scene.box_ids) != PAPER_PILE]
+    if other:
+        warnings.warn(
+            f"{data_dir}: {len(other)} of {len(scenes)} piles are not of the paper's {PAPER_PILE} boxes (the first "
+            f"has {len(other[0].box_ids)}): their figures are not the paper's Section V-A2 setting",
+            stacklevel=2,
+        )
     done = 0
     per_size: dict[str, Any] = {}
     for r in sizes:
