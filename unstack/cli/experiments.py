@@ -184,10 +184,13 @@ def fig5a(
     require_configurations(data_dir)
     if full:
         require_paper_size(data_dir, cv)
-    result = fig5a_experiment(
-        data_dir, r=r, isets=isets, seed=seed, cv=cv, n_jobs=jobs, draw=draw, learner=learner, split_by=split_by,
-        feature_set=feature_set,
-    )  # fmt: skip
+    from unstack.cli.progress import still_working
+
+    with still_working("fig5a: features and cross-validation"):
+        result = fig5a_experiment(
+            data_dir, r=r, isets=isets, seed=seed, cv=cv, n_jobs=jobs, draw=draw, learner=learner,
+            split_by=split_by, feature_set=feature_set,
+        )  # fmt: skip
     written = save_results(results_folder(out), "fig5a.json", result, plot_fig5a)
     table = number_table(
         f"Fig. 5a: validation relations of {data_dir} ({result['relations']} relations, {result['supp']} SUPP)",
