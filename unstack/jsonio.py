@@ -291,7 +291,7 @@ def read_document(path: str | os.PathLike[str]) -> Document:
     except ValueError as error:  # an integer of more digits than Python converts
         raise InvalidFile(source, "$", f"invalid JSON: {error}") from None
     if not isinstance(data, dict):
-        raise InvalidFile(source, "$", f"expected a JSON object, got {type(data).__name__}")
+        raise InvalidFile(source, "$", f"expected a JSON object, got {type(data).__name__}: not an unstack document")
     deep = _too_deep(data, MAX_DEPTH)
     if deep is not None:
         where = format_json_path(deep[:8]) + "..."

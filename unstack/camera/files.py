@@ -76,7 +76,15 @@ def _read_json(path: str | os.PathLike[str]) -> tuple[Any, str]:
         return json.loads(file.read_text(encoding="utf-8")), source
     except FileNotFoundError:
         raise InvalidFile(source, "$", "the file does not exist") from None
-    except (OSError, UnicodeDecodeError, ValueError) as error:
+    except json.JSONDecodeError as error:
+        raise InvalidFile(source, "$", f"expected a JSON file: {error}") from None
+    except ValueError as error:  # an integer of more digits than Python converts
+        if "digits" in str(error):
+            raise InvalidFile(
+                source, "$", "expected numbers a camera gives, got an integer of thousands of digits"
+            ) from None
+        raise InvalidFile(source, "$", f"expected a JSON file: {error}") from None
+    except (OSError, UnicodeDecodeError) as error:
         raise InvalidFile(source, "$", f"expected a JSON file: {error}") from None
 
 

@@ -128,9 +128,11 @@ def simulate(
     from unstack.dataset_folders import read_manifest
 
     statistics = (read_manifest(summary.folder) or {}).get("statistics", {})
+    wanted = summary.made + summary.skipped  # the folder may hold more than this run asked for
+    asked = "" if summary.finished == wanted else f", of the {wanted} asked for"
     click.echo(
         f"{summary.folder}: {counted(summary.finished, 'configuration')} "
-        f"({summary.made} made, {summary.skipped} already there) "
+        f"({summary.made} made, {summary.skipped} already there{asked}) "
         f"in {summary.seconds:.1f} s; {statistics.get('support_relations', 0)} support relations among "
         f"{statistics.get('ordered_pairs', 0)} ordered pairs; removal labels break transitivity in "
         f"{100 * statistics.get('transitivity_violated_share', 0.0):.1f} % of "
