@@ -114,3 +114,9 @@ def test_a_bad_camera_json_file_is_refused_with_its_json_path(
     with pytest.raises(InvalidFile, match=message) as refused:
         LOADERS[loader](tmp_path / "given.json")
     assert str(refused.value).startswith(f"{tmp_path / 'given.json'}: ")
+
+
+def test_an_integer_of_thousands_of_digits_is_refused_in_the_cameras_words(tmp_path: Path) -> None:
+    (tmp_path / "k.json").write_text('{"fx": ' + "9" * 5000 + ', "fy": 600, "cx": 320, "cy": 240}')
+    with pytest.raises(InvalidFile, match=r"k.json: \$: expected numbers a camera gives, got an integer of thousands"):
+        load_intrinsics(tmp_path / "k.json")
