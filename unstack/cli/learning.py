@@ -101,9 +101,9 @@ def _examples(
     from unstack.learning.training import pooled_examples
 
     folders = (data_dirs,) if isinstance(data_dirs, str) else data_dirs
-    for folder in folders:
-        require_configurations(folder)  # before any progress bar: the error is the only line
-    with progress_bar("features") as report:
+    piles = sum(len(require_configurations(folder)) for folder in folders)  # before any bar: the error alone
+    with progress_bar("features: piles") as report:
+        report(0, piles)  # the count is known before the first pile ends
         return pooled_examples(
             folders, r=r, isets=isets, seed=seed, settings=settings, n_jobs=jobs, draw=draw,
             vary_clouds=vary_clouds, pose_noise=pose_noise, progress=report,
