@@ -173,7 +173,7 @@ def scene(
             assert depth_file is not None and intrinsics_file is not None and pose_file is not None
             cloud = depth_points(load_depth(depth_file, units=depth_units), load_intrinsics(intrinsics_file),
                                  load_pose(pose_file))  # fmt: skip
-        with _naming(cloud_file or f"{depth_file} seen from {pose_file}"):
+        with _naming(f"{cloud_file or f'{depth_file} seen from {pose_file}'} with {detections_file}"):
             built = scene_from_cloud(cloud, load_detections(detections_file), door=direction, seed=seed)
     elif cloud_file is not None:
         raise UnstackError("--cloud needs --detections: the boxes a 3-D detector found in the cloud")
