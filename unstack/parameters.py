@@ -44,6 +44,7 @@ __all__ = [
     "ISET_SIZE",
     "JOBS",
     "MAX_CONFIGS",
+    "MAX_FOLDS",
     "MAX_JOBS",
     "MISSED_SHARE",
     "OPTIONAL_COUNT",
@@ -206,8 +207,10 @@ JOBS = Interval(int, 1, MAX_JOBS)
 MAX_CONFIGS = 100_000
 #: Boxes per ISet (the paper's r): at least two.
 ISET_SIZE = Interval(int, 2)
-#: Cross-validation folds: at least two.
-FOLDS = Interval(int, 2)
+#: Cross-validation folds: at least two, at most a thousand (more is a typing slip; the folds a
+#: fit uses are at most the rarer class's relations anyway).
+MAX_FOLDS = 1000
+FOLDS = Interval(int, 2, MAX_FOLDS)
 #: Share of the seen boxes a simulated detector misses at each scan.
 MISSED_SHARE = Interval(float, 0.0, 0.9)
 #: Position error of a simulated box detector (metres).

@@ -116,7 +116,8 @@ def test_decide_on_a_scene_with_a_given_model(model: Path) -> None:
         (["evaluate", "nope.skops", "examples"], "nope.skops: $: cannot read the model file"),
         (["train", "{data}", "-o", "{tmp}/m.json"], "-o: expected a model file name ending in .skops, got"),
         (["train", "{data}", "{data}/", "-o", "{tmp}/m.skops"], "the data set is given twice"),
-        (["train", "{data}", "-o", "{tmp}/m.skops", "--cv", "1"], "--cv: expected at least 2 cross-validation folds"),
+        (["train", "{data}", "-o", "{tmp}/m.skops", "--cv", "1"], "--cv: expected 2 to 1,000 cross-validation folds"),
+        (["train", "{data}", "-o", "{tmp}/m.skops", "--cv", "99999999999999999999"], "got 99999999999999999999"),
     ],
 )
 def test_bad_input_is_one_line(arguments: list[str], message: str, tmp_path: Path, small_dataset: Path) -> None:

@@ -20,7 +20,7 @@ from unstack.jsonio import finite_json
 from unstack.learning.choices import LEARNERS, SPLITS
 from unstack.learning.features import FEATURE_SETS
 from unstack.learning.training_data import ISET_DRAWS, dataset_examples
-from unstack.parameters import MAX_JOBS
+from unstack.parameters import MAX_FOLDS, MAX_JOBS
 
 __all__ = ["evaluate", "load_support_model", "metrics_view", "probabilities", "scene_supports", "train"]
 
@@ -173,8 +173,8 @@ def train(
     from unstack.learning.model_file import save_model
     from unstack.learning.training import train_support_model, training_provenance
 
-    if cv < 2:
-        raise UnstackError(f"--cv: expected at least 2 cross-validation folds, got {cv}")
+    if not 2 <= cv <= MAX_FOLDS:
+        raise UnstackError(f"--cv: expected 2 to {MAX_FOLDS:,} cross-validation folds, got {cv}")
     if not 0.0 <= validation_size < 1.0:  # NaN too
         raise UnstackError(f"--validation-size: expected a share from 0 up to (not including) 1, got {validation_size}")
     if Path(output).suffix.lower() != ".skops":
