@@ -64,6 +64,7 @@ def test_neighbour_isets_are_the_nearest_boxes_to_a_centre(rng: np.random.Genera
 
 
 @pytest.mark.slow  # simulates the small data set
+@pytest.mark.filterwarnings("ignore:.*ISets drawn repeat")  # nearest neighbours of few boxes repeat, as they should
 def test_neighbour_isets_hold_more_support_relations(small_dataset: Path) -> None:
     near = dataset_examples(small_dataset, r=4, isets=6, seed=0, draw="neighbours")
     assert near.features.shape[1] == 19 and len(near.labels) > 0
