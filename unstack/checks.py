@@ -41,6 +41,7 @@ __all__ = [
     "check_probability_matrix",
     "check_quaternion_xyzw",
     "check_vector",
+    "finite_number",
     "light_boxes",
     "number_text",
 ]
@@ -84,6 +85,24 @@ def number_text(value: Any) -> str:
     if isinstance(value, int | np.integer) and not isinstance(value, bool) and int(value).bit_length() > 64:
         return f"an integer of about {int(int(value).bit_length() * math.log10(2)) + 1} digits"
     return repr(value)
+
+
+def finite_number(value: Any) -> float | None:
+    """``value`` as a finite float, or ``None`` when it is not one (a bool, a string, NaN, an
+    integer too large for a float).
+
+    Examples
+    --------
+    >>> finite_number(3), finite_number(float("nan")), finite_number(10**400), finite_number("1")
+    (3.0, None, None, None)
+    """
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        return None
+    try:
+        number = float(value)
+    except OverflowError:
+        return None
+    return number if math.isfinite(number) else None
 
 
 def light_boxes(ids: Sequence[str], masses: Any) -> str | None:

@@ -39,6 +39,7 @@ __all__ = [
     "load_schema",
     "read_document",
     "refuse_special_file",
+    "report_text",
     "special_file",
     "validate_document",
 ]
@@ -170,6 +171,18 @@ def finite_json(value: Any) -> Any:
     if isinstance(value, list | tuple):
         return [finite_json(item) for item in value]
     return value
+
+
+def report_text(value: Any) -> str:
+    """A report (an experiment's results, a fit report, an evaluation) as indented strict JSON:
+    undefined values (NaN, infinity) are ``null`` (:func:`finite_json`), the text ends in a newline.
+
+    Examples
+    --------
+    >>> report_text({"spearman": float("nan")})
+    '{\\n  "spearman": null\\n}\\n'
+    """
+    return json.dumps(finite_json(value), indent=2, allow_nan=False) + "\n"
 
 
 def document_text(document: dict[str, Any], target: str = "the document", advice: str = "") -> str:

@@ -15,7 +15,6 @@ Examples
 
 from __future__ import annotations
 
-import math
 import os
 import warnings
 from collections.abc import Iterable, Sequence
@@ -27,7 +26,6 @@ import numpy as np
 
 from unstack.atomic import atomic_save_array, atomic_write_text
 from unstack.checks import (
-    FLOAT_BITS,
     MAX_BOX_EDGE,
     MAX_COORDINATE,
     MAX_ID_LENGTH,
@@ -38,6 +36,7 @@ from unstack.checks import (
     check_points,
     check_quaternion_xyzw,
     check_vector,
+    finite_number,
     long_id,
     number_text,
 )
@@ -59,10 +58,8 @@ def _check_mass(mass: float | None, source: str, path: str) -> float | None:
     """A box's mass as a positive float, or None when not given."""
     if mass is None:
         return None
-    if isinstance(mass, bool) or not isinstance(mass, int | float | np.integer | np.floating):
-        raise InvalidScene(source, path, f"expected a positive number of kg, got {mass!r}")
-    number = float(mass) if not isinstance(mass, int) or mass.bit_length() <= FLOAT_BITS else math.inf
-    if not (math.isfinite(number) and number > 0):
+    number = finite_number(mass)
+    if number is None or number <= 0:
         raise InvalidScene(source, path, f"expected a positive, finite number of kg, got {number_text(mass)}")
     return number
 

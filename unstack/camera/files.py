@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from unstack.checks import MAX_COORDINATE, number_text
+from unstack.checks import MAX_COORDINATE, finite_number, number_text
 from unstack.errors import InvalidFile
 from unstack.jsonio import refuse_special_file
 
@@ -103,7 +103,7 @@ def load_intrinsics(path: str | os.PathLike[str]) -> Intrinsics:
     for name in INTRINSICS_KEYS:
         if name not in data:
             raise InvalidFile(source, "$", f"missing required key {name!r} (expected {', '.join(INTRINSICS_KEYS)})")
-        value = _real(data[name])
+        value = finite_number(data[name])
         if value is None or value <= 0:
             raise InvalidFile(
                 source, f"$.{name}", f"expected a positive number of pixels, got {number_text(data[name])}"
@@ -171,11 +171,11 @@ def load_pose(path: str | os.PathLike[str]) -> np.ndarray:
         raise InvalidFile(source, json_path, f"expected a 4 x 4 matrix of finite numbers, got {shape}")
     for row, entries in enumerate(rows):
         for column, entry in enumerate(entries):
-            if _real(entry) is None:
+            if finite_number(entry) is None:
                 raise InvalidFile(
                     source, f"{json_path}[{row}][{column}]", f"expected a finite number, got {number_text(entry)}"
                 )
-    pose = np.array([[_real(entry) for entry in entries] for entries in rows], dtype=np.float64)
+    pose = np.array([[finite_number(entry) for entry in entries] for entries in rows], dtype=np.float64)
     rotation = pose[:3, :3]
     far = np.flatnonzero(np.abs(pose[:3, 3]) > MAX_COORDINATE)
     if far.size:
@@ -191,18 +191,6 @@ def load_pose(path: str | os.PathLike[str]) -> np.ndarray:
     ):
         raise InvalidFile(source, json_path, "expected a rotation in the upper 3 x 3 block (orthonormal, det 1)")
     return pose
-
-
-def _real(value: Any) -> float | None:
-    """``value`` as a finite float, or ``None`` when it is not one (a bool, a string, NaN, an
-    integer too large for a float)."""
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        return None
-    try:
-        number = float(value)
-    except OverflowError:
-        return None
-    return number if math.isfinite(number) else None
 
 
 def _load_npy(file: Path, source: str, what: str) -> np.ndarray:

@@ -9,7 +9,6 @@ residual, the duplicates left out and the masks that could not be fitted.
 from __future__ import annotations
 
 import contextlib
-import json
 import math
 import os
 from collections.abc import Iterator
@@ -19,7 +18,7 @@ import click
 
 from unstack.checks import MAX_BOX_EDGE, MIN_BOX_EDGE
 from unstack.errors import InvalidFile, UnstackError
-from unstack.jsonio import finite_json
+from unstack.jsonio import report_text
 
 __all__ = ["scene"]
 
@@ -209,7 +208,7 @@ def scene(
             )
     built.scene.save(target, points_file=f"{target.stem}.points.npy")
     if report_file is not None:
-        atomic_write_text(Path(report_file), json.dumps(finite_json(built.report()), indent=2, allow_nan=False) + "\n")
+        atomic_write_text(Path(report_file), report_text(built.report()))
     console = Console()
     table = number_table(
         f"{len(built.scene.boxes)} boxes (gravity tilted {built.frame.tilt_deg:.1f} degrees from the input frame's z)",

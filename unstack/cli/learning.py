@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 from typing import Any
@@ -16,7 +15,7 @@ from unstack.cli.main import STATICS_HELP, data_dir_argument, model_path_option
 from unstack.cli.options import constrained
 from unstack.cli.text import counted
 from unstack.errors import UnstackError
-from unstack.jsonio import finite_json
+from unstack.jsonio import report_text
 from unstack.learning.choices import LEARNERS, SPLITS
 from unstack.learning.features import FEATURE_SETS
 from unstack.learning.training_data import ISET_DRAWS, dataset_examples
@@ -216,7 +215,7 @@ def train(
               "validation": validation, "training": {k: v for k, v in model.metadata["training"].items()
               if k != "simulation_settings"}}  # fmt: skip
     if as_json:
-        click.echo(json.dumps(finite_json(report), indent=2, allow_nan=False))
+        click.echo(report_text(report), nl=False)
         return
     best = model.metadata["best_params"]
     params = ", ".join(f"{key.rsplit('__', 1)[-1]} = {value:g}" for key, value in best.items())
@@ -276,9 +275,7 @@ def evaluate(
     if reliability:
         save_reliability_diagram(report, reliability, title=f"{model_file} on {data_dir}")
     if as_json:
-        click.echo(
-            json.dumps(finite_json({"model": model_file, "data": data_dir, **report}), indent=2, allow_nan=False)
-        )
+        click.echo(report_text({"model": model_file, "data": data_dir, **report}), nl=False)
         return
     console = Console()
     console.print(metrics_view(report, f"{model_file} on {data_dir}: confusion matrix (Fig. 5 layout)"))

@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from unstack.atomic import check_folder_path, folder_writer
-from unstack.jsonio import finite_json
+from unstack.jsonio import report_text
 
 __all__ = ["checkpoint_folder", "results_folder", "save_results"]
 
@@ -100,7 +100,7 @@ def save_results(
     from unstack.atomic import atomic_write_text
 
     document = folder / name
-    atomic_write_text(document, json.dumps(finite_json(result), indent=2, allow_nan=False) + "\n")
+    atomic_write_text(document, report_text(result))
     written = [document]
     if plot is not None:
         path = folder / (picture or Path(name).with_suffix(".png").name)
