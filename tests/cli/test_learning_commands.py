@@ -55,7 +55,10 @@ def test_evaluate_prints_the_confusion_matrix_and_a_reliability_diagram(
     assert "balanced error rate (Eq. 16)" in result.stdout and "average entropy (Eq. 15)" in result.stdout
     assert (tmp_path / "r.png").read_bytes()[:4] == b"\x89PNG"
     assert "at the paper's SUPP recall (78.4 %) the best not-SUPP recall is" in result.stdout
+    assert "relations with a feature outside the model's training range: " in result.stdout
+    assert "out of distribution" not in result.stderr  # the model's own data
     report = json.loads(unstack("evaluate", str(model), str(small_dataset), "--r", "4", "--json").stdout)
+    assert 0 <= report["out_of_range"]["share"] <= 0.1
     assert report["relations"] == report["supp"] + report["not_supp"]
     assert 0.0 <= report["fig5a"]["not_supp_recall"] <= 1.0 and report["fig5a"]["paper_not_supp_recall"] == 0.875
 

@@ -220,3 +220,27 @@ def test_a_model_that_loads_but_cannot_predict_is_refused_in_one_line(tmp_path: 
     with pytest.raises(InvalidModel, match=message) as caught:
         load_model(path)
     assert str(caught.value).startswith(str(path)) and "\n" not in str(caught.value)
+
+
+@pytest.mark.parametrize("shift, warned", [(0.0, False), (6.0, True)])
+def test_a_data_set_is_out_of_distribution_when_over_a_tenth_of_its_relations_leave_the_range(
+    fitted: tuple[SupportClassifier, np.ndarray], shift: float, warned: bool
+) -> None:
+    from unstack.learning.features import feature_names
+    from unstack.learning.model_file import DATA_SET_OUT_OF_RANGE, data_set_out_of_distribution
+
+    classifier, _ = fitted
+    settings = FeatureSettings()
+    rng = np.random.default_rng(2)
+    training = rng.normal(size=(5000, 19))  # the ranges of a training set of the usual size
+    model = SupportModel.from_classifier(classifier, settings, training={}, training_features=training)
+    data = rng.normal(size=(400, 19))
+    data[:, 3] += shift  # one feature moved by six standard deviations
+    summary = model.out_of_range_summary(data)
+    assert (summary["share"] > DATA_SET_OUT_OF_RANGE) is warned
+    warning = data_set_out_of_distribution(summary, len(data), "set")
+    if warned:
+        assert warning is not None and warning.startswith("set: out of distribution: ")
+        assert next(iter(summary["by_feature"])) == feature_names(settings)[3]  # the moved feature first
+    else:
+        assert warning is None and summary["share"] < 0.05

@@ -258,6 +258,7 @@ def evaluate(
     success rate, BER, entropy, calibration."""
     from unstack.experiments.fig5a import paper_point
     from unstack.learning.metrics import classification_report, save_reliability_diagram
+    from unstack.learning.model_file import data_set_out_of_distribution
 
     if r < 2 or isets < 1 or jobs < 1:
         raise UnstackError("expected --r >= 2, --isets >= 1 and --jobs >= 1")
@@ -272,6 +273,10 @@ def evaluate(
     probability = model.support_probability(examples.features)
     report = classification_report(examples.labels, probability)
     report["fig5a"] = paper_point(examples.labels, probability)
+    report["out_of_range"] = model.out_of_range_summary(examples.features)
+    doubt = data_set_out_of_distribution(report["out_of_range"], len(examples.features), data_dir)
+    if doubt:
+        click.echo(f"unstack: warning: {doubt}", err=True)
     if reliability:
         save_reliability_diagram(report, reliability, title=f"{model_file} on {data_dir}")
     if as_json:
@@ -284,6 +289,10 @@ def evaluate(
         f"ROC AUC {point['auc']:.3f}; at the paper's SUPP recall ({100 * point['supp_recall']:.1f} %) "
         f"the best not-SUPP recall is {100 * point['not_supp_recall']:.1f} % "
         f"(paper: {100 * point['paper_not_supp_recall']:.1f} %)"
+    )
+    console.print(
+        f"relations with a feature outside the model's training range: {report['out_of_range']['rows']:,} of "
+        f"{len(examples.features):,} ({100 * report['out_of_range']['share']:.1f} %)"
     )
 
 

@@ -46,6 +46,7 @@ from unstack.learning.features import FeatureSettings
 
 __all__ = [
     "BUNDLED_MODELS",
+    "DATA_SET_OUT_OF_RANGE",
     "DEFAULT_MODEL",
     "DEFAULT_MODEL_NAME",
     "MODEL_FORMAT",
@@ -54,6 +55,7 @@ __all__ = [
     "InvalidModel",
     "SupportModel",
     "bundled_model_path",
+    "data_set_out_of_distribution",
     "default_model_path",
     "feature_ranges",
     "load_model",
@@ -204,6 +206,31 @@ class SupportModel:
             for row, column in np.argwhere(outside)
         ]
 
+    def out_of_range_summary(self, features: np.ndarray) -> dict[str, Any]:
+        """How much of a data set's features lie outside the training range (see
+        :meth:`out_of_range`): the share of rows with any feature outside, and the rows outside
+        per feature, most first.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> model = load_model(bundled_model_path("paper"))
+        >>> far = np.full((4, len(model.metadata["feature_ranges"])), 1e3)
+        >>> summary = model.out_of_range_summary(far)
+        >>> summary["rows"], summary["share"]
+        (4, 1.0)
+        """
+        outside = self.out_of_range(features)
+        by_feature: dict[str, int] = {}
+        for _, name, *_ in outside:
+            by_feature[name] = by_feature.get(name, 0) + 1
+        rows = len({row for row, *_ in outside})
+        return {
+            "rows": rows,
+            "share": rows / len(features) if len(features) else 0.0,
+            "by_feature": dict(sorted(by_feature.items(), key=lambda item: -item[1])),
+        }
+
     def support_probability(self, features: np.ndarray) -> np.ndarray:
         """P(SUPP) for each row of ``F_XY``, on the calling thread alone (see
         :data:`PREDICT_OPENMP_THREADS`)."""
@@ -225,6 +252,31 @@ class SupportModel:
 #: How far beyond its training range (a share of the range's width) a feature may go
 #: before the input counts as out of distribution.
 RANGE_MARGIN = 0.1
+#: A data set with more than this share of its relations outside the training range is out
+#: of the model's distribution (by the range's definition, about 1-5 % of a model's own kind of
+#: data lies outside: a few tails of ~20 features).
+DATA_SET_OUT_OF_RANGE = 0.10
+
+
+def data_set_out_of_distribution(summary: dict[str, Any], relations: int, source: str) -> str | None:
+    """A warning when more than :data:`DATA_SET_OUT_OF_RANGE` of a data set's relations lie
+    outside the model's training range (``summary`` from :meth:`SupportModel.out_of_range_summary`).
+
+    Examples
+    --------
+    >>> data_set_out_of_distribution({"rows": 1, "share": 0.01, "by_feature": {"separation": 1}}, 100, "d") is None
+    True
+    >>> data_set_out_of_distribution({"rows": 50, "share": 0.5, "by_feature": {"separation": 50}}, 100, "d")[:40]
+    'd: out of distribution: 50 of 100 relati'
+    """
+    if summary["share"] <= DATA_SET_OUT_OF_RANGE:
+        return None
+    features = ", ".join(f"{name} in {count:,}" for name, count in list(summary["by_feature"].items())[:3])
+    return (
+        f"{source}: out of distribution: {summary['rows']:,} of {relations:,} relations "
+        f"({100 * summary['share']:.0f} %) have features outside the model's training range ({features}); "
+        "the scores measure extrapolation"
+    )
 
 
 def feature_ranges(features: np.ndarray, names: tuple[str, ...]) -> dict[str, list[float]]:
