@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from sklearn.utils.estimator_checks import parametrize_with_checks
@@ -116,8 +118,12 @@ def test_groups_must_match_the_rows(fixed_rng: np.random.Generator) -> None:
         SupportClassifier(cv=3, param_grid=SMALL_GRID).fit(features, labels, groups=[0, 1, 2])
 
 
-def test_too_few_of_a_class_for_the_folds_is_one_clear_error(fixed_rng: np.random.Generator) -> None:
+@pytest.mark.parametrize("cv, advice", [(3, r"more ISets, or fewer folds$"), (2, r"more ISets$")])
+def test_too_few_of_a_class_for_the_folds_is_one_clear_error(
+    fixed_rng: np.random.Generator, cv: int, advice: str
+) -> None:
     labels = np.array([1, 1, 1] + [0] * 27)  # three SUPP: some fold's training part holds one or none
     groups = np.arange(30) // 3  # ten piles of three relations, the SUPP all in the first
-    with pytest.raises(InvalidArgument, match="too few examples to cross-validate: the training part of fold"):
-        SupportClassifier(cv=3, param_grid=SMALL_GRID).fit(fixed_rng.normal(size=(30, 19)), labels, groups=groups)
+    with pytest.raises(InvalidArgument, match="too few examples to cross-validate: the training part of fold") as error:
+        SupportClassifier(cv=cv, param_grid=SMALL_GRID).fit(fixed_rng.normal(size=(30, 19)), labels, groups=groups)
+    assert re.search(advice, str(error.value))  # no fewer than two folds is offered

@@ -117,15 +117,16 @@ def _require_both_classes_in_every_fold(
 ) -> None:
     """Raise where a fold's training part holds fewer than ``calibration_folds`` examples of a
     class: a fit there fails (the calibration inside it needs that many of each)."""
+    folds = splitter.get_n_splits()
     for fold, (train, _) in enumerate(splitter.split(X, y, groups)):
         classes, counts = np.unique(y[train], return_counts=True)
         if len(classes) < 2 or counts.min() < calibration_folds:
             rarest = 0 if len(classes) < 2 else int(counts.min())
+            fewer = ", or fewer folds" if folds > 2 else ""  # two is the fewest there can be
             raise InvalidArgument(
                 f"too few examples to cross-validate: the training part of fold {fold + 1} holds {rarest} of a class "
                 f"(at least {calibration_folds} needed; {int(np.unique(y, return_counts=True)[1].min())} of the rarer "
-                f"class among {len(y)} relations in "
-                "all); give more piles or more ISets, or fewer folds"
+                f"class among {len(y)} relations in all); give more piles or more ISets{fewer}"
             )
 
 
