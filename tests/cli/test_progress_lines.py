@@ -34,3 +34,26 @@ def test_work_without_steps_says_it_is_still_working(capsys: pytest.CaptureFixtu
     with progress.still_working("deciding", every=0.05):
         time.sleep(0.12)
     assert capsys.readouterr().err.splitlines()[0] == "deciding: still working after 0 s"
+
+
+def test_a_sampled_decision_says_how_many_sweeps_of_how_many_and_the_time_left(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    import numpy as np
+
+    import unstack
+
+    rng = np.random.default_rng(3)
+    probabilities = rng.uniform(0.0, 0.3, size=(12, 12))  # one linked group of 12: sampled
+    np.fill_diagonal(probabilities, 0.0)
+    supports = unstack.Supports([f"b{k}" for k in range(12)], probabilities)
+    with progress.still_working("deciding", every=0.05):
+        decision = unstack.decide(supports, samples=200_000, seed=0)
+    lines = capsys.readouterr().err.splitlines()
+    sampled = [line for line in lines if "sampling a group of 12 boxes" in line]
+    assert sampled, lines
+    assert re.fullmatch(
+        r"deciding: sampling a group of 12 boxes: [\d,]+ of 200,\d{3} sweeps after \d+ s(; about [\d,]+ s to go for it)?",
+        sampled[-1],
+    )
+    assert decision.to_dict() == unstack.decide(supports, samples=200_000, seed=0).to_dict()  # unwatched: the same

@@ -16,10 +16,13 @@ LOG_EVERY = 30.0
 
 
 @contextmanager
-def _log_lines(description: str, every: float = LOG_EVERY) -> Iterator[Callable[[int, int], None]]:
+def _log_lines(
+    description: str, every: float = LOG_EVERY, detail: Callable[[float], str | None] | None = None
+) -> Iterator[Callable[[int, int], None]]:
     """Yield ``report(done, total)``; while the block runs, a line on stderr every ``every``
     seconds saying the latest count reported (none before the first report: ``description after
     N s``), so that work inside one long step says it is alive too; work done sooner writes nothing.
+    ``detail(seconds)``, when it returns words, is the whole line instead.
     """
     start = time.monotonic()
     latest: list[tuple[int, int]] = []
@@ -27,9 +30,11 @@ def _log_lines(description: str, every: float = LOG_EVERY) -> Iterator[Callable[
 
     def tick() -> None:
         while not stop.wait(every):
+            seconds = time.monotonic() - start
             where = f" {latest[0][0]:,} of {latest[0][1]:,}" if latest else ""
+            said = None if detail is None else detail(seconds)
             try:
-                print(f"{description}{where} after {time.monotonic() - start:.0f} s", file=sys.stderr, flush=True)
+                print(said or f"{description}{where} after {seconds:.0f} s", file=sys.stderr, flush=True)
             except (OSError, ValueError):  # stderr closed or gone: nothing more to say
                 return
 
@@ -48,9 +53,23 @@ def _log_lines(description: str, every: float = LOG_EVERY) -> Iterator[Callable[
 @contextmanager
 def still_working(description: str, every: float = LOG_EVERY) -> Iterator[None]:
     """Work without steps (one decision, one picture) says it is alive: a line on stderr every
-    :data:`LOG_EVERY` seconds (``deciding: still working after 30 s``), nothing for quick work."""
-    with _log_lines(f"{description}: still working", every):
-        yield
+    :data:`LOG_EVERY` seconds (``deciding: still working after 30 s``), nothing for quick work;
+    while the reasoner samples a group, where the sampling is (``deciding: sampling a group of
+    40 boxes: 1,200,000 of 3,000,064 sweeps after 30 s; about 45 s to go for it``)."""
+    from unstack.reasoner.progress import watching_sampling
+
+    with watching_sampling() as sampling:
+
+        def detail(seconds: float) -> str | None:
+            where = sampling.line()
+            if where is None:
+                return None
+            left = sampling.seconds_left()
+            to_go = "" if left is None else f"; about {left:,.0f} s to go for it"
+            return f"{description}: {where} after {seconds:.0f} s{to_go}"
+
+        with _log_lines(f"{description}: still working", every, detail):
+            yield
 
 
 @contextmanager

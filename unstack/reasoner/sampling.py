@@ -59,6 +59,7 @@ import numpy as np
 from unstack.errors import InvalidArgument
 from unstack.reasoner._chain_arrays import BlockArrays, ChainArrays
 from unstack.reasoner.arguments import check_budget, check_count, check_matrix, check_samples, check_seed
+from unstack.reasoner.progress import sampling_progress
 from unstack.reasoner.revisits import schedule
 from unstack.reasoner.world_masks import ONE_WORD_BOXES, mask_words, pack, unpack
 from unstack.threads import even_ranges, thread_count
@@ -595,6 +596,9 @@ def _sampled_marginals(
         samples = default_samples(n)
     deadline = None if time_limit is None else start + time_limit
     per_chain = None if samples is None else -(-samples // chains)
+    watch = sampling_progress()
+    if watch is not None:  # what is recorded: whole rounds of sweeps in every chain
+        watch.start(n, None if per_chain is None else chains * -(-per_chain // _ROUND_SWEEPS) * _ROUND_SWEEPS)
     with _Chains(
         p, chains=chains, seed=seed, burn_in=burn_in, tries=tries, blocks=blocks, start=warm, wide=wide
     ) as state:
@@ -622,6 +626,8 @@ def _sampled_marginals(
             state.sums[:, :rounds] = 0.0
             state.advance(_ROUND_SWEEPS, record=True, rounds=rounds)
             round_seconds = (time.perf_counter() - call_start) / rounds
+            if watch is not None:
+                watch.done = chains * (recorded + rounds * _ROUND_SWEEPS)
             for r in range(rounds):
                 batches[:, filled] += state.sums[:, r]
                 partial += _ROUND_SWEEPS
