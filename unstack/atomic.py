@@ -108,6 +108,8 @@ def check_output_path(path: str | os.PathLike[str], *, inputs: Iterable[str | os
     from unstack.errors import InvalidArgument
     from unstack.jsonio import special_file
 
+    if not isinstance(path, str | os.PathLike):
+        raise InvalidArgument(f"expected a file name for the output (a str or path-like), got {type(path).__name__}")
     if str(path) == "-":
         raise InvalidArgument("-: expected a file name for the output (--json prints the document on standard output)")
     target = Path(path)

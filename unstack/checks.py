@@ -14,6 +14,7 @@ array([[0. , 0.7],
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
@@ -230,7 +231,9 @@ def check_ids(
 
 
 def check_metadata(value: Any, *, source: str = "<array>", error: type[InvalidFile] = InvalidScene) -> dict[str, Any]:
-    """Check free-form metadata (an object with string keys, or None) and return a copy.
+    """Check free-form metadata (an object with string keys, or None) and return a deep copy
+    of it as its JSON document holds it: what the file would not keep is refused here, not
+    when it is saved (numpy numbers become numbers, tuples lists, non-finite numbers an error).
 
     Examples
     --------
@@ -245,7 +248,53 @@ def check_metadata(value: Any, *, source: str = "<array>", error: type[InvalidFi
         return {}
     if not isinstance(value, Mapping) or not all(isinstance(key, str) for key in value):
         raise error(source, "$.metadata", f"expected an object (a dict with string keys), got {type(value).__name__}")
-    return dict(value)
+    try:  # the quick way; the walk below only to say where the first value JSON cannot hold is
+        text = json.dumps(value, allow_nan=False, default=_numpy_to_json)
+    except (TypeError, ValueError, RecursionError) as failure:
+        reason = str(failure)
+        try:
+            _json_value(value, "$.metadata", source, error)  # raises where the dump failed
+        except RecursionError:
+            reason = "nested too deeply, or holding itself"
+        raise error(source, "$.metadata", f"expected a JSON object: {reason}") from None
+    copied: dict[str, Any] = json.loads(text)
+    return copied
+
+
+def _numpy_to_json(value: Any) -> Any:
+    """numpy's numbers and arrays as the numbers and lists JSON holds; anything else refused."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"{type(value).__name__} is not JSON")
+
+
+def _json_value(value: Any, path: str, source: str, error: type[InvalidFile]) -> Any:
+    """A deep copy of ``value`` as the JSON document would hold it (numpy scalars and arrays as
+    numbers and lists, tuples as lists); an error at ``path`` for anything JSON cannot hold."""
+    if value is None or isinstance(value, bool | str):
+        return value
+    if isinstance(value, np.ndarray | np.generic):
+        return _json_value(value.tolist() if isinstance(value, np.ndarray) else value.item(), path, source, error)
+    if isinstance(value, int):
+        return value
+    if isinstance(value, float):
+        if not np.isfinite(value):
+            raise error(source, path, f"expected a finite number, got {value}")
+        return float(value)
+    if isinstance(value, Mapping):
+        for key in value:
+            if not isinstance(key, str):
+                raise error(source, path, f"expected an object with string keys, got the key {key!r}")
+        return {key: _json_value(item, f"{path}.{key}", source, error) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [_json_value(item, f"{path}[{index}]", source, error) for index, item in enumerate(value)]
+    raise error(
+        source,
+        path,
+        f"expected a JSON value (text, a number, true, false, null, a list or an object), got {type(value).__name__}",
+    )
 
 
 def check_vector(

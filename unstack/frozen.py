@@ -10,7 +10,26 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["set_frozen_fields"]
+import numpy as np
+
+__all__ = ["read_only", "set_frozen_fields"]
+
+
+def read_only(array: np.ndarray, given: Any = None) -> np.ndarray:
+    """``array`` made read-only, copied first where it holds the caller's ``given`` data: the
+    data model freezes its own arrays, never the caller's.
+
+    Examples
+    --------
+    >>> mine = np.zeros(3)
+    >>> frozen = read_only(mine, mine)
+    >>> frozen.flags.writeable, mine.flags.writeable, frozen is mine
+    (False, True, False)
+    """
+    if isinstance(given, np.ndarray) and np.may_share_memory(array, given):
+        array = array.copy()
+    array.setflags(write=False)
+    return array
 
 
 def set_frozen_fields(instance: Any, **fields: Any) -> None:

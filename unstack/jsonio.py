@@ -214,10 +214,17 @@ def document_text(document: dict[str, Any], target: str = "the document", advice
     >>> document_text({"format": "unstack.supports/1", "objects": ["a"]})
     '{\\n  "format": "unstack.supports/1",\\n  "objects": [\\n    "a"\\n  ]\\n}\\n'
     """
-    text = json.dumps(document, indent=2) + "\n"
+    try:  # strict JSON: unstack's reader refuses NaN and Infinity, so they are never written
+        text = json.dumps(document, indent=2, allow_nan=False) + "\n"
+    except (TypeError, ValueError) as error:
+        from unstack.errors import InvalidArgument
+
+        raise InvalidArgument(
+            f"{target}: the document holds a value JSON cannot ({error}); nothing was written"
+        ) from None
     if len(text) <= MAX_DOCUMENT_BYTES:  # characters: the JSON is ASCII
         return text
-    text = json.dumps(document, separators=(",", ":")) + "\n"
+    text = json.dumps(document, separators=(",", ":"), allow_nan=False) + "\n"
     if len(text) <= MAX_DOCUMENT_BYTES:
         return text
     from unstack.errors import InvalidArgument

@@ -41,7 +41,7 @@ from unstack.checks import (
     number_text,
 )
 from unstack.errors import InvalidScene
-from unstack.frozen import set_frozen_fields
+from unstack.frozen import read_only, set_frozen_fields
 from unstack.geometry import overlapping_pairs
 from unstack.jsonio import Document, read_document, refuse_special_file, validate_document
 
@@ -338,9 +338,9 @@ class Scene:
             if bad.size:
                 i, j = bad[0]
                 raise InvalidScene(source, f"$.ground_truth.support[{i}][{j}]", f"expected 0 or 1, got {truth[i, j]}")
-            truth.setflags(write=False)
+            truth = read_only(truth, ground_truth)
         cloud = _check_coordinates(check_points(points, source=source, path=points_path), source, points_path)
-        cloud.setflags(write=False)
+        cloud = read_only(cloud, points)
         _refuse_overlaps(boxes, source)
         set_frozen_fields(
             self,

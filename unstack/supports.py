@@ -23,7 +23,7 @@ import numpy as np
 from unstack.atomic import atomic_write_text
 from unstack.checks import check_ids, check_metadata, check_probability_matrix, check_vector
 from unstack.errors import InvalidSupports
-from unstack.frozen import set_frozen_fields
+from unstack.frozen import read_only, set_frozen_fields
 from unstack.jsonio import Document, read_document, validate_document
 
 __all__ = ["SUPPORTS_FORMAT", "Supports", "load_supports"]
@@ -82,14 +82,13 @@ class Supports:
         heights: Any = None,
     ) -> None:
         ids = check_ids(objects, source=source)
-        matrix = check_probability_matrix(probabilities, len(ids), source=source)
-        matrix.setflags(write=False)
+        matrix = read_only(check_probability_matrix(probabilities, len(ids), source=source), probabilities)
         mass_vector = None
         if masses is not None:
             mass_vector = check_vector(
                 masses, len(ids), positive=True, source=source, path="$.masses", error=InvalidSupports
             )
-            mass_vector.setflags(write=False)
+            mass_vector = read_only(mass_vector, masses)
         load_vector = None
         if hidden_load is not None:
             load_vector = check_vector(
@@ -102,11 +101,11 @@ class Supports:
                     f"$.hidden_load[{negative[0]}]",
                     f"expected a non-negative number, got {load_vector[negative[0]]}",
                 )
-            load_vector.setflags(write=False)
+            load_vector = read_only(load_vector, hidden_load)
         height_vector = None
         if heights is not None:
             height_vector = check_vector(heights, len(ids), source=source, path="$.heights", error=InvalidSupports)
-            height_vector.setflags(write=False)
+            height_vector = read_only(height_vector, heights)
         set_frozen_fields(
             self,
             hidden_load=load_vector,

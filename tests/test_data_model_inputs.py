@@ -1,0 +1,94 @@
+"""The data model keeps its own copies of what a caller hands it: the caller's arrays stay the
+caller's (writeable), metadata is copied as its JSON document holds it, and nothing is saved
+that unstack would refuse to read back."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+import unstack
+from unstack.errors import InvalidArgument, InvalidScene, InvalidSupports
+
+PROBABILITIES = [[0.0, 0.2, 0.1], [0.7, 0.0, 0.3], [0.4, 0.5, 0.0]]
+IDS = ["a", "b", "c"]
+
+
+def _scene(points: np.ndarray, metadata: dict[str, Any] | None = None) -> unstack.Scene:
+    box = unstack.Box("a", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2])
+    return unstack.Scene([box], points, ["a"], metadata=metadata)
+
+
+def test_supports_leave_the_callers_arrays_writeable_and_unshared() -> None:
+    matrix = np.array(PROBABILITIES)
+    masses, heights = np.array([1.0, 2.0, 3.0]), np.array([0.2, 0.6, 1.0])
+    supports = unstack.Supports(IDS, matrix, masses, heights=heights)
+    assert matrix.flags.writeable and masses.flags.writeable and heights.flags.writeable
+    matrix[0, 1] = 0.99
+    assert supports.probabilities[0, 1] == 0.2  # the caller's change is not the supports'
+    assert not supports.probabilities.flags.writeable
+
+
+def test_a_scene_leaves_the_callers_cloud_writeable_and_unshared() -> None:
+    cloud = np.random.default_rng(0).uniform(0.0, 1.0, size=(50, 3))
+    scene = _scene(cloud)
+    cloud[0] = 9.0
+    assert cloud.flags.writeable and not np.array_equal(scene.points[0], cloud[0])
+    assert not scene.points.flags.writeable
+
+
+def test_metadata_is_a_deep_copy_in_json_types() -> None:
+    given = {"nested": {"list": [1, 2]}, "number": np.float32(0.5), "count": np.int64(3), "pair": (1, 2)}
+    supports = unstack.Supports(IDS, PROBABILITIES, metadata=given)
+    given["nested"]["list"].append(3)
+    assert supports.metadata == {"nested": {"list": [1, 2]}, "number": 0.5, "count": 3, "pair": [1, 2]}
+    assert type(supports.metadata["number"]) is float and type(supports.metadata["count"]) is int
+
+
+@pytest.mark.parametrize(
+    "metadata, message",
+    [
+        ({"x": float("nan")}, r"\$\.metadata\.x: expected a finite number, got nan"),
+        ({"a": {"b": [1, float("inf")]}}, r"\$\.metadata\.a\.b\[1\]: expected a finite number, got inf"),
+        ({"x": object()}, r"\$\.metadata\.x: expected a JSON value \(text, a number, .*\), got object"),
+        ({"a": {(1, 2): 3}}, r"\$\.metadata\.a: expected an object with string keys, got the key \(1, 2\)"),
+    ],
+)
+@pytest.mark.parametrize("kind", ["supports", "scene"])
+def test_metadata_a_file_could_not_hold_is_refused_naming_its_path(
+    metadata: dict[str, Any], message: str, kind: str
+) -> None:
+    error = InvalidSupports if kind == "supports" else InvalidScene
+    with pytest.raises(error, match=message):
+        if kind == "supports":
+            unstack.Supports(IDS, PROBABILITIES, metadata=metadata)
+        else:
+            _scene(np.zeros((1, 3)), metadata)
+
+
+def test_metadata_holding_itself_is_refused_in_one_line() -> None:
+    looped: dict[str, Any] = {}
+    looped["self"] = looped
+    with pytest.raises(InvalidSupports, match=r"\$\.metadata: expected a JSON object: nested too deeply, or holding"):
+        unstack.Supports(IDS, PROBABILITIES, metadata=looped)
+
+
+@pytest.mark.parametrize("path", [None, b"out.json", 3])
+def test_saving_to_something_that_is_no_file_name_is_refused(path: Any) -> None:
+    supports = unstack.Supports(IDS, PROBABILITIES)
+    with pytest.raises(InvalidArgument, match=r"^expected a file name for the output \(a str or path-like\), got "):
+        supports.save(path)
+
+
+def test_a_value_put_into_the_metadata_afterwards_that_json_cannot_hold_is_not_saved(tmp_path: Path) -> None:
+    supports = unstack.Supports(IDS, PROBABILITIES)
+    supports.metadata["late"] = float("nan")  # the dict is the caller's to change; the file is ours
+    target = tmp_path / "late.json"
+    with pytest.raises(
+        InvalidArgument, match=r"late.json: the document holds a value JSON cannot .*nothing was written"
+    ):
+        supports.save(target)
+    assert not target.exists() and list(tmp_path.iterdir()) == []
