@@ -18,9 +18,12 @@ def _half(n: int) -> np.ndarray:
 
 
 def _watched(n: int) -> tuple[int, int, int | None]:
+    seen: list[int] = []
     with watching_sampling() as watch:
+        original = watch.start
+        watch.start = lambda boxes, total: (seen.append(boxes), original(boxes, total))  # type: ignore[method-assign]
         sampled_marginals(_half(n), samples=2048, seed=n)
-    return watch.boxes, watch.done, watch.total
+    return seen[0], watch.done, watch.total
 
 
 def test_threads_each_see_their_own_group_only() -> None:
@@ -41,5 +44,10 @@ def test_the_total_is_what_is_recorded_or_unknown_under_a_time_limit(
     assert (watch.seconds_left() is None) == (time_limit is not None)
 
 
-def test_nothing_is_said_before_a_group_is_sampled() -> None:
-    assert SamplingProgress().line() is None
+def test_nothing_is_said_before_a_group_is_sampled_or_after_its_sampling() -> None:
+    progress = SamplingProgress()
+    assert progress.line() is None
+    progress.start(12, 4096)
+    assert progress.line() == "sampling a group of 12 boxes: 0 of 4,096 sweeps"
+    progress.finish()  # the rest of the decision (a physics veto, say) is not sampling
+    assert progress.line() is None

@@ -13,8 +13,8 @@ Examples
 >>> half = np.full((3, 3), 0.5); np.fill_diagonal(half, 0)
 >>> with watching_sampling() as watch:
 ...     _ = sampled_marginals(half, samples=4096, seed=0)
->>> watch.boxes, watch.done, watch.total
-(3, 4096, 4096)
+>>> watch.done, watch.total, watch.line() is None  # the group's sampling is over
+(4096, 4096, True)
 """
 
 from __future__ import annotations
@@ -42,8 +42,12 @@ class SamplingProgress:
         """A new group's sampling begins."""
         self.boxes, self.done, self.total, self.started = boxes, 0, total, time.perf_counter()
 
+    def finish(self) -> None:
+        """The group's sampling is over: nothing to say until the next group starts."""
+        self.boxes = 0
+
     def line(self) -> str | None:
-        """Where the run is, in words (``None`` before any group is sampled).
+        """Where the run is, in words (``None`` while no group is being sampled).
 
         Examples
         --------

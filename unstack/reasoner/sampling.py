@@ -658,6 +658,8 @@ def _sampled_marginals(
             if deadline is not None and time.perf_counter() + round_seconds >= deadline and filled >= 2:
                 break  # the next round would end after the deadline
 
+        if watch is not None:
+            watch.finish()
         totals = batches.sum(axis=1)  # every recorded sweep, including the open batch
         marginals = totals.sum(axis=0) / (chains * recorded)
         batch_marginals = batches[:, :filled].reshape(chains * filled, n, n) / batch_length
