@@ -49,6 +49,18 @@ def test_a_mask_inside_a_larger_one_is_a_duplicate_left_out(three_cartons) -> No
     assert built.scene.detected == ("b00", "b01", "b02")
 
 
+@pytest.mark.parametrize("merged", ["whole image", "two cartons"])
+def test_a_mask_holding_several_boxes_is_left_out_and_theirs_are_kept(three_cartons, merged: str) -> None:
+    depth, masks, pose = render_tops(three_cartons)
+    big = np.ones_like(masks[0]) if merged == "whole image" else masks[0] | masks[1]
+    built = scene_from_depth(depth, INTRINSICS, pose, [*masks, big], known_sizes=SIZES)
+    assert built.scene.detected == ("b00", "b01", "b02") and not built.duplicates
+    held = "b00, b01 and b02" if merged == "whole image" else "b00 and b01"
+    assert built.unfitted == {
+        "b03": f"its mask holds the masks of {held}: a detection of several boxes (or of the whole image)"
+    }
+
+
 def test_without_known_sizes_the_top_and_the_drop_to_the_floor_give_the_size(three_cartons) -> None:
     depth, masks, pose = render_tops(three_cartons[:1])
     built = scene_from_depth(depth, INTRINSICS, pose, masks)

@@ -42,9 +42,19 @@ from unstack.camera.planes import PLANE_THRESHOLD, fit_plane
 from unstack.errors import InvalidFile, UnstackError
 from unstack.scene import Box
 
-__all__ = ["DUPLICATE_SHARE", "FittedBox", "boxes_from_masks", "duplicate_masks", "fit_box", "min_area_rectangle"]
+__all__ = [
+    "DUPLICATE_SHARE",
+    "FittedBox",
+    "boxes_from_masks",
+    "duplicate_masks",
+    "fit_box",
+    "merged_masks",
+    "min_area_rectangle",
+]
 
-#: A mask with at least this share of its pixels inside a larger mask is a duplicate.
+#: A mask with at least this share of its pixels inside a larger mask is a duplicate; a mask
+#: holding two or more masks this way that are not duplicates of each other is a detection of
+#: several boxes (or of none: a whole-image mask).
 DUPLICATE_SHARE = 0.5
 #: Fewer points than this on a mask's top face (or front face) cannot be fitted.
 MIN_FACE_POINTS = 30
@@ -330,7 +340,8 @@ def _faces(size: Sequence[float]) -> list[tuple[float, float, float]]:
 
 
 def duplicate_masks(masks: Sequence[np.ndarray]) -> dict[int, int]:
-    """Masks mostly inside a larger one: ``{duplicate index: the larger mask's index}``.
+    """Masks mostly inside a larger one: ``{duplicate index: the larger mask's index}``; a mask
+    that holds several boxes (:func:`merged_masks`) is nobody's original and nobody's duplicate.
 
     Examples
     --------
@@ -339,17 +350,70 @@ def duplicate_masks(masks: Sequence[np.ndarray]) -> dict[int, int]:
     >>> other = np.zeros((4, 4), bool); other[3, 3] = True
     >>> duplicate_masks([big, small, other])
     {1: 0}
+    >>> duplicate_masks([np.ones((4, 4), bool), big, other])  # the whole image holds two boxes
+    {}
     """
-    areas = [int(mask.sum()) for mask in masks]
+    inside = _Containment(masks)
+    merged = merged_masks(masks)
     duplicates = {}
-    for k, mask in enumerate(masks):
-        for j, other in enumerate(masks):
-            if j == k or areas[j] < areas[k] or (areas[j] == areas[k] and j > k) or j in duplicates:
+    for k in range(len(masks)):
+        if k in merged:
+            continue
+        for j in range(len(masks)):
+            if j == k or j in merged or j in duplicates or not inside.larger(j, k):
                 continue
-            if (mask & other).sum() >= DUPLICATE_SHARE * areas[k]:
+            if inside(k, j):
                 duplicates[k] = j
                 break
     return duplicates
+
+
+def merged_masks(masks: Sequence[np.ndarray]) -> dict[int, list[int]]:
+    """Masks holding most of two or more smaller masks that are not duplicates of each other (a
+    detection of several boxes, or a whole-image mask): ``{index: the masks it holds}``.
+
+    Examples
+    --------
+    >>> left = np.zeros((4, 4), bool); left[:, :2] = True
+    >>> right = np.zeros((4, 4), bool); right[:, 2:] = True
+    >>> merged_masks([np.ones((4, 4), bool), left, right])
+    {0: [1, 2]}
+    """
+    inside = _Containment(masks)
+    merged = {}
+    for j in range(len(masks)):
+        held = [k for k in range(len(masks)) if inside.areas[k] < inside.areas[j] and inside(k, j)]
+        apart = [k for n, k in enumerate(held) if not any(inside(k, m) or inside(m, k) for m in held[:n])]
+        if len(apart) >= 2:
+            merged[j] = held
+    return merged
+
+
+class _Containment:
+    """Whether most of one mask lies in another (at least :data:`DUPLICATE_SHARE` of its
+    pixels), counted only where the two masks' bounding boxes meet."""
+
+    def __init__(self, masks: Sequence[np.ndarray]) -> None:
+        self.masks = masks
+        self.areas = [int(mask.sum()) for mask in masks]
+        self.bounds = []
+        for mask in masks:
+            rows, columns = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+            empty = len(rows) == 0
+            self.bounds.append((0, 0, 0, 0) if empty else (rows[0], rows[-1] + 1, columns[0], columns[-1] + 1))
+
+    def larger(self, j: int, k: int) -> bool:
+        """Mask ``j`` comes before ``k`` by area (ties: the first given)."""
+        return self.areas[j] > self.areas[k] or (self.areas[j] == self.areas[k] and j < k)
+
+    def __call__(self, k: int, j: int) -> bool:
+        """Most of mask ``k`` lies in mask ``j``."""
+        top, bottom = max(self.bounds[k][0], self.bounds[j][0]), min(self.bounds[k][1], self.bounds[j][1])
+        left, right = max(self.bounds[k][2], self.bounds[j][2]), min(self.bounds[k][3], self.bounds[j][3])
+        if top >= bottom or left >= right:
+            return False
+        shared = (self.masks[k][top:bottom, left:right] & self.masks[j][top:bottom, left:right]).sum()
+        return bool(shared >= DUPLICATE_SHARE * self.areas[k]) and self.areas[k] > 0
 
 
 def boxes_from_masks(

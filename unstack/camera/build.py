@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from unstack.camera.boxes import FittedBox, boxes_from_masks, duplicate_masks
+from unstack.camera.boxes import FittedBox, boxes_from_masks, duplicate_masks, merged_masks
 from unstack.camera.files import Intrinsics
 from unstack.camera.planes import GravityFrame, depth_points, gravity_frame
 from unstack.errors import UnstackError
@@ -156,7 +156,8 @@ def scene_from_depth(
     frame = gravity_frame(cloud, door=np.asarray(door, dtype=np.float64), seed=seed)
     _check_upright(frame, pose)
     duplicates = duplicate_masks(masks)
-    kept = [k for k in range(len(masks)) if k not in duplicates]
+    merged = merged_masks(masks)
+    kept = [k for k in range(len(masks)) if k not in duplicates and k not in merged]
     mask_points = []
     for k in kept:
         points = frame.apply(depth_points(depth_m, intrinsics, pose, masks[k]))
@@ -164,6 +165,16 @@ def scene_from_depth(
             points = points[rng.choice(len(points), MAX_MASK_POINTS, replace=False)]
         mask_points.append(points)
     fitted, unfitted = boxes_from_masks(mask_points, [names[k] for k in kept], known_sizes=known_sizes, seed=seed)
+    for j, held in merged.items():
+        named = [names[k] for k in held[:3]]
+        others = (
+            f"{', '.join(named[:-1])} and {named[-1]}"
+            if len(held) <= 3
+            else f"{', '.join(named)} and {len(held) - 3} more"
+        )
+        unfitted[names[j]] = (
+            f"its mask holds the masks of {others}: a detection of several boxes (or of the whole image)"
+        )
     if not fitted:
         raise UnstackError(f"no box could be fitted: {'; '.join(f'{k}: {why}' for k, why in unfitted.items())}")
     fitted = _without_overlaps(fitted, unfitted)
