@@ -61,6 +61,31 @@ def test_a_mask_holding_depth_values_is_a_mask_where_they_are_not_zero(tmp_path:
     assert load_mask(_png(tmp_path / "m.png", values)).sum() == 6
 
 
+@pytest.mark.parametrize(
+    "name, image_format, message",
+    [
+        ("m.jpg", "JPEG", r"m.jpg: \$: expected a mask .png or .npy, got 'm.jpg'"),
+        ("m.bmp", "BMP", r"m.bmp: \$: expected a mask .png or .npy, got 'm.bmp'"),
+        ("m.png", "JPEG", r"m.png: \$: expected a PNG or .npy mask, got a JPEG image \(its compression blurs edges"),
+        ("m.png", "BMP", r"m.png: \$: expected a PNG or .npy mask, got a BMP image$"),
+    ],
+)
+def test_a_mask_in_another_image_format_is_refused_whatever_its_name(
+    tmp_path: Path, name: str, image_format: str, message: str
+) -> None:
+    values = np.zeros((4, 5), dtype=np.uint8)
+    values[1:3, 1:4] = 255
+    Image.fromarray(values).save(tmp_path / name, format=image_format)
+    with pytest.raises(InvalidFile, match=message):
+        load_mask(tmp_path / name)
+
+
+def test_a_depth_png_that_is_another_format_inside_is_refused(tmp_path: Path) -> None:
+    Image.fromarray(np.full((4, 5), 200, dtype=np.uint8)).save(tmp_path / "d.png", format="JPEG")
+    with pytest.raises(InvalidFile, match=r"d.png: \$: expected a PNG or .npy depth image, got a JPEG image"):
+        load_depth(tmp_path / "d.png")
+
+
 def test_an_empty_mask_is_refused(tmp_path: Path) -> None:
     with pytest.raises(InvalidFile, match="the mask is empty"):
         load_mask(_png(tmp_path / "m.png", np.zeros((4, 5), dtype=np.uint8)))

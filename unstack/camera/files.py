@@ -205,10 +205,15 @@ def _load_npy(file: Path, source: str, what: str) -> np.ndarray:
     return array
 
 
-def _read_image(file: Path) -> np.ndarray:
+def _read_png(file: Path, what: str) -> np.ndarray:
+    """A PNG file's pixels; any other image format, whatever its name, is refused (a JPEG's
+    compression moves the edges of a mask and the values of a depth image)."""
     from PIL import Image
 
     with Image.open(file) as image:
+        if image.format != "PNG":
+            lossy = " (its compression blurs edges and values)" if image.format in ("JPEG", "WEBP", "JPEG2000") else ""
+            raise InvalidFile(str(file), "$", f"expected a PNG or .npy {what}, got a {image.format} image{lossy}")
         return np.array(image)
 
 
@@ -232,7 +237,7 @@ def load_depth(path: str | os.PathLike[str], *, units: str | None = None) -> np.
         if suffix == ".npy":
             raw = _load_npy(file, source, "depth image")
         elif suffix == ".png":
-            raw = _read_image(file)
+            raw = _read_png(file, "depth image")
         else:
             raise InvalidFile(source, "$", f"expected a depth image .png (16-bit) or .npy, got {file.name!r}")
     except InvalidFile:
@@ -283,7 +288,10 @@ def load_mask(path: str | os.PathLike[str], shape: tuple[int, int] | None = None
     if not file.is_file():
         raise InvalidFile(source, "$", "the mask does not exist")
     try:
-        raw = _load_npy(file, source, "mask") if file.suffix.lower() == ".npy" else _read_image(file)
+        suffix = file.suffix.lower()
+        if suffix not in (".png", ".npy"):
+            raise InvalidFile(source, "$", f"expected a mask .png or .npy, got {file.name!r}")
+        raw = _load_npy(file, source, "mask") if suffix == ".npy" else _read_png(file, "mask")
     except InvalidFile:
         raise
     except Exception as error:  # noqa: BLE001 - any reader failure is the file's fault
