@@ -61,6 +61,16 @@ def test_a_mask_holding_several_boxes_is_left_out_and_theirs_are_kept(three_cart
     }
 
 
+@pytest.mark.parametrize("scale, doubted", [(1.0, False), (2.5, True), (0.4, True)])
+def test_known_sizes_far_from_every_measured_face_are_doubted(three_cartons, scale: float, doubted: bool) -> None:
+    depth, masks, pose = render_tops(three_cartons)  # sizes off by a factor: depth units, or sizes not in metres
+    sizes = [tuple(scale * edge for edge in size) for size in SIZES]
+    doubts = scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=sizes).doubts()
+    assert bool(doubts) is doubted
+    if doubted:
+        assert "are the depth image's units right (--depth-units) and the sizes in metres?" in doubts[0]
+
+
 def test_without_known_sizes_the_top_and_the_drop_to_the_floor_give_the_size(three_cartons) -> None:
     depth, masks, pose = render_tops(three_cartons[:1])
     built = scene_from_depth(depth, INTRINSICS, pose, masks)

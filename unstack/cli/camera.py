@@ -234,6 +234,6 @@ def scene(
     from unstack.scene import load_scene
     from unstack.understanding.plausibility import scene_warnings
 
-    for warning in scene_warnings(load_scene(target)):  # what decide and validate will say of it
+    for warning in [*built.doubts(), *scene_warnings(load_scene(target))]:  # and what decide will say of it
         _warn(warning)
     click.echo(f"scene in {target}; decide with: unstack decide {target}")
