@@ -92,3 +92,11 @@ def test_a_value_put_into_the_metadata_afterwards_that_json_cannot_hold_is_not_s
     ):
         supports.save(target)
     assert not target.exists() and list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("mass", [10_000.5, 1.7e308])
+def test_a_mass_above_what_the_schemas_allow_is_refused_in_the_library_too(mass: float) -> None:
+    with pytest.raises(InvalidSupports, match=r"\$\.masses\[0\]: expected at most 10,000 kg \(a carton; kg\?\), got "):
+        unstack.Supports(IDS, PROBABILITIES, masses=[mass, 1.0, 1.0])
+    with pytest.raises(InvalidScene, match=r"\$\.mass: expected at most 10,000 kg \(a carton; kg\?\), got "):
+        unstack.Box("a", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2], mass=mass)

@@ -31,6 +31,7 @@ __all__ = [
     "MAX_BOX_EDGE",
     "MAX_COORDINATE",
     "MAX_ID_LENGTH",
+    "MAX_MASS",
     "MIN_BOX_EDGE",
     "QUATERNION_NORM_TOLERANCE",
     "REFUSED_OVERLAP",
@@ -71,8 +72,10 @@ MAX_COORDINATE = 100.0
 #: Two boxes sharing more than this share of the smaller one's volume are refused.
 REFUSED_OVERLAP = 0.5
 #: A box lighter than this (kg) is warned about: no carton weighs less, so the masses are
-#: likely in another unit (the heaviest accepted, 10,000 kg, is in the schemas).
+#: likely in another unit.
 LIGHT_BOX = 0.01
+#: A box heavier than this (kg) is refused, as the schemas refuse it: a unit error.
+MAX_MASS = 10_000.0
 
 
 def number_text(value: Any) -> str:

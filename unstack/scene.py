@@ -29,6 +29,7 @@ from unstack.checks import (
     MAX_BOX_EDGE,
     MAX_COORDINATE,
     MAX_ID_LENGTH,
+    MAX_MASS,
     MIN_BOX_EDGE,
     REFUSED_OVERLAP,
     check_ids,
@@ -61,6 +62,8 @@ def _check_mass(mass: float | None, source: str, path: str) -> float | None:
     number = finite_number(mass)
     if number is None or number <= 0:
         raise InvalidScene(source, path, f"expected a positive, finite number of kg, got {number_text(mass)}")
+    if number > MAX_MASS:
+        raise InvalidScene(source, path, f"expected at most {MAX_MASS:,.0f} kg (a carton; kg?), got {number:g}")
     return number
 
 

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from unstack.atomic import atomic_write_text
-from unstack.checks import check_ids, check_metadata, check_probability_matrix, check_vector
+from unstack.checks import MAX_MASS, check_ids, check_metadata, check_probability_matrix, check_vector
 from unstack.errors import InvalidSupports
 from unstack.frozen import read_only, set_frozen_fields
 from unstack.jsonio import Document, read_document, validate_document
@@ -88,6 +88,13 @@ class Supports:
             mass_vector = check_vector(
                 masses, len(ids), positive=True, source=source, path="$.masses", error=InvalidSupports
             )
+            heavy = np.flatnonzero(mass_vector > MAX_MASS)
+            if heavy.size:
+                raise InvalidSupports(
+                    source,
+                    f"$.masses[{heavy[0]}]",
+                    f"expected at most {MAX_MASS:,.0f} kg (a carton; kg?), got {mass_vector[heavy[0]]:g}",
+                )
             mass_vector = read_only(mass_vector, masses)
         load_vector = None
         if hidden_load is not None:
