@@ -69,6 +69,18 @@ def test_wrong_arguments_are_invalid_arguments(examples: Path) -> None:
         unstack.support_probabilities(unstack.load_scene(examples / "scene3.json"), statics="no")  # type: ignore[arg-type]
 
 
+def test_numpys_booleans_are_flags_like_pythons(examples: Path) -> None:
+    import numpy as np
+
+    scene = unstack.load_scene(examples / "pile5.scene.json")
+    supports = unstack.load_supports(examples / "stack5.supports.json")
+    assert unstack.decide(supports, statics=np.True_).choice == unstack.decide(supports).choice
+    with pytest.raises(InvalidArgument, match=r"so statics=False would be ignored"):
+        unstack.decide(supports, statics=np.False_)  # type: ignore[arg-type]
+    flagged = unstack.decide(scene, statics=np.False_, physics_veto=np.False_)  # type: ignore[arg-type]
+    assert flagged.to_dict() == unstack.decide(scene, statics=False).to_dict()
+
+
 def test_statics_raises_the_box_leant_on_and_can_be_turned_off(examples: Path) -> None:
     scene = unstack.load_scene(examples / "leaning.scene.json")
     raised, kept = unstack.support_probabilities(scene), unstack.support_probabilities(scene, statics=False)

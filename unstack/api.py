@@ -218,14 +218,17 @@ def support_probabilities(scene: Scene, model: ModelArgument = None, *, statics:
     if not isinstance(scene, Scene):
         raise InvalidArgument(f"expected a Scene, got {type(scene).__name__}")
     from unstack.pipeline import scene_support_probabilities
+    from unstack.reasoner.arguments import check_flag
 
-    if not isinstance(statics, bool):
-        raise InvalidArgument(f"statics must be True or False, got {statics!r}")
+    statics = check_flag(statics, "statics")
     loaded = _model(model)
     return scene_support_probabilities(scene, loaded, model_name=model_label(loaded), statics=statics)
 
 
 def _supports(scene_or_supports: Any, model: Any, statics: bool = True) -> Supports:
+    from unstack.reasoner.arguments import check_flag
+
+    statics = check_flag(statics, "statics")
     if isinstance(scene_or_supports, Supports):
         if model is not None:
             raise InvalidArgument(
@@ -357,13 +360,12 @@ def decide(
     >>> decide(unstack.Supports(["a", "b"], [[0, 0.2], [0.7, 0]]), seed=0).choice
     'a'
     """
-    from unstack.reasoner.arguments import check_margin
+    from unstack.reasoner.arguments import check_flag, check_margin
     from unstack.reasoner.decision import decide as decide_supports
 
     if free_cost is not None:
         free_cost = check_margin(free_cost, "free_cost")
-    if not isinstance(physics_veto, bool):
-        raise InvalidArgument(f"physics_veto must be True or False, got {physics_veto!r}")
+    physics_veto = check_flag(physics_veto, "physics_veto")
     veto_scene = _physics_veto_scene(scene_or_supports, cost) if physics_veto else None
     supports = _supports(scene_or_supports, model, statics)
     if cost == "moves":

@@ -286,17 +286,14 @@ def physics_veto(
     (False, True)
     """
     from unstack.geometry import bounding_boxes
-    from unstack.reasoner.arguments import check_margin
+    from unstack.reasoner.arguments import check_flag, check_margin
 
     free_cost = check_margin(free_cost, "free_cost")
     if not check_margin(veto_at, "veto_at") > 0:
         raise InvalidArgument(f"veto_at must be positive (a pick moving no box is never vetoed), got {veto_at!r}")
     if isinstance(worlds, bool) or not isinstance(worlds, int) or worlds < 1:
         raise InvalidArgument(f"worlds must be a positive integer, got {worlds!r}")
-    if not isinstance(net, bool):
-        raise InvalidArgument(f"net must be True or False, got {net!r}")
-    if not isinstance(draw_masses, bool):
-        raise InvalidArgument(f"draw_masses must be True or False, got {draw_masses!r}")
+    net, draw_masses = check_flag(net, "net"), check_flag(draw_masses, "draw_masses")
     from unstack.sim.belief import FILLS
 
     if fill not in FILLS or fill == "cloud":

@@ -30,6 +30,7 @@ __all__ = [
     "check_budget",
     "check_choice",
     "check_count",
+    "check_flag",
     "check_margin",
     "check_matrix",
     "check_samples",
@@ -147,6 +148,19 @@ def check_choice(value: Any, name: str, choices: tuple[str, ...]) -> str:
     'exact'
     """
     return OneOf(choices).check(value, name)
+
+
+def check_flag(value: Any, name: str) -> bool:
+    """``True`` or ``False`` (numpy's booleans too, as numpy's numbers are numbers elsewhere).
+
+    Examples
+    --------
+    >>> check_flag(np.True_, "statics")
+    True
+    """
+    if not isinstance(value, bool | np.bool_):
+        raise InvalidArgument(f"{name} must be True or False, got {value!r}")
+    return bool(value)
 
 
 def check_matrix(value: Any, name: str = "probabilities") -> np.ndarray:
