@@ -91,3 +91,43 @@ def test_a_world_prints_nothing_on_stdout(repo: Path) -> None:
     )
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=repo)
     assert result.stdout == "{}\n"
+
+
+#: What the dependencies unstack imports lazily change in a process on import, and nothing of
+#: unstack's own: scikit-learn sets two OpenMP environment variables (when unset), scipy and
+#: scikit-learn add warning filters. The reference page names them.
+DEPENDENCIES_ENVIRONMENT = {"KMP_DUPLICATE_LIB_OK", "KMP_INIT_AT_FORK"}
+
+
+@pytest.mark.slow  # a fresh interpreter that imports scikit-learn
+def test_a_decision_changes_no_process_state_but_what_its_dependencies_set_on_import(repo: Path) -> None:
+    code = (
+        "import json, logging, os, signal, sys, warnings\n"
+        "import numpy as np\n"
+        "def state():\n"
+        "    return {'environment': dict(os.environ), 'filters': [repr(f) for f in warnings.filters],\n"
+        "            'print': repr(np.get_printoptions()), 'random': repr(np.random.get_state()[1][:4]),\n"
+        "            'errors': repr(np.geterr()), 'cwd': os.getcwd(), 'root': repr(logging.getLogger().handlers),\n"
+        "            'level': logging.getLogger().level, 'sigint': repr(signal.getsignal(signal.SIGINT)),\n"
+        "            'recursion': sys.getrecursionlimit()}\n"
+        "before = state()\n"
+        "import sklearn, scipy.stats  # what unstack imports lazily, imported alone\n"
+        "dependencies = state()\n"
+        "import unstack\n"
+        "scene = unstack.load('examples/pile5.scene.json')\n"
+        "unstack.decide(scene); unstack.plan(unstack.load('examples/stack5.supports.json'))\n"
+        "after = state()\n"
+        "print(json.dumps({'before': before, 'dependencies': dependencies, 'after': after}))\n"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=repo)
+    import json
+
+    states = json.loads(result.stdout)
+    before, dependencies, after = states["before"], states["dependencies"], states["after"]
+    changed = {key for key in set(before["environment"]) | set(after["environment"])
+               if before["environment"].get(key) != after["environment"].get(key)}  # fmt: skip
+    assert changed <= DEPENDENCIES_ENVIRONMENT
+    assert after["environment"] == dependencies["environment"]  # the dependencies' own, nothing of unstack's
+    assert after["filters"] == dependencies["filters"]
+    for key in ("print", "random", "errors", "cwd", "root", "level", "sigint", "recursion"):
+        assert after[key] == before[key], key
