@@ -197,7 +197,7 @@ def warm_up(progress: Callable[[str, float], None] | None = None, *, jobs: int =
     """
     from unstack.reasoner.arguments import check_count
 
-    check_count(jobs, "jobs")
+    jobs = min(check_count(jobs, "jobs"), len(KERNELS))  # a process a group of kernels at most
     if jobs == 1:
         seconds = {}
         for name, _ in KERNELS:

@@ -40,8 +40,21 @@ def test_millimetres_declared_as_metres_are_refused(tmp_path: Path) -> None:
 
 
 def test_a_depth_image_without_readings_is_refused(tmp_path: Path) -> None:
-    with pytest.raises(InvalidFile, match="holds no reading"):
+    with pytest.raises(InvalidFile, match=r"holds no reading \(every pixel is 0 or not a number\)"):
         load_depth(_png(tmp_path / "d.png", np.zeros((4, 5), dtype=np.uint16)))
+    np.save(tmp_path / "d.npy", np.full((4, 5), -1.5))
+    with pytest.raises(InvalidFile, match=r"holds no reading \(every pixel is 0, negative or not a number\)"):
+        load_depth(tmp_path / "d.npy")
+
+
+@pytest.mark.parametrize(
+    "value, question",
+    [(65535, r"every reading is 65535, the largest the image holds: a code for no reading\?"),
+     (52000, r"are the values in a finer unit than millimetres \(a depth scale of 0.25 mm, say\)\?")],
+)  # fmt: skip
+def test_a_png_of_readings_beyond_any_camera_asks_the_right_question(tmp_path: Path, value: int, question: str) -> None:
+    with pytest.raises(InvalidFile, match=f"declared in mm but the median reading is [0-9.]+ m: {question}"):
+        load_depth(_png(tmp_path / "d.png", np.full((4, 5), value, dtype=np.uint16)))
 
 
 def test_a_pose_inside_an_object_is_read(tmp_path: Path) -> None:

@@ -256,13 +256,20 @@ def load_depth(path: str | os.PathLike[str], *, units: str | None = None) -> np.
     values = raw.astype(np.float64)
     valid = np.isfinite(values) & (values > 0)
     if not valid.any():
-        raise InvalidFile(source, "$", "the depth image holds no reading (every pixel is 0 or not a number)")
+        negative = bool((np.isfinite(values) & (values < 0)).any())
+        what = "every pixel is 0, negative or not a number" if negative else "every pixel is 0 or not a number"
+        raise InvalidFile(source, "$", f"the depth image holds no reading ({what})")
     metres = np.where(valid, values, 0.0) * DEPTH_UNITS[declared]
     median = float(np.median(metres[valid]))
     if median > MAX_DEPTH_M:
-        raise InvalidFile(
-            source, "$", f"declared in {declared} but the median reading is {median:g} m: are the values millimetres?"
-        )
+        readings = values[valid]
+        if np.issubdtype(raw.dtype, np.integer) and readings.min() == np.iinfo(raw.dtype).max:
+            question = f"every reading is {readings[0]:g}, the largest the image holds: a code for no reading?"
+        elif declared == "mm":
+            question = "are the values in a finer unit than millimetres (a depth scale of 0.25 mm, say)?"
+        else:
+            question = "are the values millimetres?"
+        raise InvalidFile(source, "$", f"declared in {declared} but the median reading is {median:g} m: {question}")
     if declared == "mm" and float(values[valid].max()) <= MAX_DEPTH_M:
         raise InvalidFile(
             source, "$", f"declared in mm but every reading is at most {MAX_DEPTH_M:g} mm: are the values metres?"

@@ -104,7 +104,8 @@ def _door(text: str | None) -> list[float] | None:
 @click.option("--depth", "depth_file", default=None, type=click.Path(dir_okay=False),
               help="Depth image: a 16-bit PNG (mm) or a .npy of floats (m).")  # fmt: skip
 @click.option("--depth-units", type=click.Choice(["mm", "m"]), default=None,
-              help="Units of the depth values (default: mm for a PNG, m for a .npy); checked.")  # fmt: skip
+              help="Units of the depth values (default: mm for a PNG or a .npy of integers, m for a .npy of "
+              "floats); checked.")  # fmt: skip
 @click.option("--intrinsics", "intrinsics_file", default=None, type=click.Path(dir_okay=False),
               help='JSON {"fx", "fy", "cx", "cy", "width", "height"} in pixels.')  # fmt: skip
 @click.option("--pose", "pose_file", default=None, type=click.Path(dir_okay=False),

@@ -211,10 +211,48 @@ FREE_COST_OPTION = click.option(
 )
 
 
-def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
-    """The options shared by ``decide`` and ``plan``: method, cost, sampling budget, seed."""
+def _reasoning_options(*, plan: bool) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """The options shared by ``decide`` and ``plan``: method, cost, sampling budget, seed; their
+    help says what they do in the one command or the other."""
+
+    def add(command: Callable[..., Any]) -> Callable[..., Any]:
+        return _add_reasoning_options(command, plan=plan)
+
+    return add
+
+
+def _default_samples_text() -> str:
+    """The sampler's default budget by group size, in words (from the sampler itself)."""
+    from itertools import groupby
+
+    from unstack.reasoner.sampling import WIDE_SAMPLES, default_samples
+
+    sizes = [(n, default_samples(n)) for n in range(2, 65)]
+    spans = []
+    for budget, group in groupby(sizes, key=lambda row: row[1]):
+        members = [n for n, _ in group]
+        first, last = members[0], members[-1]
+        spans.append(f"{budget} for {first}+" if budget == WIDE_SAMPLES else f"{budget} for {first}-{last}")
+    return ", ".join(spans) + " boxes"
+
+
+def _add_reasoning_options(command: Callable[..., Any], *, plan: bool) -> Callable[..., Any]:
     from unstack.reasoner.costs import COSTS, DEFAULT_COST
     from unstack.reasoner.decision import METHODS
+    from unstack.reasoner.plan import PLAN_SAMPLES
+
+    moves = (
+        ""
+        if plan
+        else "; moves (a scene): the boxes taking the box out is expected to move, from the learned disturbance model"
+    )
+    samples = (
+        f"Recorded sweeps per sampled group at each step (default {PLAN_SAMPLES}, the chains starting from the "
+        "previous step's; reproducible with --seed)."
+        if plan
+        else f"Recorded sweeps per sampled group (default {_default_samples_text()}; reproducible with --seed)."
+    )
+    seconds = "each step" if plan else "the whole decision"
 
     options = [
         click.option(
@@ -227,24 +265,23 @@ def _reasoning_options(command: Callable[..., Any]) -> Callable[..., Any]:
         ),
         click.option(
             "--cost",
-            type=click.Choice([*COSTS, "moves"]),
+            type=click.Choice([*COSTS] if plan else [*COSTS, "moves"]),
             default=DEFAULT_COST,
             show_default=True,
             help="load: supported boxes, each with the undetected load on it; count: number of supported "
-            "boxes (Eq. 11); mass: their total mass (needs masses); moves (a scene, decide only): the boxes "
-            "taking the box out is expected to move, from the learned disturbance model.",
+            f"boxes (Eq. 11); mass: their total mass (needs masses){moves}.",
         ),
         click.option(
             "--samples",
             type=SAMPLES,
             default=None,
-            help="Recorded sweeps per sampled group (default 4096, 2048 for 64+ boxes; reproducible with --seed).",
+            help=samples,
         ),
         click.option(
             "--time-limit",
             type=SECONDS,
             default=None,
-            help="Seconds for the whole decision instead of a number of sweeps (not reproducible; under 10 "
+            help=f"Seconds for {seconds} (not reproducible; with --samples, whichever ends first; under 10 "
             "also samples groups of 8).",
         ),
         click.option("--seed", type=SEED, default=None, help="Seed of the sampler."),
@@ -317,13 +354,13 @@ def cli() -> None:
     "-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON decision to this file (atomically)."
 )
 @click.option("--timing", is_flag=True, help="Add wall-clock seconds to the JSON (it is canonical without them).")
-@_reasoning_options
+@_reasoning_options(plan=False)
 @FREE_COST_OPTION
 @click.option(
     "--physics-veto", is_flag=True,
     help="For a scene, with the physics engine (unstack[sim]): try the pick in belief worlds built from the scene "
     "and, where it is expected to move a box, take the box holding nothing up expected to move the fewest "
-    "(tenths of a second to seconds).",
+    "(0.3-2 s on simulated piles of 5-40 boxes; tens of seconds where the belief worlds do not stand still).",
 )  # fmt: skip
 @model_option
 @click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)
@@ -373,7 +410,7 @@ def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str, 
 @click.argument("file", type=str)
 @click.option("--json", "as_json", is_flag=True, help="Print the plan as unstack.plan/1 JSON.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON plan to this file.")
-@_reasoning_options
+@_reasoning_options(plan=True)
 @FREE_COST_OPTION
 @model_option
 @click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)
@@ -447,7 +484,7 @@ def warm_up(jobs: int | None) -> None:
     from unstack.warmup import warm_up as compile_kernels
 
     total = len(KERNELS)
-    jobs = jobs if jobs is not None else max(1, min(total, os.cpu_count() or 1))
+    jobs = min(total, jobs) if jobs is not None else max(1, min(total, os.cpu_count() or 1))  # one a group at most
     done = [0]
     start = time.perf_counter()
     click.echo(
