@@ -415,7 +415,9 @@ def unload(
 @click.option("--max-picks", type=CONTAINER("max_picks"), default=None, help="Stop each pile after this many picks.")
 @click.option("--samples", type=SAMPLES, default=CONTAINER_SAMPLES, show_default=True,
               help="Recorded sweeps per sampled group in each decision.")  # fmt: skip
-@click.option("--seed", type=CONTAINER("seed"), default=0, show_default=True)
+@click.option("--seed", type=CONTAINER("seed"), default=0, show_default=True,
+              help="Seed of the decisions' sampling, the belief worlds and the detector's misses "
+              "(pile N: seed + N).")  # fmt: skip
 @click.option("--jobs", type=CONTAINER("n_jobs"), default=1, show_default=True, help="Piles run in parallel.")
 @click.option("--scheduler", default=None,
               help="Address of a dask.distributed scheduler (tcp://HOST:PORT): piles run on its workers.")  # fmt: skip
@@ -610,7 +612,8 @@ def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, pi
               help="Share of the seen boxes the detector misses at each scan.")  # fmt: skip
 @click.option("--worlds", type=CALIBRATION("worlds"), default=None, help="Belief worlds per decision (default 4).")
 @click.option("--max-picks", type=CALIBRATION("max_picks"), default=None, help="Stop each pile after this many picks.")
-@click.option("--seed", type=CALIBRATION("seed"), default=0, show_default=True)
+@click.option("--seed", type=CALIBRATION("seed"), default=0, show_default=True,
+              help="Seed of the detector's misses and the belief worlds.")  # fmt: skip
 @click.option("--fill", type=CALIBRATION("fill"), default="cloud", show_default=True,
               help="What the belief puts where no box is seen: the cloud's unexplained points, or all the "
                    "space the sensor cannot see next to the boxes.")  # fmt: skip
@@ -663,7 +666,8 @@ def belief_calibration_command(
 @out_folder_option("Folder of the collected states (resumable).")
 @click.option("--piles", type=RESPONSES("piles"), default=None, help="The first N piles of each data set.")
 @click.option("--max-picks", type=RESPONSES("max_picks"), default=None, help="Stop each pile after this many picks.")
-@click.option("--seed", type=RESPONSES("seed"), default=0, show_default=True)
+@click.option("--seed", type=RESPONSES("seed"), default=0, show_default=True,
+              help="Seed of the mixed policy's choices, its sampled decisions and the removals' order.")  # fmt: skip
 @click.option("--behaviour", type=RESPONSES("behaviour"), default="mixed", show_default=True,
               help="What takes the picks: mixed (the probe's best, the highest or a random box, drawn) or a "
               "decision maker of `unstack experiment container` (the states it reaches itself, as DAgger "
@@ -710,7 +714,8 @@ def pick_responses(
 @model_path_option
 @click.option("--folds", type=TRAINING("folds"), default=5, show_default=True,
               help="Grouped folds (piles held out together) of the held-out figures.")  # fmt: skip
-@click.option("--seed", type=TRAINING("random_state"), default=0, show_default=True)
+@click.option("--seed", type=TRAINING("random_state"), default=0, show_default=True,
+              help="Seed of the learner.")  # fmt: skip
 @click.option("--jobs", type=PICK_TABLE("n_jobs"), default=1, show_default=True,
               help="Piles in parallel.")  # fmt: skip
 def train_disturbance_command(states: str, out: str, model_path: str | None, folds: int, seed: int, jobs: int) -> None:

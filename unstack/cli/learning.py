@@ -76,7 +76,10 @@ def data_sets_view(reports: dict[str, dict[str, Any]]) -> Table:
     return table
 
 
-ISETS_FROM_HELP = "How ISets are drawn: random detected boxes, or a detected box and its nearest neighbours."
+ISETS_FROM_HELP = (
+    "How ISets are drawn: random: random detected boxes; neighbours: a detected box and its nearest neighbours; "
+    "mixed: each ISet one or the other at even odds."
+)
 FEATURES_HELP = (
     "paper: the 19 numbers of Eq. 6; extended: those and 17 contact features (gaps, overlaps, cloud); "
     "general: 15 features of the two boxes' poses (oriented footprints, gaps, tilt, separation), no cloud."
@@ -136,12 +139,17 @@ def _files_in(folder: str) -> list[Path]:
               help="Seed of the ISets, the split and the folds.")  # fmt: skip
 @click.option("--split-by", type=click.Choice(list(SPLITS)), default="pairs", show_default=True,
               help="pairs: the paper's split of the relations; configuration: whole piles on one side.")  # fmt: skip
-@click.option("--cv", type=int, default=10, show_default=True, help="Cross-validation folds on the training part.")
-@click.option("--validation-size", type=float, default=0.3, show_default=True, help="Share held out for validation.")
+@click.option("--cv", type=int, default=10, show_default=True,
+              help="Cross-validation folds on the training part (2-1,000; fewer where the rarer class or the piles "
+              "are fewer).")  # fmt: skip
+@click.option("--validation-size", type=float, default=0.3, show_default=True,
+              help="Share held out for validation (0 to below 1; 0: none held out, no hold-out figures).")  # fmt: skip
 @click.option("--features", "feature_set", type=click.Choice(list(FEATURE_SETS)), default="paper",
               show_default=True, help=FEATURES_HELP)  # fmt: skip
-@click.option("--offset", type=float, default=1.0, show_default=True, help="d: interest-point offset (m).")
-@click.option("--sigma", type=float, default=0.5, show_default=True, help="Width of the DBAF's Gaussian (m).")
+@click.option("--offset", type=float, default=1.0, show_default=True,
+              help="d: interest-point offset (m; above 0, at most 10).")  # fmt: skip
+@click.option("--sigma", type=float, default=0.5, show_default=True,
+              help="Width of the DBAF's Gaussian (m; above 0, at most 10).")  # fmt: skip
 @click.option("--jobs", type=click.IntRange(1, MAX_JOBS), default=1, show_default=True, help="Parallel processes.")
 @click.option("--json", "as_json", is_flag=True, help="Print the training report as JSON.")
 def train(
@@ -241,7 +249,9 @@ def train(
 @click.option("--seed", type=click.IntRange(min=0), default=1, show_default=True, help="Seed of the ISets.")
 @click.option("--jobs", type=click.IntRange(1, MAX_JOBS), default=1, show_default=True, help="Parallel processes.")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
-@click.option("--reliability", type=click.Path(dir_okay=False), default=None, help="Write a reliability diagram PNG.")
+@click.option(
+    "--reliability", type=click.Path(dir_okay=False), default=None, help="Write a reliability diagram (.png or .svg)."
+)
 def evaluate(
     model_file: str,
     data_dir: str,

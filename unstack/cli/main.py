@@ -388,7 +388,14 @@ def decide(file: str, as_json: bool, output: str | None, timing: bool, model: st
 @click.option("--json", "as_json", is_flag=True, help="Print every world as JSON (unstack.payoff/1).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), help="Also write the JSON payoff matrix to this file.")
 @click.option("--limit", type=click.IntRange(min=1), default=20, show_default=True, help="Worlds shown in the table.")
-@click.option("--cost", type=click.Choice(list(PAYOFF_COSTS)), default="count", show_default=True)
+@click.option(
+    "--cost",
+    type=click.Choice(list(PAYOFF_COSTS)),
+    default="count",
+    show_default=True,
+    help="count: the boxes each action brings down in each world (Eq. 11); mass: their mass (needs "
+    "masses). decide's default load cost, which adds the undetected load, is not listed world by world.",
+)
 @model_option
 def worlds(file: str, as_json: bool, output: str | None, limit: int, cost: str, model: str | None) -> None:
     """Print the payoff matrix (Table II): consistent worlds, their probabilities and action costs.
