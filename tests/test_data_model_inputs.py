@@ -100,3 +100,10 @@ def test_a_mass_above_what_the_schemas_allow_is_refused_in_the_library_too(mass:
         unstack.Supports(IDS, PROBABILITIES, masses=[mass, 1.0, 1.0])
     with pytest.raises(InvalidScene, match=r"\$\.mass: expected at most 10,000 kg \(a carton; kg\?\), got "):
         unstack.Box("a", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2], mass=mass)
+
+
+def test_an_empty_file_name_is_said_to_be_empty_not_a_folder() -> None:
+    from unstack.errors import InvalidFile
+
+    with pytest.raises(InvalidFile, match=r"^'': \$: expected a file name, got an empty one$"):
+        unstack.load("")

@@ -273,6 +273,8 @@ def read_document(path: str | os.PathLike[str]) -> Document:
             raise InvalidFile(source, "$", f"cannot read standard input: {error}") from None
     else:
         file = Path(path)
+        if source == "":
+            raise InvalidFile("''", "$", "expected a file name, got an empty one")
         if "\0" in source:
             raise InvalidFile(source.replace("\0", "\\0"), "$", "expected a file name, got one with a NUL character")
         try:

@@ -47,6 +47,8 @@ REFUSALS = [
     ([*SCENE, "--depth-units", "m"], "declared in m but the median reading is"),
     ([*SCENE, "--ids", "a,"], "--ids: expected 2 non-empty box ids separated by commas, got 'a,'"),
     ([*SCENE, "--sizes", ""], "--sizes: expected sizes like 0.4x0.3x0.3 separated by commas, got ''"),
+    ([*SCENE, "--sizes", "0.4x0.3x0.3,"], "separated by commas, got '' in '0.4x0.3x0.3,'"),
+    ([*SCENE, "--ids", "a," + "b" * 300], "--ids: expected an id of at most 200 characters, got one of 300 ('bbbb"),
     ([*SCENE, "--door", "0,0,1"], "within 15 degrees of the vertical"),
     ([*SCENE, "--sizes", "0.01x0.01x0.01"], "--sizes: expected three edges of 0.02-5 m per size, got '0.01x0.01x0.01'"),
     ([*DETECTED, "--sizes", "0.4x0.3x0.3", "--ids", "a,b"], "--sizes and --ids apply to mask files and a depth image"),

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import click
 
-from unstack.checks import MAX_BOX_EDGE, MIN_BOX_EDGE
+from unstack.checks import MAX_BOX_EDGE, MAX_ID_LENGTH, MIN_BOX_EDGE, long_id
 from unstack.errors import InvalidFile, UnstackError
 from unstack.jsonio import report_text
 
@@ -32,7 +32,8 @@ def _sizes(text: str | None) -> list[tuple[float, float, float]] | None:
         try:
             edges = tuple(float(value) for value in item.lower().split("x"))
         except ValueError:
-            raise UnstackError(f"--sizes: expected sizes like 0.4x0.3x0.3 separated by commas, got {item!r}") from None
+            where = f"{item!r} in {text!r}" if item != text else repr(text)
+            raise UnstackError(f"--sizes: expected sizes like 0.4x0.3x0.3 separated by commas, got {where}") from None
         if len(edges) != 3 or not all(MIN_BOX_EDGE <= edge <= MAX_BOX_EDGE for edge in edges):
             raise UnstackError(
                 f"--sizes: expected three edges of {MIN_BOX_EDGE:g}-{MAX_BOX_EDGE:g} m per size, got {item!r}"
@@ -187,6 +188,9 @@ def scene(
             raise UnstackError(f"--ids names {len(names)} boxes but {len(mask_files)} masks were given")
         if ids is not None and not all(names):
             raise UnstackError(f"--ids: expected {len(mask_files)} non-empty box ids separated by commas, got {ids!r}")
+        for path, name in zip(mask_files, names, strict=True):
+            if len(name) > MAX_ID_LENGTH:  # before any fitting: an id no scene holds
+                raise UnstackError(f"{'--ids' if ids is not None else path}: {long_id(name)}")
         unnamed = [path for path, name in zip(mask_files, names, strict=True) if not name]
         if unnamed:
             raise UnstackError(
