@@ -84,6 +84,11 @@ def intrinsics(**change: Any) -> dict[str, Any]:
         ("intrinsics", intrinsics(cx=1e308), r"\$\.cx: expected a principal point inside the image \(0 to 640 px\)"),
         (
             "intrinsics",
+            intrinsics(fx=304.6, fy=30.0),
+            r"\$\.fy: expected square-ish pixels \(fx / fy between 0\.5 and 2\), got fx 304\.6 and fy 30",
+        ),
+        (
+            "intrinsics",
             intrinsics(cy=481),
             r"\$\.cy: expected a principal point inside the image \(0 to 480 px\), got 481",
         ),

@@ -43,6 +43,9 @@ MAX_DEPTH_M = 20.0
 FIELD_OF_VIEW = (1.0, 170.0)
 #: The widest and tallest depth image read (pixels; depth cameras give 1-2 thousand).
 MAX_PIXELS = 16384
+#: Pixels this much taller than wide (or wider than tall) are no depth camera's: fx / fy is 1
+#: within a percent on the cameras in use.
+MAX_PIXEL_ASPECT = 2.0
 #: The keys of a pinhole camera's intrinsics.
 INTRINSICS_KEYS = ("fx", "fy", "cx", "cy", "width", "height")
 #: Keys that give a lens distortion (OpenCV's and ROS's names, in lower case).
@@ -128,6 +131,14 @@ def load_intrinsics(path: str | os.PathLike[str]) -> Intrinsics:
                 f"expected a focal length that sees {FIELD_OF_VIEW[0]:g} to {FIELD_OF_VIEW[1]:g} degrees across "
                 f"{values[side]:g} px ({low:.3g} to {high:.3g} px), got {values[focal]:g}",
             )
+    aspect = values["fx"] / values["fy"]
+    if not 1.0 / MAX_PIXEL_ASPECT <= aspect <= MAX_PIXEL_ASPECT:
+        raise InvalidFile(
+            source,
+            "$.fy",
+            f"expected square-ish pixels (fx / fy between {1 / MAX_PIXEL_ASPECT:g} and {MAX_PIXEL_ASPECT:g}), "
+            f"got fx {values['fx']:g} and fy {values['fy']:g}",
+        )
     ignored = sorted(str(key) for key in data if key not in INTRINSICS_KEYS and str(key).lower() not in DISTORTION_KEYS)
     if ignored:
         warnings.warn(f"{source}: keys passed over (a pinhole camera needs only {', '.join(INTRINSICS_KEYS)}): "
