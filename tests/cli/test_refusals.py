@@ -60,6 +60,10 @@ REFUSALS = [
     ([*SIMULATE, "--configs", "-3"], "Invalid value for '--configs': -3 is not in the range 1<=x<=100000"),
     ([*SIMULATE, "--configs", "10000000000"], "'--configs': 10000000000 is not in the range 1<=x<=100000"),
     ([*SIMULATE, "--jobs", "0"], "Invalid value for '--jobs': 0 is not in the range 1<=x<=256"),
+    (
+        [*SIMULATE, "--resolution", "96x72", "--min-pixels", "100000"],
+        "settings.sensor.min_pixels: expected at most the image's 6,912 pixels (96 x 72): no box could be detected",
+    ),
     ([*SIMULATE, "--boxes", "1"], "boxes 1-1: a pile of one box supports nothing"),
     ([*SIMULATE, "--resolution", "big"], "--resolution: expected WIDTHxHEIGHT in pixels"),
     ([*SIMULATE, "--width", "0"], "'--width': expected a positive extent of at most 100 m, got 0.0"),

@@ -396,9 +396,16 @@ def _values(cls: type, data: Any, where: str, fail: Any) -> dict[str, Any]:
 
 
 def _check_pairs(pile: PileSettings, sensor: SensorSettings, where: str, fail: Any) -> None:
-    """The settings whose limits depend on another field: the mass range's order, far beyond near."""
+    """The settings whose limits depend on another field: the mass range's order, far beyond near,
+    a box's pixels within the image."""
     if not sensor.near < sensor.far:
         fail(f"{where}.sensor.far", f"expected beyond near ({sensor.near}), got {sensor.far}")
+    if sensor.min_pixels > sensor.width * sensor.height:
+        fail(
+            f"{where}.sensor.min_pixels",
+            f"expected at most the image's {sensor.width * sensor.height:,} pixels ({sensor.width} x "
+            f"{sensor.height}): no box could be detected, got {sensor.min_pixels:,}",
+        )
     low, high = pile.mass_range
     if low > high:
         fail(f"{where}.pile.mass_range", f"expected [low, high] with low <= high, got [{low}, {high}]")
