@@ -221,9 +221,9 @@ def test_decide_on_a_scene_takes_the_highest_free_box_unless_free_cost_is_0(tmp_
     assert "Unload first: tall (tied with low: EC below 0.5, holding nothing up; the highest wins)" in words
 
 
-def test_a_free_cost_on_support_probabilities_exits_2() -> None:
+def test_a_free_cost_on_support_probabilities_exits_2_naming_the_option() -> None:
     result = unstack("decide", PILE5, "--free-cost", "0.5")
-    assert_one_line_error(result, "free_cost takes the highest box by its centre")
+    assert_one_line_error(result, "--free-cost takes the highest box by its centre")
 
 
 def test_near_ties_on_supports_without_heights_exit_2() -> None:

@@ -14,6 +14,7 @@ import contextlib
 import functools
 import importlib
 import os
+import re
 import sys
 import time
 from collections.abc import Callable, Iterator
@@ -23,7 +24,7 @@ import click
 
 from unstack.cli.options import Checked
 from unstack.cli.text import printable
-from unstack.errors import UnstackError
+from unstack.errors import InvalidArgument, UnstackError
 from unstack.reasoner.arguments import check_budget, check_margin, check_samples, check_seed
 from unstack.reasoner.costs import PAYOFF_COSTS
 
@@ -127,7 +128,7 @@ class _Group(click.Group):
             _quiet_broken_pipe()
         except UnstackError as error:
             _remove_empty_new_folders(ctx)
-            _fail(str(error))
+            _fail(_option_names(str(error)) if isinstance(error, InvalidArgument) else str(error))
         except OSError as error:
             _remove_empty_new_folders(ctx)
             _fail(f"{getattr(error, 'filename', None) or ''}: {error.strerror or error}".lstrip(": "))
@@ -322,6 +323,28 @@ def _first_call(loaded: Any) -> Iterator[None]:
 
         with announcing_compilation(announce):
             yield
+
+
+#: The library's keyword arguments that the command line knows as options of other names.
+OPTION_NAMES = {
+    "near_tie_margin": "--near-ties",
+    "free_cost": "--free-cost",
+    "time_limit": "--time-limit",
+    "physics_veto": "--physics-veto",
+}
+
+
+def _option_names(message: str) -> str:
+    """A library argument error in the command line's words: its keyword names as option names.
+
+    Examples
+    --------
+    >>> _option_names("p.json: free_cost takes the highest box by its centre")
+    'p.json: --free-cost takes the highest box by its centre'
+    """
+    for keyword, option in OPTION_NAMES.items():
+        message = re.sub(rf"\b{keyword}\b", option, message)
+    return message
 
 
 #: A run the command line announces up front when its budget allows longer (seconds).
