@@ -121,7 +121,7 @@ def _run_piles(
 @experiment.command()
 @out_folder_option("Folder for table1.json.")
 @click.option("--max-n", type=Checked(int, functools.partial(TABLE_SIZE.check, name="max_n")), default=6,
-              show_default=True, help="Largest n (7 takes seconds, 8 minutes).")  # fmt: skip
+              show_default=True, help="Largest n (3 to 8; 7 takes seconds, 8 minutes).")  # fmt: skip
 @click.option("--full", is_flag=True, help="The paper's size: n = 3..7 (overrides --max-n).")
 def table1(out: str, max_n: int, full: bool) -> None:
     """Table I: consistent worlds for n = 3..max-n by the exact engine and SAT, against the paper and OEIS."""
@@ -292,8 +292,9 @@ def decisions(
 @experiment.command()
 @data_dir_argument
 @out_folder_option("Folder for real7.json.")
-@click.option("--model", "model_path", default=None, help="Model trained on piles of the same four sizes.")
-@click.option("--piles", type=REAL7("piles"), default=None, help="Use only the first N piles.")
+@click.option("--model", "model_path", default=None,
+              help="Model file or shipped model's name (default: the default model, general).")  # fmt: skip
+@click.option("--piles", type=REAL7("piles"), default=None, help="Use only the first N piles (default: all).")
 def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) -> None:
     """The paper's real setting in simulation: every ISet of r = 3, 4, 5 of each 7-box pile."""
     from unstack.cli.main import load_model_option
@@ -615,8 +616,10 @@ def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, pi
 @click.option("--seed", type=CALIBRATION("seed"), default=0, show_default=True,
               help="Seed of the detector's misses and the belief worlds.")  # fmt: skip
 @click.option("--fill", type=CALIBRATION("fill"), default="cloud", show_default=True,
-              help="What the belief puts where no box is seen: the cloud's unexplained points, or all the "
-                   "space the sensor cannot see next to the boxes.")  # fmt: skip
+              help="What the belief puts where no box is seen: cloud: the cloud's unexplained points; occlusion: "
+                   "all the space the sensor cannot see next to the boxes; sampled: runs of it kept at a fixed "
+                   "chance; scaled: at a chance scaled by its volume; faces: the space behind surfaces no "
+                   "detected box explains; cartons: that, and whole hidden cartons drawn into the rest.")  # fmt: skip
 @click.option("--view", type=CALIBRATION("view"), default="candidates", show_default=True,
               help="Boxes in the belief: the reachable candidates, or every box the detector reports.")  # fmt: skip
 @click.option("--jobs", type=CALIBRATION("n_jobs"), default=1, show_default=True, help="Piles run in parallel.")
@@ -664,7 +667,8 @@ def belief_calibration_command(
 @experiment.command("pick-responses")
 @click.argument("data_dirs", nargs=-1, required=True, type=click.Path(file_okay=False))
 @out_folder_option("Folder of the collected states (resumable).")
-@click.option("--piles", type=RESPONSES("piles"), default=None, help="The first N piles of each data set.")
+@click.option("--piles", type=RESPONSES("piles"), default=None,
+              help="The first N piles of each data set (default: all).")  # fmt: skip
 @click.option("--max-picks", type=RESPONSES("max_picks"), default=None, help="Stop each pile after this many picks.")
 @click.option("--seed", type=RESPONSES("seed"), default=0, show_default=True,
               help="Seed of the mixed policy's choices, its sampled decisions and the removals' order.")  # fmt: skip
