@@ -123,6 +123,28 @@ def test_the_decision_json_records_the_veto_within_its_schema(small_dataset: Pat
     assert document["physics_veto"]["worlds"] == 4 and document["physics_veto"]["fill"] == "faces"
 
 
+@pytest.mark.parametrize(
+    "high, doubt",
+    [
+        (Box("high", [0.4, 0.4, 0.3], [1.0, 0.3, 0.75]), "'high' floats 0.60 m up"),  # nothing under it
+        (Box("high", [0.4, 0.4, 0.3], [1.0, 0.1, 0.2]), "'low' and 'high' overlap (42 %)"),  # into 'low'
+    ],
+)
+def test_poses_that_cannot_stand_keep_the_reasoners_pick_without_physics(high: Box, doubt: str) -> None:
+    low = Box("low", [0.4, 0.4, 0.3], [1.0, -0.1, 0.15])
+    scene = Scene([low, high], np.zeros((0, 3)), ["low", "high"], source="fit.json")
+    default = unstack.decide(scene, seed=0)
+    kept = unstack.decide(scene, seed=0, physics_veto=True)
+    assert kept.choice == default.choice and kept.physics_veto is not None
+    assert kept.physics_veto["skipped"] == [doubt] and kept.physics_veto["tried"] == []
+    assert not kept.physics_veto["vetoed"]
+    assert any(
+        warning.startswith(f"physics veto: not applied: poses of the scene cannot stand as reported ({doubt})")
+        for warning in kept.warnings
+    )
+    Draft202012Validator(load_schema("unstack.decision/1")).validate(kept.to_dict())
+
+
 def test_support_probabilities_and_the_moves_cost_are_refused() -> None:
     supports = unstack.load(REPO / "examples" / "stack5.supports.json")
     with pytest.raises(InvalidArgument, match="physics veto builds the boxes' poses"):

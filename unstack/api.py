@@ -335,8 +335,8 @@ def decide(
         For a scene, with the physics engine installed (``unstack[sim]``): try the pick in
         belief worlds built from the scene and, where it is expected to move a box, take the
         box holding nothing up expected to move the fewest (:func:`unstack.physics_veto.physics_veto`,
-        seeded by ``seed``; 0.3-2 s on simulated piles of 5-40 boxes, tens of seconds where
-        the belief worlds do not stand still with nothing taken). Not with support probabilities or
+        seeded by ``seed``; 0.3-2 s on simulated piles of 5-40 boxes; not applied, with a warning,
+        where the scene's poses cannot stand as reported). Not with support probabilities or
         the ``moves`` cost.
 
     Returns

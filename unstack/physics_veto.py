@@ -46,6 +46,7 @@ import numpy as np
 from unstack.errors import InvalidArgument
 from unstack.height_veto import FREE_COST, probability_below
 from unstack.scene import Scene
+from unstack.understanding.plausibility import standing_doubts
 
 if TYPE_CHECKING:
     from unstack.reasoner.decision import Decision
@@ -73,6 +74,8 @@ WALL_SLACK = 0.02
 #: Boxes that fell out of the door lie on the floor before it (the simulator's apron reaches 1.5 m),
 #: at most this far (metres); a box further out than its own size beyond it is a scene in another frame.
 DOOR_SPILL = 2.0
+#: Poses that cannot stand named one by one in the warning of a veto not applied, before "N more".
+NAMED_DOUBTS = 4
 
 
 def _expected_moved(
@@ -302,6 +305,16 @@ def physics_veto(
     missing = [box_id for box_id in decision.objects if box_id not in scene.detected]
     if missing:
         raise InvalidArgument(f"{scene.source}: the decision's boxes {missing} are not detected boxes of the scene")
+    doubts = standing_doubts(scene)
+    if doubts:  # physics would act out the poses' errors, whatever is taken: no evidence on the pick
+        more = f"; {len(doubts) - NAMED_DOUBTS} more" if len(doubts) > NAMED_DOUBTS else ""
+        named = "; ".join(doubts[:NAMED_DOUBTS]) + more
+        record = {**_record({}, decision.choice, False, veto_at, worlds, fill), "skipped": doubts}
+        warning = (
+            f"physics veto: not applied: poses of the scene cannot stand as reported ({named}); physics on them "
+            "would move those boxes whatever is taken, so the reasoner's pick is kept"
+        )
+        return dataclasses.replace(decision, physics_veto=record, warnings=(*decision.warnings, warning))
     given = scene if world_scene is None else world_scene
     settings = world_settings(given)
     built, slid = _inside_container(given, settings)

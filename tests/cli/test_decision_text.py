@@ -132,3 +132,16 @@ def test_expected_costs_too_small_for_four_decimals_keep_three_significant_digit
     text = text_of(unstack.decide(grams, cost="mass"))
     assert "3e-07" in text and "1.8e-06" in text and "0.0000" not in text
     assert "0.1000" in text_of(unstack.decide(grams, cost="count"))
+
+
+@pytest.mark.slow  # the physics engine is imported
+def test_a_physics_veto_not_applied_says_so_and_keeps_the_pick() -> None:
+    boxes = [
+        unstack.Box("low", [0.4, 0.4, 0.3], [1.0, -0.1, 0.15]),
+        unstack.Box("high", [0.4, 0.4, 0.3], [1.0, 0.3, 0.75]),
+    ]
+    decision = unstack.decide(unstack.Scene(boxes, np.zeros((0, 3)), ["low", "high"]), seed=0, physics_veto=True)
+    assert (
+        "physics on what the robot sees: not applied, 1 pose cannot stand as reported (see the warning); the "
+        f"reasoner's pick {decision.choice} is kept" in text_of(decision)
+    )

@@ -383,7 +383,7 @@ def cli() -> None:
     "--physics-veto", is_flag=True,
     help="For a scene, with the physics engine (unstack[sim]): try the pick in belief worlds built from the scene "
     "and, where it is expected to move a box, take the box holding nothing up expected to move the fewest "
-    "(0.3-2 s on simulated piles of 5-40 boxes; tens of seconds where the belief worlds do not stand still).",
+    "(0.3-2 s on simulated piles of 5-40 boxes; not applied where the scene's poses cannot stand).",
 )  # fmt: skip
 @model_option
 @click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)

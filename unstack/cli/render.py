@@ -119,6 +119,11 @@ def _footer(decision: Decision, model: str) -> Text:
 
 def _physics(record: dict[str, Any], choice: str) -> Text:
     """What physics on the belief expected the pick, and the boxes tried instead, to move."""
+    if "skipped" in record:
+        count = len(record["skipped"])
+        poses = "1 pose cannot" if count == 1 else f"{count} poses cannot"
+        return Text(f"physics on what the robot sees: not applied, {poses} stand as reported (see the warning); "
+                    f"the reasoner's pick {printable(choice)} is kept\n")  # fmt: skip
     tried = record["tried"]
     pick = tried[0]
     text = Text(

@@ -52,6 +52,7 @@ __all__ = [
     "overlap_share",
     "overlapping_pairs",
     "scene_warnings",
+    "standing_doubts",
 ]
 
 #: More than this share of the smaller box's volume shared with another is warned about (the
@@ -170,3 +171,34 @@ def scene_warnings(scene: Scene) -> list[str]:
                 "is the cloud in the same frame and unit (metres) as the boxes?"
             )
     return warnings
+
+
+def standing_doubts(scene: Scene) -> list[str]:
+    """The poses of a scene that cannot stand as reported, briefly (empty when all can): boxes
+    overlapping by more than :data:`WARNED_OVERLAP`, reaching more than :data:`BELOW_FLOOR`
+    into the floor, or detected boxes floating (the warnings of :func:`scene_warnings` that a
+    physics engine would act out: such boxes move whatever is taken).
+
+    Examples
+    --------
+    >>> from unstack.scene import Box, Scene
+    >>> lifted = Box("lifted", [0.4, 0.4, 0.4], [1.0, 0.0, 0.6])
+    >>> standing_doubts(Scene([lifted], np.zeros((0, 3)), ["lifted"]))
+    ["'lifted' floats 0.40 m up"]
+    """
+    doubts = [
+        f"{scene.boxes[i].id!r} and {scene.boxes[j].id!r} overlap ({100 * share:.0f} %)"
+        for i, j, share in overlapping_pairs(scene.boxes, WARNED_OVERLAP)
+    ]
+    bounds = bounding_boxes(scene.boxes)
+    doubts += [
+        f"{box.id!r} reaches {-low:.2f} m into the floor"
+        for box, low in zip(scene.boxes, bounds[:, 2], strict=True)
+        if low < -BELOW_FLOOR
+    ]
+    index = {box.id: k for k, box in enumerate(scene.boxes)}
+    for box_id in scene.detected:
+        height = _floating(scene, bounds, index[box_id])
+        if height is not None:
+            doubts.append(f"{box_id!r} floats {height:.2f} m up")
+    return doubts
