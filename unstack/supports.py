@@ -31,6 +31,13 @@ __all__ = ["SUPPORTS_FORMAT", "Supports", "load_supports"]
 SUPPORTS_FORMAT = "unstack.supports/1"
 
 
+def _refuse_first(vector: np.ndarray, bad: np.ndarray, source: str, path: str, expected: str) -> None:
+    """Raise at the first entry of ``vector`` where ``bad`` holds: ``path[k]: expected ..., got value``."""
+    rows = np.flatnonzero(bad)
+    if rows.size:
+        raise InvalidSupports(source, f"{path}[{rows[0]}]", f"expected {expected}, got {vector[rows[0]]:g}")
+
+
 @dataclass(frozen=True, eq=False)
 class Supports:
     """Pairwise support probabilities of ``n`` detected boxes.
@@ -88,26 +95,16 @@ class Supports:
             mass_vector = check_vector(
                 masses, len(ids), positive=True, source=source, path="$.masses", error=InvalidSupports
             )
-            heavy = np.flatnonzero(mass_vector > MAX_MASS)
-            if heavy.size:
-                raise InvalidSupports(
-                    source,
-                    f"$.masses[{heavy[0]}]",
-                    f"expected at most {MAX_MASS:,.0f} kg (a carton; kg?), got {mass_vector[heavy[0]]:g}",
-                )
+            _refuse_first(
+                mass_vector, mass_vector > MAX_MASS, source, "$.masses", f"at most {MAX_MASS:,.0f} kg (a carton; kg?)"
+            )
             mass_vector = read_only(mass_vector, masses)
         load_vector = None
         if hidden_load is not None:
             load_vector = check_vector(
                 hidden_load, len(ids), source=source, path="$.hidden_load", error=InvalidSupports
             )
-            negative = np.flatnonzero(load_vector < 0)
-            if negative.size:
-                raise InvalidSupports(
-                    source,
-                    f"$.hidden_load[{negative[0]}]",
-                    f"expected a non-negative number, got {load_vector[negative[0]]}",
-                )
+            _refuse_first(load_vector, load_vector < 0, source, "$.hidden_load", "a non-negative number")
             load_vector = read_only(load_vector, hidden_load)
         height_vector = None
         if heights is not None:
