@@ -62,6 +62,16 @@ def experiment() -> None:
     """
 
 
+def _seed_option(checked: Any, what: str) -> Callable[[Any], Any]:
+    """An experiment's ``--seed`` (checked by ``checked``, default 0): the seed of ``what``."""
+    return click.option("--seed", type=checked, default=0, show_default=True, help=f"Seed of {what}.")
+
+
+def _jobs_option(checked: Any, meaning: str = "Piles run in parallel.") -> Callable[[Any], Any]:
+    """An experiment's ``--jobs`` (checked by ``checked``, default 1)."""
+    return click.option("--jobs", type=checked, default=1, show_default=True, help=meaning)
+
+
 def _iset_options(checked: Callable[[str], Any], *, isets: int, isets_help: str) -> Callable[[Any], Any]:
     """The options of an experiment on ISets: ``--r`` boxes each, ``--isets`` of them (``isets`` by
     default), drawn as ``--isets-from`` says; ``checked`` gives each the constraints of the library
@@ -156,12 +166,10 @@ def table1(out: str, max_n: int, full: bool) -> None:
               help="pairs: the paper's split of the relations; configuration: whole piles on one side.")  # fmt: skip
 @click.option("--features", "feature_set", type=FIG5A("feature_set"), default="paper",
               show_default=True, help=FEATURES_HELP)  # fmt: skip
-@click.option("--seed", type=FIG5A("seed"), default=0, show_default=True,
-              help="Seed of the ISets, split and folds.")  # fmt: skip
+@_seed_option(FIG5A("seed"), "the ISets, split and folds")
 @click.option("--cv", type=FIG5A("cv"), default=10, show_default=True,
               help="Cross-validation folds.")  # fmt: skip
-@click.option("--jobs", type=FIG5A("n_jobs"), default=1, show_default=True,
-              help="Parallel processes.")  # fmt: skip
+@_jobs_option(FIG5A("n_jobs"), "Parallel processes.")
 @click.option("--full", is_flag=True, help="Insist on the paper's size: at least 200 configurations, 10 folds.")
 def fig5a(
     data_dir: str,
@@ -226,8 +234,7 @@ def fig5a(
 @out_folder_option("Folder for decisions.json and fig4.png.")
 @model_path_option
 @_iset_options(DECISIONS, isets=50, isets_help="Test ISets (the paper: 493).")
-@click.option("--seed", type=DECISIONS("seed"), default=0, show_default=True,
-              help="Seed of the ISets.")  # fmt: skip
+@_seed_option(DECISIONS("seed"), "the ISets")
 @click.option("--full", is_flag=True, help="The paper's size: 493 test ISets (overrides --isets).")
 @click.option("--pair-with", "pair_with", type=click.Path(dir_okay=False), default=None,
               help="decisions.json of an earlier run on the same ISets (another model, say): "
@@ -329,15 +336,14 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
               help="Recorded sweeps per sampled group in each decision (reproducible with the seed).")  # fmt: skip
 @click.option("--time-limit", type=SECONDS, default=None,
               help="Seconds per decision instead of --samples (not reproducible).")  # fmt: skip
-@click.option("--seed", type=UNLOAD("seed"), default=0, show_default=True,
-              help="Seed of the sampler and the random order.")  # fmt: skip
+@_seed_option(UNLOAD("seed"), "the sampler and the random order")
 @click.option("--full", is_flag=True, help="Every configuration of the data set (overrides --configs).")
 @click.option("--cost", type=UNLOAD("cost"), default=DEFAULT_COST, show_default=True,
               help="Cost of unstack's decisions: load (hidden load counted), count (Eq. 11) or mass.")  # fmt: skip
 @click.option("--closed-loop", is_flag=True,
               help="Also unstack and highest-first sensing the pile again before each pick (3x slower).")  # fmt: skip
 @click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)
-@click.option("--jobs", type=UNLOAD("n_jobs"), default=1, show_default=True, help="Piles run in parallel.")
+@_jobs_option(UNLOAD("n_jobs"))
 @click.option("--scheduler", default=None,
               help="Address of a dask.distributed scheduler (tcp://HOST:PORT): piles run on its workers.")  # fmt: skip
 def unload(
@@ -416,10 +422,10 @@ def unload(
 @click.option("--max-picks", type=CONTAINER("max_picks"), default=None, help="Stop each pile after this many picks.")
 @click.option("--samples", type=SAMPLES, default=CONTAINER_SAMPLES, show_default=True,
               help="Recorded sweeps per sampled group in each decision.")  # fmt: skip
-@click.option("--seed", type=CONTAINER("seed"), default=0, show_default=True,
-              help="Seed of the decisions' sampling, the belief worlds and the detector's misses "
-              "(pile N: seed + N).")  # fmt: skip
-@click.option("--jobs", type=CONTAINER("n_jobs"), default=1, show_default=True, help="Piles run in parallel.")
+@_seed_option(
+    CONTAINER("seed"), "the decisions' sampling, the belief worlds and the detector's misses (pile N: seed + N)"
+)
+@_jobs_option(CONTAINER("n_jobs"))
 @click.option("--scheduler", default=None,
               help="Address of a dask.distributed scheduler (tcp://HOST:PORT): piles run on its workers.")  # fmt: skip
 @click.option("--disturbance", "disturbance_path", type=click.Path(dir_okay=False, exists=True), default=None,
@@ -563,7 +569,7 @@ def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int
 @out_folder_option("Folder for camera-roundtrip.json.")
 @model_path_option
 @click.option("--piles", type=ROUNDTRIP("piles"), default=2, show_default=True, help="Piles (the first N).")
-@click.option("--jobs", type=ROUNDTRIP("n_jobs"), default=1, show_default=True, help="Piles run in parallel.")
+@_jobs_option(ROUNDTRIP("n_jobs"))
 def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, piles: int, jobs: int) -> None:
     """Render piles as camera files, build the scenes back (unstack scene's method), compare with the truth.
 
@@ -613,8 +619,7 @@ def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, pi
               help="Share of the seen boxes the detector misses at each scan.")  # fmt: skip
 @click.option("--worlds", type=CALIBRATION("worlds"), default=None, help="Belief worlds per decision (default 4).")
 @click.option("--max-picks", type=CALIBRATION("max_picks"), default=None, help="Stop each pile after this many picks.")
-@click.option("--seed", type=CALIBRATION("seed"), default=0, show_default=True,
-              help="Seed of the detector's misses and the belief worlds.")  # fmt: skip
+@_seed_option(CALIBRATION("seed"), "the detector's misses and the belief worlds")
 @click.option("--fill", type=CALIBRATION("fill"), default="cloud", show_default=True,
               help="What the belief puts where no box is seen: cloud: the cloud's unexplained points; occlusion: "
                    "all the space the sensor cannot see next to the boxes; sampled: runs of it kept at a fixed "
@@ -622,7 +627,7 @@ def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, pi
                    "detected box explains; cartons: that, and whole hidden cartons drawn into the rest.")  # fmt: skip
 @click.option("--view", type=CALIBRATION("view"), default="candidates", show_default=True,
               help="Boxes in the belief: the reachable candidates, or every box the detector reports.")  # fmt: skip
-@click.option("--jobs", type=CALIBRATION("n_jobs"), default=1, show_default=True, help="Piles run in parallel.")
+@_jobs_option(CALIBRATION("n_jobs"))
 def belief_calibration_command(
     data_dir: str, out: str, piles: int, detector_misses: float, worlds: int | None, max_picks: int | None, seed: int,
     fill: str, view: str, jobs: int,
@@ -670,8 +675,7 @@ def belief_calibration_command(
 @click.option("--piles", type=RESPONSES("piles"), default=None,
               help="The first N piles of each data set (default: all).")  # fmt: skip
 @click.option("--max-picks", type=RESPONSES("max_picks"), default=None, help="Stop each pile after this many picks.")
-@click.option("--seed", type=RESPONSES("seed"), default=0, show_default=True,
-              help="Seed of the mixed policy's choices, its sampled decisions and the removals' order.")  # fmt: skip
+@_seed_option(RESPONSES("seed"), "the mixed policy's choices, its sampled decisions and the removals' order")
 @click.option("--behaviour", type=RESPONSES("behaviour"), default="mixed", show_default=True,
               help="What takes the picks: mixed (the probe's best, the highest or a random box, drawn) or a "
               "decision maker of `unstack experiment container` (the states it reaches itself, as DAgger "
@@ -679,7 +683,7 @@ def belief_calibration_command(
 @model_path_option
 @click.option("--disturbance", "disturbance_path", type=click.Path(dir_okay=False, exists=True), default=None,
               help="Disturbance model file of a moves maker taking the picks (default: the shipped one).")  # fmt: skip
-@click.option("--jobs", type=RESPONSES("n_jobs"), default=1, show_default=True, help="Piles run in parallel.")
+@_jobs_option(RESPONSES("n_jobs"))
 @click.option("--scheduler", default=None,
               help="Address of a dask.distributed scheduler (tcp://HOST:PORT): piles run on its workers.")  # fmt: skip
 def pick_responses(
@@ -718,10 +722,8 @@ def pick_responses(
 @model_path_option
 @click.option("--folds", type=TRAINING("folds"), default=5, show_default=True,
               help="Grouped folds (piles held out together) of the held-out figures.")  # fmt: skip
-@click.option("--seed", type=TRAINING("random_state"), default=0, show_default=True,
-              help="Seed of the learner.")  # fmt: skip
-@click.option("--jobs", type=PICK_TABLE("n_jobs"), default=1, show_default=True,
-              help="Piles in parallel.")  # fmt: skip
+@_seed_option(TRAINING("random_state"), "the learner")
+@_jobs_option(PICK_TABLE("n_jobs"), "Piles in parallel.")
 def train_disturbance_command(states: str, out: str, model_path: str | None, folds: int, seed: int, jobs: int) -> None:
     """Fit the disturbance model (what a pick moves) on collected states; report it held out.
 
