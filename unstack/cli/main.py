@@ -128,7 +128,10 @@ class _Group(click.Group):
             _quiet_broken_pipe()
         except UnstackError as error:
             _remove_empty_new_folders(ctx)
-            _fail(_option_names(str(error)) if isinstance(error, InvalidArgument) else str(error))
+            command = self.get_command(ctx, ctx.invoked_subcommand) if ctx.invoked_subcommand else None
+            if isinstance(error, InvalidArgument) and command is not None:
+                _fail(_option_names(str(error), command))
+            _fail(str(error))
         except OSError as error:
             _remove_empty_new_folders(ctx)
             _fail(f"{getattr(error, 'filename', None) or ''}: {error.strerror or error}".lstrip(": "))
@@ -325,25 +328,21 @@ def _first_call(loaded: Any) -> Iterator[None]:
             yield
 
 
-#: The library's keyword arguments that the command line knows as options of other names.
-OPTION_NAMES = {
-    "near_tie_margin": "--near-ties",
-    "free_cost": "--free-cost",
-    "time_limit": "--time-limit",
-    "physics_veto": "--physics-veto",
-}
-
-
-def _option_names(message: str) -> str:
-    """A library argument error in the command line's words: its keyword names as option names.
+def _option_names(message: str, command: click.Command) -> str:
+    """A library argument error in the command line's words: the keyword arguments that are
+    options of ``command`` by another name (``near_tie_margin``: ``--near-ties``) named as options.
+    Only names with an underscore: a plain word (``model``, ``samples``) is left as it is.
 
     Examples
     --------
-    >>> _option_names("p.json: free_cost takes the highest box by its centre")
+    >>> from unstack.cli.main import decide
+    >>> _option_names("p.json: free_cost takes the highest box by its centre", decide)
     'p.json: --free-cost takes the highest box by its centre'
     """
-    for keyword, option in OPTION_NAMES.items():
-        message = re.sub(rf"\b{keyword}\b", option, message)
+    for parameter in command.params:
+        if isinstance(parameter, click.Option) and parameter.name and "_" in parameter.name:
+            option = max(parameter.opts, key=len)  # the long form
+            message = re.sub(rf"\b{parameter.name}\b", option, message)
     return message
 
 
