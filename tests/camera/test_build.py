@@ -71,6 +71,20 @@ def test_known_sizes_far_from_every_measured_face_are_doubted(three_cartons, sca
         assert "are the depth image's units right (--depth-units) and the sizes in metres?" in doubts[0]
 
 
+def test_a_camera_beyond_the_pile_from_the_door_is_doubted(three_cartons) -> None:
+    import dataclasses
+
+    depth, masks, pose = render_tops(three_cartons)
+    built = scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES)
+    assert built.camera is not None and not built.doubts()  # the camera on the door's side of the pile
+    pile_x = float(np.median([box.position[0] for box in built.scene.boxes]))
+    beyond = dataclasses.replace(built, camera=(pile_x + 1.0, 0.0, 1.5))
+    assert beyond.doubts() == [
+        f"the camera stands beyond the pile from the door (x {pile_x + 1.0:.2f} m, the boxes' median {pile_x:.2f} m; "
+        "x runs from the door inwards): does --door point out of the container?"
+    ]
+
+
 def test_without_known_sizes_the_top_and_the_drop_to_the_floor_give_the_size(three_cartons) -> None:
     depth, masks, pose = render_tops(three_cartons[:1])
     built = scene_from_depth(depth, INTRINSICS, pose, masks)

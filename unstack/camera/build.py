@@ -52,6 +52,10 @@ def _check_upright(frame: GravityFrame, pose: np.ndarray) -> None:
 #: the known sizes are wrong: the camera example's 23 boxes, 13 seen in part, err by a median
 #: 0.09 m; depth in centimetres read as millimetres by 0.53 m, sizes of 1.5 m by 2.4 m.
 SIZE_DOUBT_M = 0.25
+#: A camera further in than the boxes' median by more than this (metres) stands beyond the pile
+#: from the door: the door's direction was given the wrong way (a camera looking down from above
+#: the pile stands about level with it).
+DOOR_DOUBT_M = 0.3
 
 
 @dataclass(frozen=True)
@@ -70,6 +74,8 @@ class CameraScene:
         A mask left out as a duplicate -> the larger mask it lies in.
     unfitted : dict of str to str
         A mask no box was kept for -> why.
+    camera : tuple of float, optional
+        Where the camera stands in the scene's frame (x from the door inwards).
     """
 
     scene: Scene
@@ -77,18 +83,27 @@ class CameraScene:
     fitted: tuple[FittedBox, ...]
     duplicates: dict[str, str] = field(default_factory=dict)
     unfitted: dict[str, str] = field(default_factory=dict)
+    camera: tuple[float, float, float] | None = None
 
     def doubts(self) -> list[str]:
         """What the fits say of the inputs, as warnings: measured faces far from every known
-        size (depth in other units than declared, or sizes not in metres)."""
+        size (depth in other units than declared, or sizes not in metres), a camera beyond the
+        pile from the door (``door`` the wrong way)."""
+        doubts = []
         errors = [item.size_error_m for item in self.fitted]
-        if not errors or float(np.median(errors)) <= SIZE_DOUBT_M:
-            return []
-        return [
-            f"the measured faces differ from the nearest known size by {float(np.median(errors)):.2f} m "
-            f"(median over {len(errors)} boxes, two edges summed): are the depth image's units right "
-            "(--depth-units) and the sizes in metres?"
-        ]
+        if errors and float(np.median(errors)) > SIZE_DOUBT_M:
+            doubts.append(
+                f"the measured faces differ from the nearest known size by {float(np.median(errors)):.2f} m "
+                f"(median over {len(errors)} boxes, two edges summed): are the depth image's units right "
+                "(--depth-units) and the sizes in metres?"
+            )
+        pile_x = float(np.median([box.position[0] for box in self.scene.boxes]))
+        if self.camera is not None and self.camera[0] > pile_x + DOOR_DOUBT_M:
+            doubts.append(
+                f"the camera stands beyond the pile from the door (x {self.camera[0]:.2f} m, the boxes' median "
+                f"{pile_x:.2f} m; x runs from the door inwards): does --door point out of the container?"
+            )
+        return doubts
 
     def report(self) -> dict[str, Any]:
         """JSON-ready: gravity (tilt, planes, floor), every fitted box with its residual, duplicates."""
@@ -206,4 +221,6 @@ def scene_from_depth(
         }
     }
     scene = Scene(boxes, frame.apply(cloud), [box.id for box in boxes], metadata=metadata, source="<camera>")
-    return CameraScene(scene, frame, tuple(fitted), {names[k]: names[j] for k, j in duplicates.items()}, unfitted)
+    camera_x, camera_y, camera_z = (float(value) for value in frame.apply(pose[None, :3, 3])[0])
+    duplicated = {names[k]: names[j] for k, j in duplicates.items()}
+    return CameraScene(scene, frame, tuple(fitted), duplicated, unfitted, (camera_x, camera_y, camera_z))
