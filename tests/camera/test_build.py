@@ -71,6 +71,13 @@ def test_known_sizes_far_from_every_measured_face_are_doubted(three_cartons, sca
         assert "are the depth image's units right (--depth-units) and the sizes in metres?" in doubts[0]
 
 
+def test_fitted_boxes_larger_than_cartons_are_doubted(three_cartons) -> None:
+    depth, masks, pose = render_tops(three_cartons)
+    assert not scene_from_depth(depth, INTRINSICS, pose, masks).doubts()
+    far = scene_from_depth(depth * 3.0, INTRINSICS, pose, masks)  # a depth scale three times too large
+    assert any(doubt.startswith("the fitted boxes are larger than cartons") for doubt in far.doubts())
+
+
 def test_a_camera_beyond_the_pile_from_the_door_is_doubted(three_cartons) -> None:
     import dataclasses
 

@@ -52,6 +52,10 @@ def _check_upright(frame: GravityFrame, pose: np.ndarray) -> None:
 #: the known sizes are wrong: the camera example's 23 boxes, 13 seen in part, err by a median
 #: 0.09 m; depth in centimetres read as millimetres by 0.53 m, sizes of 1.5 m by 2.4 m.
 SIZE_DOUBT_M = 0.25
+#: Fitted boxes whose longest edges' median is above this (metres) are no cartons: the depth is
+#: in a finer unit than declared (the camera example's 23 boxes: 0.40 m; read at 4 times the
+#: depth, 1.29 m).
+LARGE_FIT_M = 1.0
 #: A camera further in than the boxes' median by more than this (metres) stands beyond the pile
 #: from the door: the door's direction was given the wrong way (a camera looking down from above
 #: the pile stands about level with it).
@@ -87,8 +91,8 @@ class CameraScene:
 
     def doubts(self) -> list[str]:
         """What the fits say of the inputs, as warnings: measured faces far from every known
-        size (depth in other units than declared, or sizes not in metres), a camera beyond the
-        pile from the door (``door`` the wrong way)."""
+        size (depth in other units than declared, or sizes not in metres), boxes larger than
+        cartons, a camera beyond the pile from the door (``door`` the wrong way)."""
         doubts = []
         errors = [item.size_error_m for item in self.fitted]
         if errors and float(np.median(errors)) > SIZE_DOUBT_M:
@@ -96,6 +100,12 @@ class CameraScene:
                 f"the measured faces differ from the nearest known size by {float(np.median(errors)):.2f} m "
                 f"(median over {len(errors)} boxes, two edges summed): are the depth image's units right "
                 "(--depth-units) and the sizes in metres?"
+            )
+        longest = float(np.median([box.size.max() for box in self.scene.boxes]))
+        if longest > LARGE_FIT_M:
+            doubts.append(
+                f"the fitted boxes are larger than cartons (their longest edges' median is {longest:.2f} m): are the "
+                "depth image's units right (--depth-units)?"
             )
         pile_x = float(np.median([box.position[0] for box in self.scene.boxes]))
         if self.camera is not None and self.camera[0] > pile_x + DOOR_DOUBT_M:
