@@ -54,7 +54,9 @@ def write(tmp_path: Path, document: Any, name: str = "input.json") -> Path:
 
 BAD_SUPPORTS = [
     pytest.param("{not json", r"\$: invalid JSON at line 1 column 2", id="malformed"),
-    pytest.param("[1, 2]", r"\$: expected a JSON object, got list", id="not-object"),
+    pytest.param("[1, 2]", r"\$: expected a JSON object, got a list", id="not-object"),
+    pytest.param("null", r"\$: expected a JSON object, got null", id="null"),
+    pytest.param("  \n", r"\$: expected a JSON document, got an empty text", id="empty-text"),
     pytest.param(
         supports_document(format="unstack.supports/2"),
         r"\$\.format: unsupported version 'unstack.supports/2'",

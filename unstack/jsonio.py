@@ -37,6 +37,7 @@ __all__ = [
     "finite_json",
     "format_json_path",
     "load_schema",
+    "parse_json",
     "read_document",
     "refuse_special_file",
     "report_text",
@@ -148,6 +149,46 @@ def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
             raise _DuplicateKey(key)
         data[key] = value
     return data
+
+
+def parse_json(text: str, source: str) -> Any:
+    """The JSON value in ``text``, read strictly: a key given twice in one object, invalid JSON
+    (NaN, Infinity, an empty text), nesting too deep for Python or an integer of more digits than
+    Python converts are one-line :class:`InvalidFile` errors naming ``source``.
+
+    Examples
+    --------
+    >>> parse_json('[{"id": "a"}]', "d.json")
+    [{'id': 'a'}]
+    >>> parse_json('{"id": "a", "id": "b"}', "d.json")
+    Traceback (most recent call last):
+    ...
+    unstack.errors.InvalidFile: d.json: $: the key 'id' appears twice in one JSON object
+    """
+    if not text.strip():
+        raise InvalidFile(source, "$", "expected a JSON document, got an empty text")
+    try:
+        return json.loads(text, object_pairs_hook=_unique_keys)
+    except _DuplicateKey as error:
+        raise InvalidFile(source, "$", f"the key {error.key!r} appears twice in one JSON object") from None
+    except json.JSONDecodeError as error:
+        raise InvalidFile(
+            source, "$", f"invalid JSON at line {error.lineno} column {error.colno}: {error.msg}"
+        ) from None
+    except RecursionError:
+        raise InvalidFile(source, "$", f"expected JSON nested at most {MAX_DEPTH} levels deep") from None
+    except ValueError as error:  # an integer of more digits than Python converts
+        raise InvalidFile(source, "$", f"invalid JSON: {error}") from None
+
+
+def _json_kind(value: Any) -> str:
+    """What a JSON value is, in JSON's words (``null``, a list, ...)."""
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    kinds = {list: "a list", str: "a string", int: "a number", float: "a number"}
+    return kinds.get(type(value), type(value).__name__)
 
 
 def _mib(size: int) -> str:
@@ -300,20 +341,9 @@ def read_document(path: str | os.PathLike[str]) -> Document:
         except OSError as error:
             raise InvalidFile(source, "$", f"cannot read the file: {error}") from None
         base_dir = file.resolve().parent
-    try:
-        data = json.loads(text, object_pairs_hook=_unique_keys)
-    except _DuplicateKey as error:
-        raise InvalidFile(source, "$", f"the key {error.key!r} appears twice in one JSON object") from None
-    except json.JSONDecodeError as error:
-        raise InvalidFile(
-            source, "$", f"invalid JSON at line {error.lineno} column {error.colno}: {error.msg}"
-        ) from None
-    except RecursionError:
-        raise InvalidFile(source, "$", f"expected JSON nested at most {MAX_DEPTH} levels deep") from None
-    except ValueError as error:  # an integer of more digits than Python converts
-        raise InvalidFile(source, "$", f"invalid JSON: {error}") from None
+    data = parse_json(text, source)
     if not isinstance(data, dict):
-        raise InvalidFile(source, "$", f"expected a JSON object, got {type(data).__name__}: not an unstack document")
+        raise InvalidFile(source, "$", f"expected a JSON object, got {_json_kind(data)}: not an unstack document")
     deep = _too_deep(data, MAX_DEPTH)
     if deep is not None:
         where = format_json_path(deep[:8]) + "..."

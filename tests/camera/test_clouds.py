@@ -131,3 +131,44 @@ def test_points_without_a_reading_are_left_out_with_a_warning_in_every_format(tm
     with pytest.warns(UserWarning, match=r"2 of 10 points without a finite reading \(NaN\) left out"):
         read = load_cloud(path)
     assert read.shape == (8, 3) and np.allclose(read, cloud[np.isfinite(cloud).all(axis=1)])
+
+
+def test_a_binary_pcd_with_pcls_padding_fields_and_counts_is_read(tmp_path: Path) -> None:
+    points = np.random.default_rng(5).uniform(-1, 1, (20, 3))
+    header = (  # PCL's PointNormal: padding fields all named "_", and a field of two components
+        "VERSION 0.7\nFIELDS x y z _ normal_x _ curvature\nSIZE 4 4 4 1 4 1 4\nTYPE F F F U F U F\n"
+        f"COUNT 1 1 1 4 3 4 2\nWIDTH {len(points)}\nHEIGHT 1\nPOINTS {len(points)}\nDATA binary\n"
+    )
+    record = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("p", "u1", (4,)), ("n", "<f4", (3,)),
+                       ("q", "u1", (4,)), ("c", "<f4", (2,))])  # fmt: skip
+    rows = np.zeros(len(points), dtype=record)
+    rows["x"], rows["y"], rows["z"] = points.T
+    (tmp_path / "normals.pcd").write_bytes(header.encode() + rows.tobytes())
+    assert load_cloud(tmp_path / "normals.pcd") == pytest.approx(points.astype("<f4").astype(np.float64), abs=1e-6)
+
+
+@pytest.mark.parametrize(
+    "scale, hint",
+    [(1000.0, r"a cloud in millimetres\? unstack works in metres"),
+     (1e30, r"no coordinates in metres: the wrong byte order, or fields other than x, y and z\?")],  # bytes swapped
+)  # fmt: skip
+def test_a_cloud_not_in_metres_is_refused_saying_what_its_values_look_like(
+    tmp_path: Path, scale: float, hint: str
+) -> None:
+    np.save(tmp_path / "cloud.npy", np.random.default_rng(6).uniform(0.5, 2.0, (200, 3)) * scale)
+    with pytest.raises(
+        InvalidFile, match=rf"cloud.npy: \$: [\d,]+ of [\d,]+ points lie beyond 100 m of the origin .*{hint}"
+    ):
+        load_cloud(tmp_path / "cloud.npy")
+
+
+def test_a_cloud_file_of_another_kind_names_the_three_read(tmp_path: Path) -> None:
+    (tmp_path / "cloud.xyz").write_text("0 0 0\n")
+    with pytest.raises(InvalidFile, match=r"cloud.xyz: \$: expected a .npy, .ply or .pcd point cloud file, got"):
+        load_cloud(tmp_path / "cloud.xyz")
+
+
+def test_detections_with_a_key_twice_in_one_object_are_refused(tmp_path: Path) -> None:
+    (tmp_path / "boxes.json").write_text('[{"id": "a", "id": "b", "center": [1, 0, 0.2], "size": [0.4, 0.4, 0.4]}]')
+    with pytest.raises(InvalidFile, match=r"boxes.json: \$: the key 'id' appears twice in one JSON object"):
+        load_detections(tmp_path / "boxes.json")

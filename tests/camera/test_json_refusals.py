@@ -28,12 +28,12 @@ def intrinsics(**change: Any) -> dict[str, Any]:
         (
             "detections",
             [{"id": "a", "center": [0, 0], "size": [1, 1, 1]}],
-            r"\$\[0\]\.center: expected 3 finite numbers",
+            r"\$\[0\]\.center: expected 3 numbers, got shape \(2,\)",
         ),
         (
             "detections",
             [{"id": "a", "center": [0, 0, 0], "size": [1, -1, 1]}],
-            r"\$\[0\]\.size: expected positive edges",
+            r"\$\[0\]\.size\[1\]: expected a positive number, got -1",
         ),
         (
             "detections",
@@ -41,6 +41,16 @@ def intrinsics(**change: Any) -> dict[str, Any]:
             r"\$\[0\]: expected an object with a non-empty string id",
         ),
         ("detections", {"boxes": []}, r"\$\.boxes: expected a non-empty list"),
+        (
+            "detections",
+            [{"id": "a", "center": [10**400, 0, 0], "size": [1, 1, 1]}],
+            r"\$\[0\]\.center\[0\]: expected a finite number, got an integer of about 401 digits",
+        ),
+        (
+            "detections",
+            [{"id": "a", "center": [0, 0, 0], "size": [1, 1, 1], "yaw_deg": "north"}],
+            r"\$\[0\]\.yaw_deg: expected a finite number of degrees, got 'north'",
+        ),
         (
             "detections",
             [{"id": "a", "center": [0, 0, 0], "size": [1, 1, 1], "yaw_deg": 1e308}],

@@ -21,7 +21,6 @@ Examples
 
 from __future__ import annotations
 
-import json
 import os
 import warnings
 from collections.abc import Sequence
@@ -32,15 +31,18 @@ import numpy as np
 
 from unstack.camera.build import CameraScene
 from unstack.camera.planes import gravity_frame
-from unstack.checks import check_quaternion_xyzw
+from unstack.checks import check_quaternion_xyzw, check_vector, finite_number, number_text
 from unstack.errors import InvalidFile, UnstackError
-from unstack.jsonio import refuse_special_file
+from unstack.jsonio import parse_json, refuse_special_file
 from unstack.scene import Box, Scene
 
 __all__ = ["load_cloud", "load_detections", "scene_from_cloud"]
 
 #: The largest yaw a detection may give (degrees, either way): ten turns; beyond, a typing slip.
 MAX_YAW_DEG = 3600.0
+#: A cloud whose points reach further than this from the origin (median) holds no coordinates in
+#: metres, nor in millimetres of a container: a byte order or field mix-up.
+MILLIMETRE_CLOUD = 1e5
 #: What a detection is read from (the yaw or the quaternion, not both).
 DETECTION_KEYS = ("id", "center", "size", "yaw_deg", "orientation_xyzw")
 _PCD_TYPES = {("F", 4): "<f4", ("F", 8): "<f8", ("I", 1): "<i1", ("I", 2): "<i2", ("I", 4): "<i4",
@@ -98,16 +100,21 @@ def _load_pcd(file: Path) -> np.ndarray:
         return np.column_stack(picked)
     if data != "binary":
         raise InvalidFile(source, "$", f"PCD data {data!r} is not read; save the cloud as ascii or binary PCD")
-    try:
-        dtype = np.dtype([(name, _PCD_TYPES[(kind, size)], (count,)) if count > 1 else (name, _PCD_TYPES[(kind, size)])
-                          for name, kind, size, count in zip(fields, types, sizes, counts, strict=True)])  # fmt: skip
-    except KeyError:
-        raise InvalidFile(source, "$", "expected PCD fields of types F, I or U of 1-8 bytes") from None
+    unknown = [f"{kind}{size}" for kind, size in zip(types, sizes, strict=True) if (kind, size) not in _PCD_TYPES]
+    if unknown:
+        read = ", ".join(f"{kind}{size}" for kind, size in _PCD_TYPES)
+        raise InvalidFile(source, "$", f"expected PCD fields of TYPE and SIZE {read}, got {unknown[0]}")
+    # positional names: PCL pads with fields all called "_"; x, y and z are their first fields of that name
+    kinds = [_PCD_TYPES[(kind, size)] for kind, size in zip(types, sizes, strict=True)]
+    dtype = np.dtype([(f"f{k}", kind, (count,)) if count > 1 else (f"f{k}", kind)
+                      for k, (kind, count) in enumerate(zip(kinds, counts, strict=True))])  # fmt: skip
     held = (len(raw) - offset) // dtype.itemsize
     if held < points:
         raise InvalidFile(source, "$", f"the header gives {points} POINTS, the binary data holds {held}")
     records = np.frombuffer(raw, dtype=dtype, count=points, offset=offset)
-    return np.column_stack([records[name].astype(np.float64) for name in ("x", "y", "z")])
+    picked = [records[f"f{fields.index(name)}"] for name in ("x", "y", "z")]
+    with np.errstate(invalid="ignore", over="ignore"):  # garbage (a wrong byte order) becomes NaN, said below
+        return np.column_stack([(values[:, 0] if values.ndim == 2 else values).astype(np.float64) for values in picked])
 
 
 def load_cloud(path: str | os.PathLike[str]) -> np.ndarray:
@@ -117,9 +124,10 @@ def load_cloud(path: str | os.PathLike[str]) -> np.ndarray:
     from unstack.scene import MAX_CLOUD_FILE_BYTES, MAX_POINTS, finite_points, load_points
 
     file = Path(path)
+    if file.suffix.lower() not in (".npy", ".ply", ".pcd"):
+        raise InvalidFile(str(file), "$", f"expected a .npy, .ply or .pcd point cloud file, got {file.name!r}")
     if file.suffix.lower() != ".pcd":
-        cloud = np.asarray(load_points(file, source=str(file), json_path="$", drop_non_finite=True))
-        return cloud
+        return _in_metres(np.asarray(load_points(file, source=str(file), json_path="$", drop_non_finite=True)), file)
     refuse_special_file(file)
     if not file.is_file():
         raise InvalidFile(str(file), "$", "the point cloud file does not exist")
@@ -133,7 +141,33 @@ def load_cloud(path: str | os.PathLike[str]) -> np.ndarray:
     cloud = _load_pcd(file)
     if len(cloud) > MAX_POINTS:
         raise InvalidFile(str(file), "$", f"expected at most {MAX_POINTS:,} points, got {len(cloud):,}")
-    return check_points(finite_points(cloud, str(file)), source=str(file), path="$")
+    return _in_metres(check_points(finite_points(cloud, str(file)), source=str(file), path="$"), file)
+
+
+def _in_metres(cloud: np.ndarray, file: Path) -> np.ndarray:
+    """``cloud`` when its points lie within :data:`~unstack.checks.MAX_COORDINATE` of the
+    origin, as a scene's must; otherwise one line saying what the values look like."""
+    from unstack.checks import MAX_COORDINATE
+
+    if len(cloud) == 0:
+        return cloud
+    reach = np.abs(cloud).max(axis=1)
+    far = reach > MAX_COORDINATE
+    if not far.any():
+        return cloud
+    typical = float(np.median(reach))
+    if typical > MILLIMETRE_CLOUD:
+        hint = "no coordinates in metres: the wrong byte order, or fields other than x, y and z?"
+    elif typical > MAX_COORDINATE / 10:
+        hint = "a cloud in millimetres? unstack works in metres"
+    else:
+        hint = "points further away than any container: leave them out"
+    raise InvalidFile(
+        str(file),
+        "$",
+        f"{int(far.sum()):,} of {len(cloud):,} points lie beyond {MAX_COORDINATE:g} m of the origin (the points' "
+        f"median reach {typical:,.4g}): {hint}",
+    )
 
 
 def load_detections(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
@@ -143,11 +177,12 @@ def load_detections(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
     source = str(file)
     refuse_special_file(file)
     try:
-        data = json.loads(file.read_text(encoding="utf-8"))
+        text = file.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise InvalidFile(source, "$", "the detections file does not exist") from None
-    except (OSError, UnicodeDecodeError, ValueError) as error:
+    except (OSError, UnicodeDecodeError) as error:
         raise InvalidFile(source, "$", f"expected a JSON file: {error}") from None
+    data = parse_json(text, source)  # a key twice in one object refused, as in every document
     base = "$"
     if isinstance(data, dict):
         data, base = data.get("boxes"), "$.boxes"
@@ -172,32 +207,28 @@ def check_detections(detections: Sequence[Any], *, source: str = "<detections>",
         if item["id"] in seen:
             raise InvalidFile(source, f"{where}.id", f"box id {item['id']!r} appears twice")
         seen.add(item["id"])
-        for name, length in (("center", 3), ("size", 3)):
-            value = item.get(name)
-            if (
-                not isinstance(value, list)
-                or len(value) != length
-                or not all(
-                    isinstance(entry, int | float) and not isinstance(entry, bool) and np.isfinite(entry)
-                    for entry in value
-                )
-            ):
-                raise InvalidFile(source, f"{where}.{name}", f"expected {length} finite numbers (metres)")
-        if not all(edge > 0 for edge in item["size"]):
-            raise InvalidFile(source, f"{where}.size", "expected positive edges")
+        for name in ("center", "size"):
+            if name not in item:
+                raise InvalidFile(source, f"{where}.{name}", "expected 3 finite numbers (metres), got none")
+            check_vector(item[name], 3, positive=name == "size", source=source, path=f"{where}.{name}",
+                         error=InvalidFile)  # fmt: skip
         if "orientation_xyzw" in item and "yaw_deg" in item:
             raise InvalidFile(source, where, "expected yaw_deg or orientation_xyzw, not both")
         if "orientation_xyzw" in item:
             check_quaternion_xyzw(item["orientation_xyzw"], source=source, path=f"{where}.orientation_xyzw",
                                   error=InvalidFile)  # fmt: skip
-        elif not isinstance(item.get("yaw_deg", 0.0), int | float) or isinstance(item.get("yaw_deg"), bool):
-            raise InvalidFile(source, f"{where}.yaw_deg", "expected a number of degrees")
-        elif not abs(item.get("yaw_deg", 0.0)) <= MAX_YAW_DEG:  # NaN too
-            raise InvalidFile(
-                source,
-                f"{where}.yaw_deg",
-                f"expected a yaw within {MAX_YAW_DEG:g} degrees either way, got {item['yaw_deg']}",
-            )
+        elif "yaw_deg" in item:
+            yaw = finite_number(item["yaw_deg"])
+            if yaw is None:
+                raise InvalidFile(
+                    source,
+                    f"{where}.yaw_deg",
+                    f"expected a finite number of degrees, got {number_text(item['yaw_deg'])}",
+                )
+            if abs(yaw) > MAX_YAW_DEG:
+                raise InvalidFile(
+                    source, f"{where}.yaw_deg", f"expected a yaw within {MAX_YAW_DEG:g} degrees either way, got {yaw:g}"
+                )
         try:  # the edges and coordinates a scene's box may have, at the detection's own path
             Box(item["id"], item["size"], item["center"], source=source, path=where)
         except InvalidFile as error:
