@@ -13,6 +13,8 @@ from unstack.errors import InvalidFile
 from unstack.pictures.values import read_decision_values
 
 SUPPORTS = unstack.Supports(["a", "b", "c"], [[0, 0.8, 0.1], [0.1, 0, 0.7], [0.0, 0.1, 0]])
+#: A physics veto's record as a decision writes it (the pick tried and kept).
+VETO = {"fill": "faces", "worlds": 4, "veto_at": 1.0, "vetoed": False, "tried": [{"box": "a", "expected_moved": 0.0}]}
 
 
 def _written(tmp_path: Path, document: dict[str, Any]) -> Path:
@@ -28,6 +30,15 @@ def _written(tmp_path: Path, document: dict[str, Any]) -> Path:
         ({"expected_costs": [0.0, 1.0]}, r"\$\.expected_costs: expected 3 numbers \(one per object\), got 2"),
         ({"marginals": [[0.0] * 3] * 2}, r"\$\.marginals: expected a 3 x 3 matrix"),
         ({"ties": ["a", "z"]}, r"\$\.ties\[1\]: expected one of the objects, got 'z'"),
+        (
+            {"physics_veto": {**VETO, "skipped": ["'a' floats 0.30 m up"], "vetoed": True, "tried": []}},
+            r"\$\.physics_veto\.vetoed: expected false: the veto was not applied \(skipped\)",
+        ),
+        (
+            {"physics_veto": {**VETO, "skipped": ["'a' floats 0.30 m up"]}},
+            r"\$\.physics_veto\.tried: expected no box tried: the veto was not applied \(skipped\)",
+        ),
+        ({"physics_veto": {**VETO, "tried": []}}, r"\$\.physics_veto\.tried: expected at least the pick tried"),
     ],
 )
 def test_a_decision_at_odds_with_its_objects_is_invalid_for_validate_and_render(

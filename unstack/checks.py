@@ -398,7 +398,7 @@ def check_points(
 
 def check_decision_document(document: Document) -> None:
     """What the ``unstack.decision/1`` schema cannot say: one cost (and error) per object, a
-    square matrix of them, the choice and the ties among them.
+    square matrix of them, the choice and the ties among them, a physics veto that is one thing.
 
     Raises
     ------
@@ -430,6 +430,24 @@ def check_decision_document(document: Document) -> None:
     for index, box in enumerate(data.get("ties", [])):
         if box not in known:
             raise InvalidFile(source, f"$.ties[{index}]", f"expected one of the objects, got {box!r}")
+    veto = data.get("physics_veto")
+    if veto is not None:
+        _check_physics_veto(veto, source)
+
+
+def _check_physics_veto(veto: dict[str, Any], source: str) -> None:
+    """A veto not applied (``skipped``) vetoed nothing and tried nothing; one applied tried the pick."""
+    if "skipped" in veto:
+        if veto["vetoed"]:
+            raise InvalidFile(source, "$.physics_veto.vetoed", "expected false: the veto was not applied (skipped)")
+        if veto["tried"]:
+            raise InvalidFile(
+                source, "$.physics_veto.tried", "expected no box tried: the veto was not applied (skipped)"
+            )
+    elif not veto["tried"]:
+        raise InvalidFile(
+            source, "$.physics_veto.tried", "expected at least the pick tried (or skipped, saying why not)"
+        )
 
 
 def check_plan_document(document: Document) -> None:
