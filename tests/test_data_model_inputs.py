@@ -76,11 +76,22 @@ def test_metadata_holding_itself_is_refused_in_one_line() -> None:
         unstack.Supports(IDS, PROBABILITIES, metadata=looped)
 
 
-@pytest.mark.parametrize("path", [None, b"out.json", 3])
-def test_saving_to_something_that_is_no_file_name_is_refused(path: Any) -> None:
+@pytest.mark.parametrize(
+    "path, message",
+    [(None, r" \(a str or path-like\), got NoneType"), (b"out.json", r" \(a str or path-like\), got bytes"),
+     ("", r", got an empty one"), ("out.json/", r", got a folder's \(it ends with '/'\)")],
+)  # fmt: skip
+def test_saving_to_something_that_is_no_file_name_is_refused(tmp_path: Path, path: Any, message: str) -> None:
     supports = unstack.Supports(IDS, PROBABILITIES)
-    with pytest.raises(InvalidArgument, match=r"^expected a file name for the output \(a str or path-like\), got "):
-        supports.save(path)
+    target = f"{tmp_path}/{path}" if path == "out.json/" else path
+    with pytest.raises(InvalidArgument, match=r"expected a file name for the output" + message):
+        supports.save(target)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_metadata_keys_that_are_not_text_are_named() -> None:
+    with pytest.raises(InvalidSupports, match=r"\$\.metadata: expected string keys, got the key 1 \(int\)"):
+        unstack.Supports(IDS, PROBABILITIES, metadata={1: "x"})
 
 
 def test_a_value_put_into_the_metadata_afterwards_that_json_cannot_hold_is_not_saved(tmp_path: Path) -> None:

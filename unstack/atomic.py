@@ -112,6 +112,10 @@ def check_output_path(path: str | os.PathLike[str], *, inputs: Iterable[str | os
         raise InvalidArgument(f"expected a file name for the output (a str or path-like), got {type(path).__name__}")
     if str(path) == "-":
         raise InvalidArgument("-: expected a file name for the output (--json prints the document on standard output)")
+    if str(path) == "":
+        raise InvalidArgument("expected a file name for the output, got an empty one")
+    if str(path).endswith(("/", os.sep)):
+        raise InvalidArgument(f"{path}: expected a file name for the output, got a folder's (it ends with '/')")
     target = Path(path)
     kind = special_file(target)
     if kind is not None:  # a rename would replace a pipe or a device with a file

@@ -249,8 +249,11 @@ def check_metadata(value: Any, *, source: str = "<array>", error: type[InvalidFi
     """
     if value is None:
         return {}
-    if not isinstance(value, Mapping) or not all(isinstance(key, str) for key in value):
+    if not isinstance(value, Mapping):
         raise error(source, "$.metadata", f"expected an object (a dict with string keys), got {type(value).__name__}")
+    for key in value:
+        if not isinstance(key, str):
+            raise error(source, "$.metadata", f"expected string keys, got the key {key!r} ({type(key).__name__})")
     try:  # the quick way; the walk below only to say where the first value JSON cannot hold is
         text = json.dumps(value, allow_nan=False, default=_numpy_to_json)
     except (TypeError, ValueError, RecursionError) as failure:
