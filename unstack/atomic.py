@@ -304,6 +304,9 @@ def atomic_save_figure(figure: Any, path: str | os.PathLike[str], *, dpi: int = 
     True
     """
     suffix = Path(path).suffix.lstrip(".").lower() or "png"
+    dateless = {"svg": {"Date": None}, "pdf": {"CreationDate": None}}.get(suffix)  # no time of writing in the file
+    if dateless is not None and "metadata" not in savefig:
+        savefig["metadata"] = dateless
     with atomic_path(path) as temporary:
         figure.savefig(temporary, dpi=dpi, format=suffix, **savefig)
 

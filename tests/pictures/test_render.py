@@ -109,6 +109,13 @@ def test_png_and_svg(tmp_path: Path, wall: Scene, wall_decision: DecisionValues,
     head = target.read_bytes()[:8]
     assert head == b"\x89PNG\r\n\x1a\n" if suffix == "png" else head.startswith(b"<?xml")
     assert [path.name for path in tmp_path.iterdir()] == [target.name]
+    again = tmp_path / "again" / target.name
+    again.parent.mkdir()
+    render_scene(wall, again, values=wall_decision, arrows=True)
+    if suffix == "png":  # the same picture, byte for byte
+        assert again.read_bytes() == target.read_bytes()
+    else:  # no date of writing in it (matplotlib's clipping path ids are random in every SVG)
+        assert b"<dc:date>" not in target.read_bytes()
 
 
 def test_bad_input_is_refused_before_writing(tmp_path: Path, wall: Scene, wall_decision: DecisionValues) -> None:

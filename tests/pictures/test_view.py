@@ -64,6 +64,12 @@ def test_the_page_needs_no_network(tmp_path: Path, wall: Scene, wall_decision: D
     assert "Plotly.newPlot" in page
 
 
+def test_the_same_scene_and_seed_give_the_same_page(tmp_path: Path, wall: Scene, wall_decision: DecisionValues) -> None:
+    write_view(wall, tmp_path / "a.html", values=wall_decision)
+    write_view(wall, tmp_path / "b.html", values=wall_decision)
+    assert (tmp_path / "a.html").read_bytes() == (tmp_path / "b.html").read_bytes()
+
+
 def test_bad_input(tmp_path: Path, wall: Scene) -> None:
     with pytest.raises(InvalidArgument, match="max_points must be a non-negative count, got -1"):
         write_view(wall, tmp_path / "x.html", max_points=-1)

@@ -289,6 +289,8 @@ def write_view(scene: Scene, output: str | os.PathLike[str], **options: Any) -> 
 
     check_output_path(output)
     figure = build_view(scene, **options)
-    page = figure.to_html(include_plotlyjs=True, full_html=True, config={"displaylogo": False, "responsive": True})
+    page = figure.to_html(  # a fixed element id: the same scene and seed give the same bytes
+        include_plotlyjs=True, full_html=True, config={"displaylogo": False, "responsive": True}, div_id="unstack-view"
+    )
     atomic_write_text(output, page)
     return len(page.encode("utf-8"))
