@@ -99,6 +99,16 @@ def test_a_depth_png_that_is_another_format_inside_is_refused(tmp_path: Path) ->
         load_depth(tmp_path / "d.png")
 
 
+def test_a_mask_is_where_it_is_not_zero_negative_values_too(tmp_path: Path) -> None:
+    values = np.zeros((4, 5), dtype=np.int8)
+    values[1:3, 1:4] = -1  # int8 255
+    np.save(tmp_path / "m.npy", values)
+    assert load_mask(tmp_path / "m.npy").sum() == 6
+    np.save(tmp_path / "n.npy", np.full((4, 5), np.nan))
+    with pytest.raises(InvalidFile, match=r"the mask is empty \(every pixel is 0 or not a number\)"):
+        load_mask(tmp_path / "n.npy")
+
+
 def test_an_empty_mask_is_refused(tmp_path: Path) -> None:
     with pytest.raises(InvalidFile, match="the mask is empty"):
         load_mask(_png(tmp_path / "m.png", np.zeros((4, 5), dtype=np.uint8)))

@@ -323,7 +323,10 @@ def load_mask(path: str | os.PathLike[str], shape: tuple[int, int] | None = None
     if shape is not None and raw.shape != shape:
         raise InvalidFile(source, "$", f"expected a mask of {shape[1]} x {shape[0]} pixels like the depth image, "
                           f"got {raw.shape[1]} x {raw.shape[0]}")  # fmt: skip
-    mask = np.asarray(raw) > 0
+    values = np.asarray(raw)
+    mask: np.ndarray = np.asarray(values != 0)
+    if np.issubdtype(values.dtype, np.floating):
+        mask &= np.isfinite(values)
     if not mask.any():
-        raise InvalidFile(source, "$", "the mask is empty")
+        raise InvalidFile(source, "$", "the mask is empty (every pixel is 0 or not a number)")
     return mask
