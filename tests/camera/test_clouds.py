@@ -172,3 +172,8 @@ def test_detections_with_a_key_twice_in_one_object_are_refused(tmp_path: Path) -
     (tmp_path / "boxes.json").write_text('[{"id": "a", "id": "b", "center": [1, 0, 0.2], "size": [0.4, 0.4, 0.4]}]')
     with pytest.raises(InvalidFile, match=r"boxes.json: \$: the key 'id' appears twice in one JSON object"):
         load_detections(tmp_path / "boxes.json")
+
+
+def test_detections_are_not_read_from_standard_input() -> None:
+    with pytest.raises(InvalidFile, match=r"^-: \$: detections are read from a file, not from standard input"):
+        load_detections("-")

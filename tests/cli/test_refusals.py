@@ -38,6 +38,11 @@ REFUSALS = [
     (["decide", "examples"], "examples: $: expected a JSON file, got a directory"),
     (["decide", PILE5, "--output", "{tmp}/no/such/dir/out.json"], "no/such/dir/out.json: cannot write there"),
     (["validate", "examples/scene3.json", "missing.json"], "missing.json: $: no such file"),
+    (["validate", "-", "-"], "-: standard input can be read once; it is named twice"),
+    (
+        ["render", "-", "--decision", "-", "-o", "{tmp}/both.png"],
+        "-: standard input can be read once; it is named for two",
+    ),
     (
         ["evaluate", "general", "{tmp}", "--reliability", "{tmp}/rel.txt"],
         "--reliability: {tmp}/rel.txt: expected a .png",

@@ -175,6 +175,8 @@ def load_detections(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
     than a box's are left out (with a warning)."""
     file = Path(path)
     source = str(file)
+    if source == "-":
+        raise InvalidFile(source, "$", "detections are read from a file, not from standard input; give a file name")
     refuse_special_file(file)
     try:
         text = file.read_text(encoding="utf-8")

@@ -479,6 +479,8 @@ def validate(files: tuple[str, ...]) -> None:
     """
     import unstack
 
+    if files.count("-") > 1:
+        raise UnstackError("-: standard input can be read once; it is named twice")
     invalid = 0
     for file in files:
         try:

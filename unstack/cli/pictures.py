@@ -44,6 +44,12 @@ def _load(file: str) -> tuple[Any, Path]:
 MAX_TITLE = 200
 
 
+def _stdin_once(*names: str | None) -> None:
+    """Refuse standard input (``-``) named for two inputs: it can be read once."""
+    if [name for name in names if name == "-"][1:]:
+        raise UnstackError("-: standard input can be read once; it is named for two inputs: give one of them as a file")
+
+
 def _check_title(title: str | None) -> None:
     if title is not None and (len(title) > MAX_TITLE or "\n" in title):
         raise UnstackError(f"--title: expected one line of at most {MAX_TITLE} characters, got {len(title)}")
@@ -97,6 +103,7 @@ def render(
 
     _check_suffix(output, (".png", ".svg"))
     _check_title(title)
+    _stdin_once(file, decision_file)
     check_threshold(threshold)
     loaded, base_dir = _load(file)
     title = title or Path(file).name
@@ -174,6 +181,7 @@ def view(
 
     _check_suffix(output, (".html", ".htm"))
     _check_title(title)
+    _stdin_once(file, decision_file)
     loaded, _ = _load(file)
     if isinstance(loaded, unstack.Supports):
         raise UnstackError(f"{file}: a supports file has no geometry to show in 3D; unstack render draws its graph")
