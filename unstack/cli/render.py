@@ -226,5 +226,5 @@ def _tie_rule(margin: float, free_cost: float) -> str:
     if free_cost:
         return f"EC below {free_cost:g}, holding nothing up; the highest wins"
     if margin:
-        return f"EC within {margin:g} of the lowest; the box resting highest wins"
+        return f"EC within {margin:g} of the lowest; the box resting highest wins, on one layer the lowest EC"
     return "smallest id wins"
