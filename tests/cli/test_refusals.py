@@ -58,6 +58,7 @@ REFUSALS = [
     ([*SCENE, "--sizes", "0.01x0.01x0.01"], "--sizes: expected three edges of 0.02-5 m per size, got '0.01x0.01x0.01'"),
     ([*DETECTED, "--sizes", "0.4x0.3x0.3", "--ids", "a,b"], "--sizes and --ids apply to mask files and a depth image"),
     ([*DETECTED, "--depth-units", "mm"], "--depth-units apply to mask files and a depth image"),
+    ([*DETECTED, "--intrinsics", "{tmp}/k.json"], "--intrinsics: for a depth image, not for --cloud (a cloud takes"),
     ([*SIMULATE, "--sizes", "paper3"], "'paper3' is not one of 'paper2', 'four', 'mixed'"),
     ([*SIMULATE, "--boxes", "40-30"], "box range 40-30 is reversed"),
     ([*SIMULATE, "--boxes", "many"], "--boxes: expected COUNT or LOW-HIGH (for example 30-40), got 'many'"),

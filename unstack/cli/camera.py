@@ -164,7 +164,9 @@ def scene(
 
         if cloud_file is not None:
             if depth_file or intrinsics_file:
-                raise UnstackError("give --cloud or a depth image (--depth, --intrinsics, --pose), not both")
+                named = (("--depth", depth_file), ("--intrinsics", intrinsics_file))
+                given = " and ".join(name for name, value in named if value)
+                raise UnstackError(f"{given}: for a depth image, not for --cloud (a cloud takes --pose alone)")
             cloud = load_cloud(cloud_file)
             if pose_file is not None:
                 pose = load_pose(pose_file)
