@@ -165,6 +165,10 @@ class Box:
         return data
 
 
+#: A PLY header is read from at most this many first bytes of the file.
+MAX_PLY_HEADER = 65_536
+
+
 def load_points(
     path: str | os.PathLike[str],
     *,
@@ -207,11 +211,19 @@ def load_points(
         elif file.suffix.lower() == ".ply":
             from plyfile import PlyData
 
+            declared = _ply_vertices(file, source, json_path)  # before plyfile allocates what a header claims
             ply = PlyData.read(str(file))
             if "vertex" not in ply or not {"x", "y", "z"} <= set(ply["vertex"].data.dtype.names or ()):
                 raise InvalidScene(source, json_path, f"expected a vertex element with x, y, z in {file.name!r}")
             vertices = ply["vertex"]
+            if any(vertices.data.dtype[name].shape or vertices.data.dtype[name].kind == "O" for name in "xyz"):
+                raise InvalidScene(source, json_path, f"expected one number per vertex for x, y and z in {file.name!r}")
             array = np.column_stack([vertices["x"], vertices["y"], vertices["z"]])
+            if declared is not None and ply.text is False and len(ply.elements) == 1:
+                extra = size - declared[1] - vertices.data.dtype.itemsize * len(array)
+                if extra:
+                    raise InvalidScene(source, json_path, f"{_named(file, source)}the binary data holds {extra:,} "
+                                       f"bytes beyond the header's {declared[0]:,} vertices")  # fmt: skip
         else:
             raise InvalidScene(source, json_path, f"expected a .npy or .ply file, got {file.name!r}")
     except InvalidScene:
@@ -225,6 +237,41 @@ def load_points(
     if drop_non_finite:
         array = finite_points(array, source)
     return check_points(array, source=source, path=json_path)
+
+
+def _named(file: Path, source: str) -> str:
+    """``file``'s name for a message whose source is another file (a scene naming its cloud)."""
+    return "" if source == str(file) else f"{file.name!r}: "
+
+
+def _ply_vertices(file: Path, source: str, json_path: str) -> tuple[int, int] | None:
+    """The vertex count a PLY header declares and where its data starts, refused when the count
+    is negative or above :data:`MAX_POINTS`, and, for an ascii file of vertices alone, when the
+    data's rows are another count (``None`` without a header plyfile would read)."""
+    with file.open("rb") as stream:
+        head = stream.read(MAX_PLY_HEADER)
+    end = head.find(b"end_header")
+    if end < 0:
+        return None  # plyfile says what is wrong
+    start = head.find(b"\n", end) + 1
+    lines = head[:end].decode("ascii", errors="replace").splitlines()
+    elements = [line.split() for line in lines if line.startswith("element")]
+    counts = {parts[1]: parts[2] for parts in elements if len(parts) == 3}
+    named = _named(file, source)
+    try:
+        declared = int(counts.get("vertex", "0"))
+    except ValueError:
+        raise InvalidScene(source, json_path, f"{named}expected a vertex count, got {counts['vertex']!r}") from None
+    if not 0 <= declared <= MAX_POINTS:
+        raise InvalidScene(
+            source, json_path, f"{named}expected a vertex count from 0 to {MAX_POINTS:,}, got {declared:,}"
+        )
+    ascii_data = any(line.split()[1:2] == ["ascii"] for line in lines if line.startswith("format"))
+    if ascii_data and len(elements) == 1:
+        rows = sum(1 for line in file.read_bytes()[start:].splitlines() if line.strip())
+        if rows != declared:
+            raise InvalidScene(source, json_path, f"{named}the header gives {declared:,} vertices, the data {rows:,}")
+    return declared, start
 
 
 def finite_points(cloud: Any, source: str) -> np.ndarray:

@@ -177,3 +177,32 @@ def test_detections_with_a_key_twice_in_one_object_are_refused(tmp_path: Path) -
 def test_detections_are_not_read_from_standard_input() -> None:
     with pytest.raises(InvalidFile, match=r"^-: \$: detections are read from a file, not from standard input"):
         load_detections("-")
+
+
+def _ply(path: Path, header_count: int, rows: int, *, binary: bool, extra: bytes = b"") -> Path:
+    cloud = np.random.default_rng(7).uniform(0.0, 1.0, (rows, 3)).astype("<f4")
+    kind = "binary_little_endian" if binary else "ascii"
+    header = f"ply\nformat {kind} 1.0\nelement vertex {header_count}\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+    body = cloud.tobytes() if binary else "".join(f"{x} {y} {z}\n" for x, y, z in cloud).encode()
+    path.write_bytes(header.encode() + body + extra)
+    return path
+
+
+@pytest.mark.parametrize(
+    "header_count, rows, binary, extra, message",
+    [(10, 12, False, b"", r"the header gives 10 vertices, the data 12"),
+     (12, 12, True, b"\0" * 8, r"the binary data holds 8 bytes beyond the header's 12 vertices"),
+     (10**12, 3, False, b"", r"expected a vertex count from 0 to 5,000,000, got 1,000,000,000,000"),
+     (-5, 3, False, b"", r"expected a vertex count from 0 to 5,000,000, got -5")],
+)  # fmt: skip
+def test_a_ply_whose_header_and_data_disagree_is_refused_in_one_line(
+    tmp_path: Path, header_count: int, rows: int, binary: bool, extra: bytes, message: str
+) -> None:
+    path = _ply(tmp_path / "cloud.ply", header_count, rows, binary=binary, extra=extra)
+    with pytest.raises(InvalidFile, match=rf"cloud.ply: \$: {message}$"):
+        load_cloud(path)
+
+
+@pytest.mark.parametrize("binary", [False, True])
+def test_a_ply_whose_header_and_data_agree_is_read(tmp_path: Path, binary: bool) -> None:
+    assert load_cloud(_ply(tmp_path / "cloud.ply", 12, 12, binary=binary)).shape == (12, 3)

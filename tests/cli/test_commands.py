@@ -198,7 +198,10 @@ def test_decide_on_a_scene_gives_near_ties_to_the_box_resting_highest(tmp_path: 
     )
     table = unstack("decide", str(path), "--free-cost", "0")
     words = " ".join(table.stdout.split())  # rich wraps the headline
-    assert "Unload first: high (tied with low: EC within 0.05 of the lowest; the box resting highest wins, on one layer the lowest EC)" in words
+    assert (
+        "Unload first: high (tied with low: EC within 0.05 of the lowest; the box resting highest wins, on one layer the lowest EC)"
+        in words
+    )
 
 
 def test_decide_on_a_scene_takes_the_highest_free_box_unless_free_cost_is_0(tmp_path: Path) -> None:
