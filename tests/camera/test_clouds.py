@@ -206,3 +206,19 @@ def test_a_ply_whose_header_and_data_disagree_is_refused_in_one_line(
 @pytest.mark.parametrize("binary", [False, True])
 def test_a_ply_whose_header_and_data_agree_is_read(tmp_path: Path, binary: bool) -> None:
     assert load_cloud(_ply(tmp_path / "cloud.ply", 12, 12, binary=binary)).shape == (12, 3)
+
+
+def test_the_library_takes_numpy_detections_and_leaves_out_points_without_a_reading() -> None:
+    cloud = np.vstack([_floor_and_top(np.random.default_rng(8)), [[np.nan, 0.0, 0.0]]])
+    numpy_box = {
+        "id": "a",
+        "center": np.array([0.0, 0.0, 0.15]),
+        "size": np.array([0.4, 0.3, 0.3]),
+        "yaw_deg": np.float32(30),
+    }
+    with pytest.warns(UserWarning, match=r"<cloud>: 1 of 4,801 points without a finite reading \(NaN\) left out"):
+        built = scene_from_cloud(cloud, [numpy_box])
+    plain = scene_from_cloud(
+        cloud[:-1], [{"id": "a", "center": [0.0, 0.0, 0.15], "size": [0.4, 0.3, 0.3], "yaw_deg": 30}]
+    )
+    assert np.allclose(built.scene.box("a").position, plain.scene.box("a").position)

@@ -255,10 +255,12 @@ def scene_from_cloud(
     points: np.ndarray, detections: Sequence[dict[str, Any]], *, door: Sequence[float] | None = None, seed: int = 0
 ) -> CameraScene:
     """Build a scene from a cloud and box detections in the same frame (z roughly up)."""
+    from unstack.checks import check_points
     from unstack.geometry import rotation_matrix
+    from unstack.scene import finite_points
 
     check_detections(detections)
-    cloud = np.asarray(points, dtype=np.float64)
+    cloud = check_points(finite_points(points, "<cloud>"), source="<cloud>", path="$")  # NaN left out, with a warning
     if len(cloud) < 100:
         raise UnstackError(f"the cloud holds {len(cloud)} points; at least 100 are needed for gravity and the floor")
     frame = gravity_frame(cloud, door=None if door is None else np.asarray(door, dtype=np.float64), seed=seed)
