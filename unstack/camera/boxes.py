@@ -440,5 +440,5 @@ def boxes_from_masks(
         except InvalidFile as error:  # a box no carton is: say so of the fit, not of an array
             unfitted[box_id] = f"the fitted box's {error.json_path[2:]}: {error.message}"
         except UnstackError as error:
-            unfitted[box_id] = str(error)
+            unfitted[box_id] = str(error).removeprefix(f"{box_id}: ")  # the id is said where the reason is
     return fitted, unfitted
