@@ -66,7 +66,9 @@ def _check_suffix(output: str, suffixes: tuple[str, ...]) -> None:
 @click.command()
 @click.argument("file", type=str)
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="PNG or SVG file to write.")
-@click.option("--decision", "decision_file", default=None, help=DECISION_HELP)
+@click.option(
+    "--decision", "decision_file", type=click.Path(dir_okay=False, allow_dash=True), default=None, help=DECISION_HELP
+)
 @click.option("--colour", "--color", "colour", type=click.Choice(list(COLOURINGS)), default=None,
               help="Colour boxes by expected cost (the default for a scene with detected boxes), by the ground "
               "truth (boxes each supports; no model needed), or grey.")  # fmt: skip
@@ -153,7 +155,9 @@ def render(
 @click.command()
 @click.argument("file", type=str)
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="HTML file to write.")
-@click.option("--decision", "decision_file", default=None, help=DECISION_HELP)
+@click.option(
+    "--decision", "decision_file", type=click.Path(dir_okay=False, allow_dash=True), default=None, help=DECISION_HELP
+)
 @click.option("--plan", "with_plan", is_flag=True, help="Add a slider through the unloading order.")
 @model_option
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
