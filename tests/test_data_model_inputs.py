@@ -118,3 +118,12 @@ def test_an_empty_file_name_is_said_to_be_empty_not_a_folder() -> None:
 
     with pytest.raises(InvalidFile, match=r"^'': \$: expected a file name, got an empty one$"):
         unstack.load("")
+
+
+def test_a_box_changed_in_place_to_a_value_that_is_not_finite_is_refused_where_it_is(examples: Path) -> None:
+    scene = unstack.load(examples / "pile5.scene.json")
+    scene.boxes[13].position[:] = np.nan  # a box's arrays stay writeable: scipy's rotations refuse read-only ones
+    with pytest.raises(
+        InvalidArgument, match=r"\$\.boxes\[13\]\.position: expected finite numbers, got \[nan, nan, nan\]"
+    ):
+        unstack.decide(scene)

@@ -221,8 +221,25 @@ def support_probabilities(scene: Scene, model: ModelArgument = None, *, statics:
     from unstack.reasoner.arguments import check_flag
 
     statics = check_flag(statics, "statics")
+    _refuse_changed_poses(scene)
     loaded = _model(model)
     return scene_support_probabilities(scene, loaded, model_name=model_label(loaded), statics=statics)
+
+
+def _refuse_changed_poses(scene: Scene) -> None:
+    """A box whose arrays were changed in place after the scene was made (they stay writeable:
+    scipy's rotations refuse read-only arrays) to a value that is not finite: one line, not
+    numbers that no check of the scene's file saw."""
+    import numpy as np
+
+    for index, box in enumerate(scene.boxes):
+        for name in ("size", "position", "orientation_xyzw"):
+            values = getattr(box, name)
+            if not np.all(np.isfinite(values)):
+                raise InvalidArgument(
+                    f"{scene.source}: $.boxes[{index}].{name}: expected finite numbers, got {values.tolist()} "
+                    "(changed in place after the scene was made)"
+                )
 
 
 def _supports(scene_or_supports: Any, model: Any, statics: bool = True) -> Supports:
