@@ -222,3 +222,11 @@ def test_the_library_takes_numpy_detections_and_leaves_out_points_without_a_read
         cloud[:-1], [{"id": "a", "center": [0.0, 0.0, 0.15], "size": [0.4, 0.3, 0.3], "yaw_deg": 30}]
     )
     assert np.allclose(built.scene.box("a").position, plain.scene.box("a").position)
+
+
+@pytest.mark.parametrize("door, doubted", [(None, False), ([-1.0, 0.0, 0.0], False), ([1.0, 0.0, 0.0], True)])
+def test_a_door_given_the_wrong_way_for_a_cloud_is_doubted(door: list[float] | None, doubted: bool) -> None:
+    cloud = _floor_and_top(np.random.default_rng(9)) + np.array([1.0, 0.0, 0.0])  # the pile 1 m in from the door
+    box = {"id": "a", "center": [1.0, 0.0, 0.15], "size": [0.4, 0.3, 0.3], "yaw_deg": 0}
+    doubts = scene_from_cloud(cloud, [box], door=door).doubts()
+    assert any(doubt.startswith("the boxes stand in front of the door") for doubt in doubts) is doubted

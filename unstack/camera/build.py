@@ -80,6 +80,8 @@ class CameraScene:
         A mask no box was kept for -> why.
     camera : tuple of float, optional
         Where the camera stands in the scene's frame (x from the door inwards).
+    door_given : bool
+        The door's direction was given, not taken from the camera or the cloud's frame.
     """
 
     scene: Scene
@@ -88,6 +90,7 @@ class CameraScene:
     duplicates: dict[str, str] = field(default_factory=dict)
     unfitted: dict[str, str] = field(default_factory=dict)
     camera: tuple[float, float, float] | None = None
+    door_given: bool = False
 
     def doubts(self) -> list[str]:
         """What the fits say of the inputs, as warnings: measured faces far from every known
@@ -108,6 +111,11 @@ class CameraScene:
                 "depth image's units right (--depth-units)?"
             )
         pile_x = float(np.median([box.position[0] for box in self.scene.boxes]))
+        if self.camera is None and self.door_given and pile_x < 0:
+            doubts.append(
+                f"the boxes stand in front of the door (their median x is {pile_x:.2f} m; x runs from the door "
+                "inwards): does --door point out of the container?"
+            )
         if self.camera is not None and self.camera[0] > pile_x + DOOR_DOUBT_M:
             doubts.append(
                 f"the camera stands beyond the pile from the door (x {self.camera[0]:.2f} m, the boxes' median "

@@ -284,4 +284,4 @@ def scene_from_cloud(
     metadata = {"camera": {"tilt_deg": frame.tilt_deg, "gravity_rotation": frame.rotation.tolist(),
                            "gravity_translation": frame.translation.tolist()}}  # fmt: skip
     scene = Scene(boxes, frame.apply(cloud), [box.id for box in boxes], metadata=metadata, source="<cloud>")
-    return CameraScene(scene, frame, ())
+    return CameraScene(scene, frame, (), door_given=door is not None)
