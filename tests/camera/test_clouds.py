@@ -230,3 +230,10 @@ def test_a_door_given_the_wrong_way_for_a_cloud_is_doubted(door: list[float] | N
     box = {"id": "a", "center": [1.0, 0.0, 0.15], "size": [0.4, 0.3, 0.3], "yaw_deg": 0}
     doubts = scene_from_cloud(cloud, [box], door=door).doubts()
     assert any(doubt.startswith("the boxes stand in front of the door") for doubt in doubts) is doubted
+
+
+def test_keys_beside_the_boxes_are_passed_over_with_a_warning(tmp_path: Path) -> None:
+    boxes = [{"id": "a", "center": [1.0, 0.0, 0.2], "size": [0.4, 0.4, 0.4]}]
+    (tmp_path / "boxes.json").write_text(json.dumps({"boxes": boxes, "frame": "camera", "stamp": 1}))
+    with pytest.warns(UserWarning, match=r"keys passed over \(the boxes are read from 'boxes' alone\): frame, stamp"):
+        assert [box["id"] for box in load_detections(tmp_path / "boxes.json")] == ["a"]

@@ -187,6 +187,10 @@ def load_detections(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
     data = parse_json(text, source)  # a key twice in one object refused, as in every document
     base = "$"
     if isinstance(data, dict):
+        others = sorted(str(key) for key in data if key != "boxes")
+        if others:
+            warnings.warn(f"{source}: keys passed over (the boxes are read from 'boxes' alone): {', '.join(others)}",
+                          stacklevel=2)  # fmt: skip
         data, base = data.get("boxes"), "$.boxes"
     if not isinstance(data, list) or not data:
         raise InvalidFile(source, base, "expected a non-empty list of boxes {id, center, size, yaw_deg}")
