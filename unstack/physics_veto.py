@@ -269,6 +269,9 @@ def physics_veto(
         them (ties: the box resting highest, then the smaller id), ``ties`` the boxes expected
         to move as few, and ``choice_probability`` (with a free cost) the probability that the
         choice's true expected cost is below it; else the decision with the record added.
+        When poses of ``scene`` cannot stand as reported
+        (:func:`~unstack.understanding.plausibility.standing_doubts`), nothing is tried: the
+        record's ``skipped`` names them, the choice is the decision's and a warning says why.
 
     Raises
     ------
