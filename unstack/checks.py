@@ -30,6 +30,7 @@ __all__ = [
     "LIGHT_BOX",
     "MAX_BOX_EDGE",
     "MAX_COORDINATE",
+    "MAX_HIDDEN_LOAD",
     "MAX_ID_LENGTH",
     "MAX_MASS",
     "MIN_BOX_EDGE",
@@ -44,6 +45,7 @@ __all__ = [
     "check_quaternion_xyzw",
     "check_vector",
     "finite_number",
+    "heavy_loads",
     "light_boxes",
     "number_text",
 ]
@@ -74,6 +76,9 @@ REFUSED_OVERLAP = 0.5
 #: A box lighter than this (kg) is warned about: no carton weighs less, so the masses are
 #: likely in another unit.
 LIGHT_BOX = 0.01
+#: More undetected boxes than this on one box are warned about with the load cost: a stack on
+#: one carton in a container 2.4 m high holds some 25 of the smallest cartons.
+MAX_HIDDEN_LOAD = 50.0
 #: A box heavier than this (kg) is refused, as the schemas refuse it: a unit error.
 MAX_MASS = 10_000.0
 
@@ -125,6 +130,29 @@ def light_boxes(ids: Sequence[str], masses: Any) -> str | None:
     more = f" and {len(light) - 5} more" if len(light) > 5 else ""
     boxes, weigh = ("boxes", "weigh") if len(light) > 1 else ("box", "weighs")
     return f"{boxes} {named}{more} {weigh} less than {LIGHT_BOX:g} kg, lighter than a carton; masses in kg?"
+
+
+def heavy_loads(ids: Sequence[str], hidden_load: Any) -> str | None:
+    """A warning naming the boxes with more undetected boxes on them than
+    :data:`MAX_HIDDEN_LOAD` (``None`` when there are none); the caller puts the source before it.
+
+    Examples
+    --------
+    >>> heavy_loads(["a", "b"], [1.5, 1000.0])
+    "box 'b' carries 1,000 undetected boxes, more than a stack on one carton holds (50); a count of boxes, not kg?"
+    """
+    heavy = [
+        (box_id, float(load)) for box_id, load in zip(ids, hidden_load, strict=True) if float(load) > MAX_HIDDEN_LOAD
+    ]
+    if not heavy:
+        return None
+    named = ", ".join(f"{box_id!r} carries {load:,.4g}" for box_id, load in heavy[:5])
+    more = f" and {len(heavy) - 5} more" if len(heavy) > 5 else ""
+    boxes = "boxes" if len(heavy) > 1 else "box"
+    return (
+        f"{boxes} {named}{more} undetected boxes, more than a stack on one carton holds ({MAX_HIDDEN_LOAD:g}); "
+        "a count of boxes, not kg?"
+    )
 
 
 def _matrix(value: Any, n_objects: int, source: str, path: str, error: type[InvalidFile]) -> np.ndarray:

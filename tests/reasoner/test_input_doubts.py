@@ -104,3 +104,12 @@ def test_a_scene_of_no_list_of_boxes_is_refused_with_its_path() -> None:
 
     with pytest.raises(InvalidScene, match=r"\$\.boxes: expected a list of boxes, got NoneType"):
         unstack.Scene(None, [], ["a"])  # type: ignore[arg-type]
+
+
+def test_more_undetected_boxes_on_a_box_than_a_stack_holds_are_warned_about_with_the_load_cost(chain: Supports) -> None:
+    loaded = Supports(chain.objects, chain.probabilities, hidden_load=[1000.0, 0.0, 2.0], source="pile.json")
+    assert decide(loaded).warnings == (
+        f"pile.json: box {chain.objects[0]!r} carries 1,000 undetected boxes, more than a stack on one carton holds "
+        "(50); a count of boxes, not kg?",
+    )
+    assert decide(loaded, cost="count").warnings == ()

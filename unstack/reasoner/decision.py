@@ -636,11 +636,14 @@ def decide(
 
 def _input_doubts(supports: Supports, cost: str, near_tie_margin: float | None) -> tuple[str, ...]:
     """What is doubtful in the arguments given with ``supports``: boxes lighter than a carton
-    for the mass cost, a near-tie margin above every expected cost."""
-    from unstack.checks import light_boxes
+    for the mass cost, more undetected boxes on a box than a stack holds for the load cost, a
+    near-tie margin above every expected cost."""
+    from unstack.checks import heavy_loads, light_boxes
 
     light = light_boxes(supports.objects, supports.masses) if cost == "mass" and supports.masses is not None else None
-    doubts = (light, margin_beyond_every_cost(supports, cost, "near_tie_margin", near_tie_margin))
+    loaded = supports.hidden_load is not None and cost == "load"
+    heavy = heavy_loads(supports.objects, supports.hidden_load) if loaded else None
+    doubts = (light, heavy, margin_beyond_every_cost(supports, cost, "near_tie_margin", near_tie_margin))
     return tuple(supports.named(doubt) for doubt in doubts if doubt is not None)
 
 
