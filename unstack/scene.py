@@ -284,7 +284,8 @@ def finite_points(cloud: Any, source: str) -> np.ndarray:
     finite = np.all(np.isfinite(array), axis=1)
     if not finite.all():
         warnings.warn(
-            f"{source}: {int((~finite).sum()):,} of {len(array):,} points without a finite reading (NaN) left out",
+            f"{source}: {int((~finite).sum()):,} of {len(array):,} points without a finite reading (NaN or infinite) "
+            "left out",
             stacklevel=3,
         )
     return array[finite]

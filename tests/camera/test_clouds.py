@@ -128,7 +128,7 @@ def test_points_without_a_reading_are_left_out_with_a_warning_in_every_format(tm
         PlyData([PlyElement.describe(vertices, "vertex")]).write(str(path))
     else:
         _write_pcd(path, cloud, "ascii")
-    with pytest.warns(UserWarning, match=r"2 of 10 points without a finite reading \(NaN\) left out"):
+    with pytest.warns(UserWarning, match=r"2 of 10 points without a finite reading \(NaN or infinite\) left out"):
         read = load_cloud(path)
     assert read.shape == (8, 3) and np.allclose(read, cloud[np.isfinite(cloud).all(axis=1)])
 
@@ -216,7 +216,9 @@ def test_the_library_takes_numpy_detections_and_leaves_out_points_without_a_read
         "size": np.array([0.4, 0.3, 0.3]),
         "yaw_deg": np.float32(30),
     }
-    with pytest.warns(UserWarning, match=r"<cloud>: 1 of 4,801 points without a finite reading \(NaN\) left out"):
+    with pytest.warns(
+        UserWarning, match=r"<cloud>: 1 of 4,801 points without a finite reading \(NaN or infinite\) left out"
+    ):
         built = scene_from_cloud(cloud, [numpy_box])
     plain = scene_from_cloud(
         cloud[:-1], [{"id": "a", "center": [0.0, 0.0, 0.15], "size": [0.4, 0.3, 0.3], "yaw_deg": 30}]

@@ -119,7 +119,7 @@ def _load_pcd(file: Path) -> np.ndarray:
 
 def load_cloud(path: str | os.PathLike[str]) -> np.ndarray:
     """A point cloud as (N, 3) float64 metres from ``.npy``, ``.ply`` or ``.pcd``; points without a
-    finite reading (NaN) are left out with a warning, in every format."""
+    finite reading (NaN or infinite) are left out with a warning, in every format."""
     from unstack.checks import check_points
     from unstack.scene import MAX_CLOUD_FILE_BYTES, MAX_POINTS, finite_points, load_points
 
