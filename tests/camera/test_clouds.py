@@ -239,3 +239,25 @@ def test_keys_beside_the_boxes_are_passed_over_with_a_warning(tmp_path: Path) ->
     (tmp_path / "boxes.json").write_text(json.dumps({"boxes": boxes, "frame": "camera", "stamp": 1}))
     with pytest.warns(UserWarning, match=r"keys passed over \(the boxes are read from 'boxes' alone\): frame, stamp"):
         assert [box["id"] for box in load_detections(tmp_path / "boxes.json")] == ["a"]
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [(("WIDTH 5", "WIDTH 4"), r"the PCD header's WIDTH x HEIGHT \(4 x 1\) is not its 5 POINTS"),
+     (("POINTS 5", "POINTS 5\nPOINTS 5"), r"the PCD header gives POINTS twice")],
+)  # fmt: skip
+def test_a_pcd_header_at_odds_with_itself_is_refused(tmp_path: Path, change: tuple[str, str], message: str) -> None:
+    _write_pcd(tmp_path / "cloud.pcd", np.zeros((5, 3)), "binary")
+    raw = (tmp_path / "cloud.pcd").read_bytes().replace(change[0].encode(), change[1].encode(), 1)
+    (tmp_path / "cloud.pcd").write_bytes(raw)
+    with pytest.raises(InvalidFile, match=message):
+        load_cloud(tmp_path / "cloud.pcd")
+
+
+def test_a_pcd_viewpoint_is_not_applied_and_says_so(tmp_path: Path) -> None:
+    points = np.random.default_rng(10).uniform(-1, 1, (5, 3))
+    _write_pcd(tmp_path / "cloud.pcd", points, "ascii")
+    raw = (tmp_path / "cloud.pcd").read_bytes().replace(b"VIEWPOINT 0 0 0 1 0 0 0", b"VIEWPOINT 1 2 3 1 0 0 0")
+    (tmp_path / "cloud.pcd").write_bytes(raw)
+    with pytest.warns(UserWarning, match=r"VIEWPOINT 1 2 3 1 0 0 0 is not applied: the points are taken as they are"):
+        assert load_cloud(tmp_path / "cloud.pcd") == pytest.approx(points, abs=1e-5)

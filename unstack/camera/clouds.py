@@ -63,6 +63,8 @@ def _load_pcd(file: Path) -> np.ndarray:
         if not line or line.startswith("#"):
             continue
         key, *values = line.split()
+        if key.upper() in header:
+            raise InvalidFile(source, "$", f"the PCD header gives {key.upper()} twice")
         header[key.upper()] = values
         if key.upper() == "DATA":
             break
@@ -88,6 +90,7 @@ def _load_pcd(file: Path) -> np.ndarray:
         rows = [line for line in raw[offset:].decode("ascii", errors="replace").splitlines() if line.strip()]
         if len(rows) != points:
             raise InvalidFile(source, "$", f"the header gives {points} POINTS, the ascii data holds {len(rows)} rows")
+        _check_pcd_layout(header, points, source)
         if points == 0:
             return np.zeros((0, 3))
         try:
@@ -111,10 +114,32 @@ def _load_pcd(file: Path) -> np.ndarray:
     held = (len(raw) - offset) // dtype.itemsize
     if held < points:
         raise InvalidFile(source, "$", f"the header gives {points} POINTS, the binary data holds {held}")
+    _check_pcd_layout(header, points, source)
     records = np.frombuffer(raw, dtype=dtype, count=points, offset=offset)
     picked = [records[f"f{fields.index(name)}"] for name in ("x", "y", "z")]
     with np.errstate(invalid="ignore", over="ignore"):  # garbage (a wrong byte order) becomes NaN, said below
         return np.column_stack([(values[:, 0] if values.ndim == 2 else values).astype(np.float64) for values in picked])
+
+
+def _check_pcd_layout(header: dict[str, list[str]], points: int, source: str) -> None:
+    """WIDTH x HEIGHT must be POINTS; a VIEWPOINT other than the identity is not applied (warned)."""
+    try:
+        width, height = int(header.get("WIDTH", [str(points)])[0]), int(header.get("HEIGHT", ["1"])[0])
+    except (IndexError, ValueError):
+        raise InvalidFile(source, "$", "expected whole numbers for the PCD header's WIDTH and HEIGHT") from None
+    if width * height != points:
+        raise InvalidFile(
+            source, "$", f"the PCD header's WIDTH x HEIGHT ({width} x {height}) is not its {points} POINTS"
+        )
+    viewpoint = header.get("VIEWPOINT", ["0", "0", "0", "1", "0", "0", "0"])
+    try:
+        identity = [float(value) for value in viewpoint] == [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
+    except ValueError:
+        identity = False
+    if not identity:
+        given = " ".join(viewpoint)
+        warnings.warn(f"{source}: the PCD header's VIEWPOINT {given} is not applied: the points are taken as they "
+                      "are (--pose moves a cloud into the container's frame)", stacklevel=3)  # fmt: skip
 
 
 def load_cloud(path: str | os.PathLike[str]) -> np.ndarray:
