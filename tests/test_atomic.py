@@ -122,3 +122,12 @@ def test_the_lock_of_a_killed_writer_does_not_hold(tmp_path: Path) -> None:
     with folder_writer(tmp_path, "results"):
         pass
     assert list(tmp_path.iterdir()) == []
+
+
+def test_writing_to_a_symlink_writes_through_it_and_keeps_the_link(tmp_path: Path) -> None:
+    real = tmp_path / "real.json"
+    real.write_text("old")
+    link = tmp_path / "link.json"
+    link.symlink_to(real.name)
+    atomic_write_text(link, "new")
+    assert link.is_symlink() and real.read_text() == "new"

@@ -117,6 +117,8 @@ def check_output_path(path: str | os.PathLike[str], *, inputs: Iterable[str | os
     if str(path).endswith(("/", os.sep)):
         raise InvalidArgument(f"{path}: expected a file name for the output, got a folder's (it ends with '/')")
     target = Path(path)
+    if target.is_symlink():  # write through the link: a rename onto it would replace the link itself
+        target = Path(os.path.realpath(target))
     kind = special_file(target)
     if kind is not None:  # a rename would replace a pipe or a device with a file
         raise InvalidArgument(f"{path}: cannot write there: it is {kind}, not a regular file")
