@@ -145,3 +145,19 @@ def test_a_physics_veto_not_applied_says_so_and_keeps_the_pick() -> None:
         "physics on what the robot sees: not applied, 1 pose cannot stand as reported (see the warning); the "
         f"reasoner's pick {decision.choice} is kept" in text_of(decision)
     )
+
+
+@pytest.mark.parametrize("encoding", ["ascii", "latin-1"])
+def test_ids_an_ascii_terminal_cannot_show_are_escaped_not_a_crash(tmp_path: Path, encoding: str) -> None:
+    supports = Supports(["é1", "箱", "b"], [[0, 0.6, 0.1], [0.1, 0, 0.5], [0.2, 0.1, 0]])
+    supports.save(tmp_path / "odd.json")
+    import os
+    import subprocess
+    import sys
+
+    result = subprocess.run(
+        [sys.executable, "-m", "unstack", "decide", str(tmp_path / "odd.json")],
+        capture_output=True, timeout=300, env={**os.environ, "PYTHONIOENCODING": encoding},
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert b"\\u7bb1" in result.stdout and b"Traceback" not in result.stderr

@@ -558,6 +558,9 @@ def main() -> None:
     _WARNED.clear()  # once per run of the command, also when it is run again in one process
     if sys.stdout is None:  # started with standard output closed (>&-): every result would be lost
         _fail("standard output is closed: nothing could be printed; redirect it to a file or to /dev/null")
+    for stream in (sys.stdout, sys.stderr):  # an ascii terminal (PYTHONIOENCODING=ascii) shows 'é' as \xe9
+        if stream is not None and hasattr(stream, "reconfigure"):
+            stream.reconfigure(errors="backslashreplace")
     try:
         status = cli.main(prog_name="unstack", standalone_mode=False)
     except click.exceptions.NoArgsIsHelpError as error:  # bare "unstack": the help, as click shows it
