@@ -161,3 +161,10 @@ def test_ids_an_ascii_terminal_cannot_show_are_escaped_not_a_crash(tmp_path: Pat
     )  # fmt: skip
     assert result.returncode == 0, result.stderr
     assert b"\\u7bb1" in result.stdout and b"Traceback" not in result.stderr
+
+
+@pytest.mark.parametrize("columns", ["0", "20", "abc"])
+def test_a_terminal_too_narrow_for_the_tables_still_gets_the_pick(columns: str) -> None:
+    result = unstack_cli("decide", str(EXAMPLES / "stack5.supports.json"), env={"COLUMNS": columns})
+    assert result.returncode == 0 and result.stdout.startswith("Unload first: top_left")
+    assert "top_right" in result.stdout  # the ranking's cells hold ids, not only "…"

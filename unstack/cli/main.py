@@ -550,6 +550,11 @@ def _quiet_broken_pipe() -> None:
 INTERRUPTED = 130
 
 
+#: The narrowest terminal the tables are drawn for: a narrower COLUMNS (0 printed nothing at all,
+#: 20 only "…" in every cell) is taken as this many.
+MIN_COLUMNS = 60
+
+
 def main() -> None:
     """Console-script entry point."""
     import warnings
@@ -558,6 +563,9 @@ def main() -> None:
     _WARNED.clear()  # once per run of the command, also when it is run again in one process
     if sys.stdout is None:  # started with standard output closed (>&-): every result would be lost
         _fail("standard output is closed: nothing could be printed; redirect it to a file or to /dev/null")
+    columns = os.environ.get("COLUMNS", "")
+    if columns and not (columns.isdigit() and int(columns) >= MIN_COLUMNS):  # 0 printed nothing, 20 only "…"
+        os.environ["COLUMNS"] = str(MIN_COLUMNS)
     for stream in (sys.stdout, sys.stderr):  # an ascii terminal (PYTHONIOENCODING=ascii) shows 'é' as \xe9
         if stream is not None and hasattr(stream, "reconfigure"):
             stream.reconfigure(errors="backslashreplace")
