@@ -224,8 +224,14 @@ def _warm_up_in_processes(progress: Callable[[str, float], None] | None, jobs: i
     seconds = {}
     with ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("spawn")) as pool:
         futures = {pool.submit(_compile, name): name for name in names}
-        for future in as_completed(futures):
-            seconds[futures[future]] = future.result()
-            if progress is not None:
-                progress(futures[future], seconds[futures[future]])
+        try:
+            for future in as_completed(futures):
+                seconds[futures[future]] = future.result()
+                if progress is not None:
+                    progress(futures[future], seconds[futures[future]])
+        except KeyboardInterrupt:  # Ctrl-C, or the command line's SIGTERM: the workers end now, not after compiling
+            for process in list(getattr(pool, "_processes", {}).values()):
+                process.terminate()
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
     return {name: seconds[name] for name, _ in KERNELS}

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.conftest import PILE5, unstack
+from tests.conftest import PILE5, assert_one_line_error, unstack
 
 pytestmark = pytest.mark.slow  # runs the CLI in subprocesses
 
@@ -360,3 +360,14 @@ def test_a_run_with_standard_output_closed_fails_instead_of_losing_the_result() 
     assert result.returncode == 2 and result.stderr == (
         "unstack: error: standard output is closed: nothing could be printed; redirect it to a file or to /dev/null\n"
     )
+
+
+@pytest.mark.parametrize(
+    "variable, value, message",
+    [("NUMBA_NUM_THREADS", "0", "NUMBA_NUM_THREADS: expected a whole number of at least 1, got '0'"),
+     ("NUMBA_NUM_THREADS", "abc", "NUMBA_NUM_THREADS: expected a whole number of at least 1, got 'abc'"),
+     ("NUMBA_DISABLE_JIT", "1", "NUMBA_DISABLE_JIT is set: the reasoner's kernels need numba's compiler; unset it")],
+)  # fmt: skip
+def test_numba_settings_the_reasoner_cannot_run_with_are_one_line(variable: str, value: str, message: str) -> None:
+    result = unstack("decide", "examples/pile31.supports.json", env={variable: value})
+    assert_one_line_error(result, message)

@@ -78,7 +78,10 @@ def test_render_draws_the_learned_probabilities(tmp_path: Path) -> None:
     assert arrows.read_bytes()[:4] == b"\x89PNG" and arrows.read_bytes() != plain.read_bytes()
 
 
-def test_ctrl_c_ends_a_run_with_one_line_and_exit_code_130(tmp_path: Path) -> None:
+@pytest.mark.parametrize("ending, code", [("SIGINT", 130), ("SIGTERM", 143)])
+def test_ctrl_c_or_sigterm_ends_a_run_with_one_line_and_the_shells_exit_code(
+    tmp_path: Path, ending: str, code: int
+) -> None:
     import signal
     import subprocess
     import sys
@@ -96,7 +99,8 @@ def test_ctrl_c_ends_a_run_with_one_line_and_exit_code_130(tmp_path: Path) -> No
     deadline = time.monotonic() + 120
     while not (folder / "config-0000.json").exists() and time.monotonic() < deadline and process.poll() is None:
         time.sleep(0.05)
-    process.send_signal(signal.SIGINT)
+    process.send_signal(getattr(signal, ending))
     _, stderr = process.communicate(timeout=120)
-    assert process.returncode == 130, stderr
+    assert process.returncode == code, stderr
     assert stderr.strip().splitlines()[-1] == "unstack: aborted"
+    assert not (folder / ".unstack-writer.lock").exists()  # the run unwound: its lock is gone

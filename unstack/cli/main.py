@@ -15,7 +15,9 @@ import functools
 import importlib
 import os
 import re
+import signal
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterator
 from typing import Any
@@ -548,6 +550,26 @@ def _quiet_broken_pipe() -> None:
 
 #: The exit code of a run stopped with Ctrl-C (128 + SIGINT, as the shell reports it).
 INTERRUPTED = 130
+#: The exit code of a run ended by SIGTERM (the shell's 128 + 15).
+TERMINATED = 143
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, unwound as Ctrl-C is: worker pools shut down, temporary files removed."""
+
+
+def _terminate(signum: int, frame: Any) -> None:
+    raise _Terminated
+
+
+def _check_numba_environment() -> None:
+    """Refuse numba settings the reasoner cannot run with, before any work (numba's own words
+    are a traceback, or a warning with one inside)."""
+    threads = os.environ.get("NUMBA_NUM_THREADS")
+    if threads is not None and not (threads.strip().isdigit() and int(threads) >= 1):
+        _fail(f"NUMBA_NUM_THREADS: expected a whole number of at least 1, got {threads!r}")
+    if os.environ.get("NUMBA_DISABLE_JIT", "0").strip() not in ("", "0"):
+        _fail("NUMBA_DISABLE_JIT is set: the reasoner's kernels need numba's compiler; unset it")
 
 
 #: The narrowest terminal the tables are drawn for: a narrower COLUMNS (0 printed nothing at all,
@@ -563,6 +585,9 @@ def main() -> None:
     _WARNED.clear()  # once per run of the command, also when it is run again in one process
     if sys.stdout is None:  # started with standard output closed (>&-): every result would be lost
         _fail("standard output is closed: nothing could be printed; redirect it to a file or to /dev/null")
+    _check_numba_environment()
+    if threading.current_thread() is threading.main_thread():  # a SIGTERM unwinds as Ctrl-C does
+        signal.signal(signal.SIGTERM, _terminate)
     columns = os.environ.get("COLUMNS", "")
     if columns and not (columns.isdigit() and int(columns) >= MIN_COLUMNS):  # 0 printed nothing, 20 only "…"
         os.environ["COLUMNS"] = str(MIN_COLUMNS)
@@ -581,7 +606,16 @@ def main() -> None:
         _fail(error.format_message())
     except click.Abort as error:  # Ctrl-C (the shell's 128 + SIGINT) or the end of standard input
         click.echo("unstack: aborted", err=True)
+        if isinstance(error.__cause__, _Terminated):
+            sys.exit(TERMINATED)
         sys.exit(INTERRUPTED if isinstance(error.__cause__, KeyboardInterrupt) else 1)
+    except RuntimeError as error:  # numba's disk cache when no folder for it is writable
+        if not str(error).startswith("cannot cache function"):
+            raise
+        _fail(
+            "numba cannot cache its compiled kernels: neither the package's folder nor NUMBA_CACHE_DIR (or "
+            "~/.cache) is writable; set NUMBA_CACHE_DIR to a writable folder"
+        )
     if isinstance(status, int) and status:
         sys.exit(status)
 
