@@ -371,3 +371,22 @@ def test_a_run_with_standard_output_closed_fails_instead_of_losing_the_result() 
 def test_numba_settings_the_reasoner_cannot_run_with_are_one_line(variable: str, value: str, message: str) -> None:
     result = unstack("decide", "examples/pile31.supports.json", env={variable: value})
     assert_one_line_error(result, message)
+
+
+def test_numbas_cache_without_a_writable_folder_is_one_line(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from unstack.cli import main as cli_main
+
+    def uncached(**_: object) -> None:  # what numba raises where no cache folder is writable
+        raise RuntimeError("cannot cache function '_uniform': no locator available for file '/site/_sampler.py'")
+
+    monkeypatch.setattr(cli_main.cli, "main", uncached)
+    monkeypatch.setattr(cli_main.signal, "signal", lambda *_: None)  # the test process keeps its handlers
+    with pytest.raises(SystemExit) as ended:
+        cli_main.main()
+    assert ended.value.code == 2
+    assert capsys.readouterr().err.strip() == (
+        "unstack: error: numba cannot cache its compiled kernels: neither the package's folder nor NUMBA_CACHE_DIR "
+        "(or ~/.cache) is writable; set NUMBA_CACHE_DIR to a writable folder"
+    )
