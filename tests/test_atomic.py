@@ -131,3 +131,18 @@ def test_writing_to_a_symlink_writes_through_it_and_keeps_the_link(tmp_path: Pat
     link.symlink_to(real.name)
     atomic_write_text(link, "new")
     assert link.is_symlink() and real.read_text() == "new"
+
+
+def test_a_write_that_fails_without_a_file_name_names_the_output_and_leaves_nothing(tmp_path: Path) -> None:
+    from unstack.atomic import atomic_write
+    from unstack.errors import InvalidArgument
+
+    def full_disk(stream: object) -> None:
+        raise OSError(28, "No space left on device")  # no file name, as a write to a full disk raises
+
+    target = tmp_path / "out.json"
+    with pytest.raises(
+        InvalidArgument, match=r"out.json: cannot write there: No space left on device; nothing was written"
+    ):
+        atomic_write(target, full_disk)
+    assert list(tmp_path.iterdir()) == []

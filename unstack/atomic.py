@@ -216,6 +216,12 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
             os.fsync(stream.fileno())
         os.chmod(temporary, 0o666 & ~process_umask())
         os.replace(temporary, target)
+    except OSError as error:  # a disk that fills while writing, say: the output's name, nothing half-written
+        if error.filename is not None:
+            raise
+        from unstack.errors import InvalidArgument
+
+        raise InvalidArgument(f"{path}: cannot write there: {error.strerror or error}; nothing was written") from None
     finally:
         temporary.unlink(missing_ok=True)
 
