@@ -132,6 +132,10 @@ def check_output_path(path: str | os.PathLike[str], *, inputs: Iterable[str | os
         raise InvalidArgument(f"{path}: cannot write there: the folder {folder} does not exist")
     if not folder.is_dir():
         raise InvalidArgument(f"{path}: cannot write there: {folder} is not a folder")
+    if not os.access(folder, os.X_OK):
+        raise InvalidArgument(
+            f"{path}: cannot write there: the folder {folder} cannot be entered (no execute permission)"
+        )
     if not os.access(folder, os.W_OK):
         raise InvalidArgument(f"{path}: cannot write there: the folder {folder} is not writable")
     return target
