@@ -23,6 +23,7 @@ Examples
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -38,7 +39,7 @@ from unstack.geometry import (
 )
 
 if TYPE_CHECKING:
-    from unstack.scene import Scene
+    from unstack.scene import Box, Scene
 
 __all__ = [
     "BELOW_FLOOR",
@@ -132,25 +133,23 @@ def scene_warnings(scene: Scene) -> list[str]:
         Each names the scene's source and the boxes concerned.
     """
     source = scene.source
+    poses = _unstandable(scene)
     warnings = [
         f"{source}: boxes {scene.boxes[i].id!r} and {scene.boxes[j].id!r} overlap by {100 * share:.0f} % of the "
         "smaller one's volume; check their poses"
-        for i, j, share in overlapping_pairs(scene.boxes, WARNED_OVERLAP)
+        for i, j, share in poses.overlaps
     ]
-    bounds = bounding_boxes(scene.boxes)
-    for box, (low, high) in zip(scene.boxes, bounds[:, [2, 5]], strict=True):
-        if low < -BELOW_FLOOR:
-            where = "lies wholly below" if high < 0 else f"reaches {-low:.2f} m into"
-            warnings.append(f"{source}: box {box.id!r} {where} the floor (z = 0); check its pose and the frame")
-    index = {box.id: k for k, box in enumerate(scene.boxes)}
+    for box, low, high in poses.sunk:
+        where = "lies wholly below" if high < 0 else f"reaches {-low:.2f} m into"
+        warnings.append(f"{source}: box {box.id!r} {where} the floor (z = 0); check its pose and the frame")
     for box_id in scene.detected:
-        size = scene.boxes[index[box_id]].size
+        size = scene.box(box_id).size
         if size.max() < SMALL_BOX:
             warnings.append(
                 f"{source}: box {box_id!r} is {' x '.join(f'{100 * edge:.1f}' for edge in size)} cm, smaller than a "
                 "carton; are its size and the cloud in metres?"
             )
-        height = _floating(scene, bounds, index[box_id])
+        height = poses.floating.get(box_id)
         if height is not None:
             warnings.append(
                 f"{source}: box {box_id!r} floats: its bottom is {height:.2f} m above the floor with no box or "
@@ -163,7 +162,7 @@ def scene_warnings(scene: Scene) -> list[str]:
     if len(scene.points) == 0:
         warnings.append(f"{source}: the point cloud is empty; undetected load and cloud features cannot be seen")
     else:
-        low, high = bounds[:, :3].min(axis=0) - FAR_CLOUD, bounds[:, 3:].max(axis=0) + FAR_CLOUD
+        low, high = poses.bounds[:, :3].min(axis=0) - FAR_CLOUD, poses.bounds[:, 3:].max(axis=0) + FAR_CLOUD
         near = _share_within(scene.points, low, high, NEAR_CLOUD_SHARE)
         if near < NEAR_CLOUD_SHARE:
             warnings.append(
@@ -186,19 +185,42 @@ def standing_doubts(scene: Scene) -> list[str]:
     >>> standing_doubts(Scene([lifted], np.zeros((0, 3)), ["lifted"]))
     ["'lifted' floats 0.40 m up"]
     """
-    doubts = [
-        f"{scene.boxes[i].id!r} and {scene.boxes[j].id!r} overlap ({100 * share:.0f} %)"
-        for i, j, share in overlapping_pairs(scene.boxes, WARNED_OVERLAP)
+    poses = _unstandable(scene)
+    return [
+        *(
+            f"{scene.boxes[i].id!r} and {scene.boxes[j].id!r} overlap ({100 * share:.0f} %)"
+            for i, j, share in poses.overlaps
+        ),
+        *(f"{box.id!r} reaches {-low:.2f} m into the floor" for box, low, _ in poses.sunk),
+        *(f"{box_id!r} floats {height:.2f} m up" for box_id, height in poses.floating.items()),
     ]
+
+
+@dataclass(frozen=True)
+class _Unstandable:
+    """A scene's poses that cannot stand as reported: overlapping pairs ``(i, j, share)``, boxes
+    reaching into the floor ``(box, low, high)`` and floating detected boxes (id: height), with
+    the boxes' axis-aligned bounds they were found from."""
+
+    bounds: np.ndarray
+    overlaps: list[tuple[int, int, float]]
+    sunk: list[tuple[Box, float, float]]
+    floating: dict[str, float]
+
+
+def _unstandable(scene: Scene) -> _Unstandable:
+    """What :func:`scene_warnings` and :func:`standing_doubts` say of a scene's poses, found once."""
     bounds = bounding_boxes(scene.boxes)
-    doubts += [
-        f"{box.id!r} reaches {-low:.2f} m into the floor"
-        for box, low in zip(scene.boxes, bounds[:, 2], strict=True)
+    sunk = [
+        (box, float(low), float(high))
+        for box, (low, high) in zip(scene.boxes, bounds[:, [2, 5]], strict=True)
         if low < -BELOW_FLOOR
     ]
     index = {box.id: k for k, box in enumerate(scene.boxes)}
-    for box_id in scene.detected:
-        height = _floating(scene, bounds, index[box_id])
-        if height is not None:
-            doubts.append(f"{box_id!r} floats {height:.2f} m up")
-    return doubts
+    heights = {box_id: _floating(scene, bounds, index[box_id]) for box_id in scene.detected}
+    return _Unstandable(
+        bounds,
+        overlapping_pairs(scene.boxes, WARNED_OVERLAP),
+        sunk,
+        {box_id: height for box_id, height in heights.items() if height is not None},
+    )
