@@ -18,12 +18,11 @@ Usage::
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
 import numpy as np
-from script_arguments import pile_probabilities
+from script_arguments import data_sets_parser, pile_probabilities
 
 from unstack.reasoner.sampling import sample_worlds
 
@@ -44,12 +43,11 @@ def autocorrelation_time(series: np.ndarray) -> float:
 
 
 def main(argv: list[str]) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("dataset", type=Path)
+    parser = data_sets_parser(__doc__.split("\n\n")[0], piles=None, several=False)
     parser.add_argument("--worlds", type=int, default=3000, help="sweeps per chain")
     parser.add_argument("--chains", type=int, default=2)
     args = parser.parse_args(argv)
-    for path, scene, probabilities in pile_probabilities(args.dataset):
+    for path, scene, probabilities in pile_probabilities(Path(args.data), args.piles):
         draws = [sample_worlds(probabilities, args.worlds, seed=seed) for seed in range(args.chains)]
         rows = []
         for box in range(len(probabilities)):

@@ -16,13 +16,12 @@ Usage::
 
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
-from script_arguments import pile_probabilities
+from script_arguments import data_sets_parser, pile_probabilities
 
 from unstack.reasoner.sampling import sampled_marginals
 
@@ -43,16 +42,12 @@ def spread(p: np.ndarray, runs: int, samples: int, revisits: bool) -> tuple[np.n
 
 
 def main(argv: list[str]) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("dataset", type=Path)
-    parser.add_argument("--piles", type=int, default=3)
+    parser = data_sets_parser(__doc__.split("\n\n")[0], piles=3, several=False)
     parser.add_argument("--runs", type=int, default=16)
     parser.add_argument("--samples", type=int, default=50_000)
     args = parser.parse_args(argv)
-    print(
-        f"python benchmarks/revisits.py {args.dataset} --piles {args.piles} --runs {args.runs} --samples {args.samples}"
-    )
-    for path, _, p in pile_probabilities(args.dataset, args.piles):
+    print(f"python benchmarks/revisits.py {args.data} --piles {args.piles} --runs {args.runs} --samples {args.samples}")
+    for path, _, p in pile_probabilities(Path(args.data), args.piles):
         for revisits in (False, True):
             real, reported, seconds = spread(p, args.runs, args.samples, revisits)
             top = np.argsort(-real)[:6]

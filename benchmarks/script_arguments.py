@@ -14,14 +14,16 @@ if TYPE_CHECKING:
     from unstack.scene import Scene
 
 
-def data_sets_parser(description: str, *, piles: int, several: bool = True) -> argparse.ArgumentParser:
-    """A parser of one data set folder (``several``: one or more) and ``--piles``."""
+def data_sets_parser(description: str, *, piles: int | None, several: bool = True) -> argparse.ArgumentParser:
+    """A parser of one data set folder (``several``: one or more) and ``--piles`` (``None``: all)."""
     parser = argparse.ArgumentParser(description=description)
     if several:
         parser.add_argument("data", nargs="+", help="data set folders of unstack simulate")
     else:
         parser.add_argument("data", help="a data set folder of unstack simulate")
-    parser.add_argument("--piles", type=int, default=piles, help="the first N piles of each data set")
+    parser.add_argument(
+        "--piles", type=int, default=piles, help="the first N piles of each data set (default: %(default)s)"
+    )
     return parser
 
 
