@@ -390,3 +390,16 @@ def test_numbas_cache_without_a_writable_folder_is_one_line(
         "unstack: error: numba cannot cache its compiled kernels: neither the package's folder nor NUMBA_CACHE_DIR "
         "(or ~/.cache) is writable; set NUMBA_CACHE_DIR to a writable folder"
     )
+
+
+def test_matplotlib_without_a_writable_folder_is_one_warning_line(tmp_path: Path) -> None:
+    not_a_folder = tmp_path / "mplconfig"
+    not_a_folder.write_text("")
+    result = unstack(
+        "render", "examples/pile5.scene.json", "-o", str(tmp_path / "p.png"), env={"MPLCONFIGDIR": str(not_a_folder)}
+    )
+    assert result.returncode == 0, result.stderr
+    assert result.stderr.count("\n") == 1 and result.stderr.startswith(
+        f"unstack: warning: matplotlib: MPLCONFIGDIR ({not_a_folder}) is not a writable folder; its cache is kept in "
+    ), result.stderr
+    assert result.stderr.endswith("for this run only (set MPLCONFIGDIR to a writable folder)\n")

@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import importlib
+import logging
 import os
 import re
 import signal
@@ -540,6 +541,29 @@ def _warning_line(message: Warning | str, category: type[Warning], *_: object, *
     _warn(str(message))
 
 
+#: matplotlib's words when it cannot write its folder: the folder it took instead, and why.
+_TEMPORARY_FOLDER = re.compile(
+    r"created a temporary \S* ?directory at (?P<folder>\S+) because there was an issue with (?P<issue>.+?);"
+)
+
+
+class _LibraryLogLines(logging.Handler):
+    """The warnings a library logs (matplotlib, when no folder of its own is writable) as one
+    ``unstack: warning:`` line each, instead of the logging module's bare lines on stderr."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        message = record.getMessage()
+        if message.startswith("mkdir -p failed") or message.endswith("is not a writable directory"):
+            return  # said again by the next record, with the folder taken instead
+        found = _TEMPORARY_FOLDER.search(message)
+        if found:
+            message = (
+                f"{found['issue']} is not a writable folder; its cache is kept in {found['folder']} for this run "
+                "only (set MPLCONFIGDIR to a writable folder)"
+            )
+        _warn(f"{record.name.split('.')[0]}: {message}")
+
+
 def _quiet_broken_pipe() -> None:
     """Leave quietly with exit code 1 when the reader of standard output has gone (Python's recipe:
     standard output is pointed at the null device, so the flush at exit raises nothing)."""
@@ -582,6 +606,10 @@ def main() -> None:
     import warnings
 
     warnings.showwarning = _warning_line
+    library_log = logging.getLogger("matplotlib")
+    if not any(isinstance(handler, _LibraryLogLines) for handler in library_log.handlers):
+        library_log.addHandler(_LibraryLogLines(logging.WARNING))
+        library_log.propagate = False
     _WARNED.clear()  # once per run of the command, also when it is run again in one process
     if sys.stdout is None:  # started with standard output closed (>&-): every result would be lost
         _fail("standard output is closed: nothing could be printed; redirect it to a file or to /dev/null")
