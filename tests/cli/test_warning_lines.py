@@ -30,3 +30,17 @@ def test_a_warning_the_scene_and_its_decision_both_carry_is_printed_once(capsys:
         f"unstack: warning: {scene_warning}",
         "unstack: warning: s.json: out of distribution (the decision's only)",
     ]
+
+
+def test_a_word_of_thousands_of_characters_is_cut_in_the_middle_with_its_length(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    path = "/tmp/" + "d" * 4000 + "/x.json"
+    _warn(f"{path}: cannot write there")
+    [line] = capsys.readouterr().err.splitlines()
+    assert (
+        len(line) < 300
+        and line.startswith("unstack: warning: /tmp/ddd")
+        and line.endswith("d/x.json: cannot write there")
+    )
+    assert f"…({len(path) + 1:,} characters)…" in line

@@ -26,7 +26,7 @@ from typing import Any
 import click
 
 from unstack.cli.options import Checked
-from unstack.cli.text import printable
+from unstack.cli.text import printable, shortened
 from unstack.errors import InvalidArgument, UnstackError
 from unstack.reasoner.arguments import check_budget, check_margin, check_samples, check_seed
 from unstack.reasoner.costs import PAYOFF_COSTS
@@ -99,7 +99,7 @@ _WARNED: set[str] = set()
 
 
 def _fail(message: str) -> None:
-    click.echo(f"unstack: error: {printable(message)}", err=True)
+    click.echo(f"unstack: error: {printable(shortened(message))}", err=True)
     sys.exit(2)
 
 
@@ -108,7 +108,7 @@ def _warn(message: str) -> None:
     that repeats it) is not said again."""
     if message not in _WARNED:
         _WARNED.add(message)
-        click.echo(f"unstack: warning: {printable(message)}", err=True)
+        click.echo(f"unstack: warning: {printable(shortened(message))}", err=True)
 
 
 class _Group(click.Group):

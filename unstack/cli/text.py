@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from rich.table import Table
 
-__all__ = ["counted", "number_table", "printable"]
+__all__ = ["counted", "number_table", "printable", "shortened"]
 
 
 def printable(text: str) -> str:
@@ -22,6 +23,28 @@ def printable(text: str) -> str:
     if text.isprintable():
         return text
     return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text)
+
+
+#: The longest word (a path, a value) an error or warning line shows whole.
+LONGEST_WORD = 240
+
+
+def shortened(text: str, longest: int = LONGEST_WORD) -> str:
+    """``text`` with every word (a run without spaces) longer than ``longest`` characters cut in
+    the middle, its length said: an output path of 4,000 characters is not echoed whole.
+
+    Examples
+    --------
+    >>> shortened("/tmp/" + "d" * 300 + "/x.json: cannot write there", longest=40)
+    '/tmp/ddddddddddddddd…(313 characters)…ddddd/x.json: cannot write there'
+    """
+    head, tail = longest // 2, longest // 3
+
+    def cut(word: re.Match[str]) -> str:
+        text = word.group()
+        return f"{text[:head]}…({len(text):,} characters)…{text[-tail:]}"
+
+    return re.sub(rf"\S{{{longest + 1},}}", cut, text)
 
 
 def counted(number: int, noun: str) -> str:
