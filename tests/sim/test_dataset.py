@@ -93,6 +93,20 @@ def test_a_folder_of_another_data_set_is_refused(tmp_path: Path, change: dict[st
     assert len(list_configurations(tmp_path)) == 1
 
 
+def test_a_folder_holding_only_the_manifest_of_a_stopped_run_takes_another_data_set(
+    reference: Path, tmp_path: Path
+) -> None:
+    simulate_dataset(tmp_path, small_settings(boxes=(3, 6)), configs=1, seed=22)
+    for path in tmp_path.glob("config-*"):  # as a run stopped before its first configuration leaves it
+        path.unlink()
+    (tmp_path / "timings.jsonl").unlink()
+    summary = simulate_dataset(tmp_path, small_settings(), configs=4, seed=21)
+    manifest = read_manifest(tmp_path)
+    assert summary.made == 4 and manifest is not None and (manifest["seed"], manifest["configs"]) == (21, 4)
+    assert SimulationSettings.from_dict(manifest["settings"]) == small_settings()
+    assert digests(tmp_path) == digests(reference)
+
+
 def test_a_scheduler_that_does_not_answer_fails_fast(tmp_path: Path) -> None:
     start = time.monotonic()
     with pytest.raises(SchedulerUnavailable, match=r"dask scheduler tcp://127.0.0.1:9 does not answer within 5 s"):

@@ -118,7 +118,7 @@ def _write_manifest(folder: Path, settings: SimulationSettings, seed: int, confi
     from unstack.provenance import package_versions
     from unstack.sim.configuration import SIMULATION_PACKAGES
 
-    existing = read_manifest(folder) or {}
+    existing = (read_manifest(folder) or {}) if list_configurations(folder) else {}  # else another run's, replaced
     manifest = {
         "format": DATASET_FORMAT,
         "seed": seed,
@@ -285,7 +285,7 @@ def simulate_dataset(
         raise DatasetConflict(f"{target}: expected a folder for the data set, got a file")
     check_folder_path(target, "the data set")
     manifest = read_manifest(target) if target.is_dir() else None
-    if manifest is not None:
+    if manifest is not None and list_configurations(target):  # a manifest alone: a run stopped before its first
         _check_same_dataset(target, manifest, settings, seed)
     client = connect_scheduler(scheduler) if scheduler else None
     target.mkdir(parents=True, exist_ok=True)
@@ -309,7 +309,7 @@ def _fill_dataset(
 ) -> DatasetSummary:
     """:func:`simulate_dataset`'s work in a folder it holds: the configurations still missing."""
     manifest = read_manifest(target)
-    if manifest is not None:  # again, now that no other run writes the folder
+    if manifest is not None and list_configurations(target):  # again, now that no other run writes the folder
         _check_same_dataset(target, manifest, settings, seed)
     _clean_temporaries(target)
     _write_manifest(target, settings, seed, configs)
