@@ -138,6 +138,12 @@ def test_bad_supports_files_name_file_path_and_expectation(tmp_path: Path, docum
     assert "\n" not in str(caught.value)
 
 
+def test_a_byte_order_mark_before_the_document_is_passed_over(tmp_path: Path) -> None:
+    path = tmp_path / "bom.json"
+    path.write_bytes(b"\xef\xbb\xbf" + json.dumps(supports_document()).encode())
+    assert load_supports(path).objects == ("a", "b", "c")
+
+
 def test_unknown_version_is_its_own_error(tmp_path: Path) -> None:
     with pytest.raises(UnknownFormat):
         load_supports(write(tmp_path, supports_document(format="unstack.supports/9")))

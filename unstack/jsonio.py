@@ -151,6 +151,10 @@ def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     return data
 
 
+#: The UTF-8 byte order mark, decoded.
+BYTE_ORDER_MARK = "\ufeff"
+
+
 def parse_json(text: str, source: str) -> Any:
     """The JSON value in ``text``, read strictly: a key given twice in one object, invalid JSON
     (NaN, Infinity, an empty text), nesting too deep for Python or an integer of more digits than
@@ -164,7 +168,14 @@ def parse_json(text: str, source: str) -> Any:
     Traceback (most recent call last):
     ...
     unstack.errors.InvalidFile: d.json: $: the key 'id' appears twice in one JSON object
+
+    A byte order mark before the document (Windows editors write one) is passed over, as RFC
+    8259 allows:
+
+    >>> parse_json('\\ufeff{"id": "a"}', "d.json")
+    {'id': 'a'}
     """
+    text = text.removeprefix(BYTE_ORDER_MARK)
     if not text.strip():
         raise InvalidFile(source, "$", "expected a JSON document, got an empty text")
     try:
@@ -177,8 +188,12 @@ def parse_json(text: str, source: str) -> Any:
         ) from None
     except RecursionError:
         raise InvalidFile(source, "$", f"expected JSON nested at most {MAX_DEPTH} levels deep") from None
-    except ValueError as error:  # an integer of more digits than Python converts
-        raise InvalidFile(source, "$", f"invalid JSON: {error}") from None
+    except ValueError:  # an integer of more digits than Python converts
+        raise InvalidFile(
+            source,
+            "$",
+            f"invalid JSON: an integer of more than {sys.get_int_max_str_digits():,} digits, not a number of a scene",
+        ) from None
 
 
 def _json_kind(value: Any) -> str:

@@ -62,6 +62,12 @@ def test_a_pose_inside_an_object_is_read(tmp_path: Path) -> None:
     assert load_pose(tmp_path / "pose.json").shape == (4, 4)
 
 
+def test_camera_json_written_with_a_byte_order_mark_is_read(tmp_path: Path) -> None:
+    intrinsics = {"fx": 600, "fy": 600, "cx": 320, "cy": 240, "width": 640, "height": 480}
+    (tmp_path / "k.json").write_bytes(b"\xef\xbb\xbf" + json.dumps(intrinsics).encode())
+    assert load_intrinsics(tmp_path / "k.json").fx == 600
+
+
 def test_a_mask_of_another_size_than_the_depth_image_is_refused(tmp_path: Path) -> None:
     mask = _png(tmp_path / "m.png", np.full((3, 3), 255, dtype=np.uint8))
     with pytest.raises(InvalidFile, match="expected a mask of 5 x 4 pixels like the depth image, got 3 x 3"):

@@ -18,7 +18,6 @@ Examples
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import warnings
@@ -30,7 +29,7 @@ import numpy as np
 
 from unstack.checks import MAX_COORDINATE, finite_number, number_text
 from unstack.errors import InvalidFile
-from unstack.jsonio import refuse_special_file
+from unstack.jsonio import parse_json, refuse_special_file
 
 __all__ = ["DEPTH_UNITS", "MAX_DEPTH_M", "Intrinsics", "load_depth", "load_intrinsics", "load_mask", "load_pose"]
 
@@ -76,19 +75,12 @@ def _read_json(path: str | os.PathLike[str]) -> tuple[Any, str]:
     source = str(file)
     refuse_special_file(file)
     try:
-        return json.loads(file.read_text(encoding="utf-8")), source
+        text = file.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise InvalidFile(source, "$", "the file does not exist") from None
-    except json.JSONDecodeError as error:
-        raise InvalidFile(source, "$", f"expected a JSON file: {error}") from None
-    except ValueError as error:  # an integer of more digits than Python converts
-        if "digits" in str(error):
-            raise InvalidFile(
-                source, "$", "expected numbers a camera gives, got an integer of thousands of digits"
-            ) from None
-        raise InvalidFile(source, "$", f"expected a JSON file: {error}") from None
     except (OSError, UnicodeDecodeError) as error:
         raise InvalidFile(source, "$", f"expected a JSON file: {error}") from None
+    return parse_json(text, source), source
 
 
 def load_intrinsics(path: str | os.PathLike[str]) -> Intrinsics:
