@@ -33,6 +33,17 @@ def test_a_cloud_and_detections_make_a_scene(cloud_and_detections: list[str], tm
     assert json.loads(out.read_text())["detected"] == ["low", "high"]
 
 
+def test_two_scene_files_whose_names_differ_in_case_keep_a_cloud_each(
+    cloud_and_detections: list[str], tmp_path: Path
+) -> None:
+    for name in ("x.json", "x.JSON"):
+        run = unstack("scene", *cloud_and_detections, "--out", str(tmp_path / name))
+        assert run.returncode == 0, run.stderr
+    assert json.loads((tmp_path / "x.json").read_text())["points_file"] == "x.points.npy"
+    assert json.loads((tmp_path / "x.JSON").read_text())["points_file"] == "x.JSON.points.npy"
+    assert (tmp_path / "x.points.npy").exists() and (tmp_path / "x.JSON.points.npy").exists()
+
+
 def test_a_cloud_without_detections_is_one_line(tmp_path: Path) -> None:
     np.save(tmp_path / "cloud.npy", np.zeros((200, 3)))
     run = unstack("scene", "--cloud", str(tmp_path / "cloud.npy"), "--out", str(tmp_path / "scene.json"))

@@ -49,12 +49,24 @@ def _require_depth(depth_file: str | None, intrinsics_file: str | None, pose_fil
         raise UnstackError(f"{what} with a depth image need {', '.join(missing)} (or give --cloud and --detections)")
 
 
+def cloud_beside(target: Path) -> Path:
+    """Where the cloud of the scene file ``target`` goes, beside it: its name without ``.json``, then
+    ``.points.npy`` (``x.JSON`` keeps its suffix, so that it and ``x.json`` do not share one cloud).
+
+    Examples
+    --------
+    >>> cloud_beside(Path("out/scene.json")).as_posix(), cloud_beside(Path("scene.JSON")).as_posix()
+    ('out/scene.points.npy', 'scene.JSON.points.npy')
+    """
+    return target.with_name(f"{target.name.removesuffix('.json')}.points.npy")
+
+
 def _check_outputs(target: Path, report_file: str | None, inputs: list[str | None]) -> None:
     """Fail before any work when the scene, its cloud or the report cannot be written, when two
     of them are one file, or when one would replace an input."""
     from unstack.atomic import check_output_path
 
-    outputs = [target, target.with_name(f"{target.stem}.points.npy")]
+    outputs = [target, cloud_beside(target)]
     if report_file is not None:
         outputs.append(Path(report_file))
     for output in outputs:
@@ -213,7 +225,7 @@ def scene(
             built = scene_from_depth(
                 depth, intrinsics, pose, masks, ids=names, known_sizes=known, door=direction, seed=seed
             )
-    built.scene.save(target, points_file=f"{target.stem}.points.npy")
+    built.scene.save(target, points_file=cloud_beside(target).name)
     if report_file is not None:
         atomic_write_text(Path(report_file), report_text(built.report()))
     console = Console()
