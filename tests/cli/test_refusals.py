@@ -75,7 +75,13 @@ REFUSALS = [
     ([*SIMULATE, "--width", "0"], "'--width': expected a positive extent of at most 100 m, got 0.0"),
     ([*SIMULATE, "--boxes", "9", "--sizes", "four", "--depth", "0.6", "--width", "0.8"], "do not fit a 0.6 x 0.8"),
     ([*SIMULATE, "--scheduler", "tcp://127.0.0.1:9"], "dask scheduler tcp://127.0.0.1:9 does not answer within 5 s"),
-    ([*SIMULATE, "--scheduler", "nowhere"], "scheduler: expected an address like tcp://HOST:PORT, got 'nowhere'"),
+    ([*SIMULATE, "--scheduler", "nowhere"], "'--scheduler': expected an address like tcp://HOST:PORT, got 'nowhere'"),
+    (
+        [*SIMULATE, "--scheduler", "tls://127.0.0.1:8786"],
+        "'--scheduler': tls:// needs dask's security settings",
+    ),
+    ([*SIMULATE, "--scheduler", ""], "'--scheduler': expected an address like tcp://HOST:PORT, got ''"),
+    ([*SIMULATE, "--jobs", "2", "--scheduler", "tcp://127.0.0.1:9"], "jobs: 2 local processes and a scheduler exclude"),
 ]
 
 

@@ -145,14 +145,16 @@ def test_unstack_never_takes_a_box_under_load() -> None:
 
 @pytest.mark.slow  # physics runs of every decision maker
 def test_containers_run_on_a_dask_cluster_with_the_same_results(small_dataset: Path) -> None:
-    from distributed import Client, LocalCluster
+    from distributed import LocalCluster
+
+    from unstack.sim.dataset import scheduler_client
 
     model = load_model(default_model_path())
     options = {"piles": 1, "makers": ("unstack", "highest"), "max_picks": 2, "samples": 64}
     local = container_experiment(small_dataset, model, **options)  # type: ignore[arg-type]
     with (
         LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster,
-        Client(cluster) as client,
+        scheduler_client(cluster.scheduler_address) as client,  # the command line's client: not the default one
     ):
         remote = container_experiment(small_dataset, model, client=client, **options)  # type: ignore[arg-type]
     assert remote["runs"] == local["runs"]

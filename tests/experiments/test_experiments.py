@@ -249,14 +249,15 @@ def test_unloading_resumes_from_its_checkpoints(
 
 @pytest.mark.slow  # runs experiments on a simulated data set
 def test_unloading_runs_on_a_dask_cluster(small_dataset: Path) -> None:
-    from distributed import Client, LocalCluster
+    from distributed import LocalCluster
 
     from unstack.experiments.unloading import unloading_experiment
+    from unstack.sim.dataset import scheduler_client
 
     model = load_model(default_model_path())
     with (
         LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster,
-        Client(cluster) as client,
+        scheduler_client(cluster.scheduler_address) as client,  # the command line's client: not the default one
     ):
         result = unloading_experiment(small_dataset, model, configs=2, samples=64, client=client)
     assert [pile["scene"] for pile in result["piles"]] == ["config-0000.json", "config-0001.json"]

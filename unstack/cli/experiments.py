@@ -13,7 +13,7 @@ from rich.table import Table
 
 from unstack.cli.learning import FEATURES_HELP, ISETS_FROM_HELP
 from unstack.cli.main import SAMPLES, SECONDS, STATICS_HELP, data_dir_argument, model_path_option, out_folder_option
-from unstack.cli.options import Checked, constrained
+from unstack.cli.options import Checked, constrained, scheduler_option
 from unstack.cli.progress import progress_bar
 from unstack.cli.text import number_table
 from unstack.errors import UnstackError
@@ -121,7 +121,7 @@ def _run_piles(
     progress bar, each pile's result kept in ``OUT/checkpoints``: the results folder and the result."""
     from unstack.sim.dataset import scheduler_client
 
-    with scheduler_client(scheduler) as client:  # fails in seconds, before any output
+    with scheduler_client(scheduler, arguments.get("n_jobs", 1)) as client:  # fails in seconds, before any output
         folder = results_folder(out)
         with progress_bar("piles") as report:
             result = run(**arguments, progress=report, checkpoints=folder / checkpoints, client=client)
@@ -344,8 +344,7 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
               help="Also unstack and highest-first sensing the pile again before each pick (3x slower).")  # fmt: skip
 @click.option("--statics/--no-statics", default=True, show_default=True, help=STATICS_HELP)
 @_jobs_option(UNLOAD("n_jobs"))
-@click.option("--scheduler", default=None,
-              help="Address of a dask.distributed scheduler (tcp://HOST:PORT): piles run on its workers.")  # fmt: skip
+@scheduler_option("piles")
 def unload(
     data_dir: str,
     out: str,
@@ -426,8 +425,7 @@ def unload(
     CONTAINER("seed"), "the decisions' sampling, the belief worlds and the detector's misses (pile N: seed + N)"
 )
 @_jobs_option(CONTAINER("n_jobs"))
-@click.option("--scheduler", default=None,
-              help="Address of a dask.distributed scheduler (tcp://HOST:PORT): piles run on its workers.")  # fmt: skip
+@scheduler_option("piles")
 @click.option("--disturbance", "disturbance_path", type=click.Path(dir_okay=False, exists=True), default=None,
               help="Disturbance model file of the moves maker (default: the shipped one).")  # fmt: skip
 @click.option("--occupancy", type=CONTAINER("occupancy"), default=None,
@@ -684,8 +682,7 @@ def belief_calibration_command(
 @click.option("--disturbance", "disturbance_path", type=click.Path(dir_okay=False, exists=True), default=None,
               help="Disturbance model file of a moves maker taking the picks (default: the shipped one).")  # fmt: skip
 @_jobs_option(RESPONSES("n_jobs"))
-@click.option("--scheduler", default=None,
-              help="Address of a dask.distributed scheduler (tcp://HOST:PORT): piles run on its workers.")  # fmt: skip
+@scheduler_option("piles")
 def pick_responses(
     data_dirs: tuple[str, ...], out: str, piles: int | None, max_picks: int | None, seed: int, behaviour: str,
     model_path: str | None, disturbance_path: str | None, jobs: int, scheduler: str | None,
@@ -707,7 +704,7 @@ def pick_responses(
         if behaviour == "mixed":
             _warn(f"--disturbance {disturbance_path} is not used: the picks are drawn (--behaviour mixed)")
     model = None if behaviour == "mixed" else load_model_option(model_path)[0]
-    with scheduler_client(scheduler) as client, progress_bar("piles") as report:
+    with scheduler_client(scheduler, jobs) as client, progress_bar("piles") as report:
         summaries = collect_pick_responses(
             list(data_dirs), out, piles=piles, seed=seed, max_picks=max_picks, behaviour=behaviour, model=model,
             disturbance=disturbance_path, n_jobs=jobs, client=client, progress=report,

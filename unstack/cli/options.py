@@ -38,7 +38,7 @@ import click
 from unstack.errors import InvalidArgument
 from unstack.parameters import OneOf, constraints_of
 
-__all__ = ["Checked", "constrained", "setting"]
+__all__ = ["Checked", "constrained", "scheduler_option", "setting"]
 
 
 if TYPE_CHECKING:
@@ -117,3 +117,24 @@ def setting(field: str, kind: type) -> Checked:
     from unstack.sim.settings import check_setting
 
     return Checked(kind, functools.partial(check_setting, field=field))
+
+
+def _scheduler_address(address: str) -> str:
+    from unstack.sim.dataset import check_scheduler_address  # only when an address is given
+
+    try:
+        return check_scheduler_address(address)
+    except InvalidArgument as error:  # click names the option already
+        raise InvalidArgument(str(error).removeprefix("scheduler: ")) from None
+
+
+def scheduler_option(tasks: str) -> Callable[[Any], Any]:
+    """The ``--scheduler`` option of a command whose ``tasks`` (piles, configurations) may run on a
+    dask.distributed cluster: the address checked when read, one of it or ``--jobs``."""
+    return click.option(
+        "--scheduler",
+        type=Checked(str, _scheduler_address, name="address"),
+        default=None,
+        help=f"Address of a dask.distributed scheduler (tcp://HOST:PORT): {tasks} run on its workers "
+        "(instead of --jobs).",
+    )

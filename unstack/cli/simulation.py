@@ -6,7 +6,7 @@ import re
 
 import click
 
-from unstack.cli.options import setting
+from unstack.cli.options import scheduler_option, setting
 from unstack.errors import InvalidArgument, UnstackError
 from unstack.parameters import MAX_CONFIGS, MAX_JOBS
 from unstack.sim.settings import FAMILIES, SIZE_SETS, check_setting
@@ -45,7 +45,7 @@ def parse_box_range(text: str) -> tuple[int, int]:
 @click.option("--out", "out", required=True, type=click.Path(), help="Folder of the data set (created; resumable).")
 @click.option("--jobs", type=click.IntRange(1, MAX_JOBS), default=1, show_default=True,
               help="Worker processes on this machine.")  # fmt: skip
-@click.option("--scheduler", default=None, help="Address of a dask.distributed scheduler to run the tasks on.")
+@scheduler_option("configurations")
 @click.option("--depth", type=setting("Container.depth", float), default=None,
               help="Container section depth along x (m; default: the family's).")  # fmt: skip
 @click.option("--width", type=setting("Container.width", float), default=None,

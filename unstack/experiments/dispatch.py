@@ -36,7 +36,7 @@ def run_unordered(
         from distributed import as_completed
 
         futures = [client.submit(function, *task, pure=False) for task in arguments]
-        for future in as_completed(futures):  # type: ignore[no-untyped-call]
+        for future in as_completed(futures, loop=client.loop):  # type: ignore[no-untyped-call]  # not the default client
             yield future.result()
         return
     from joblib import Parallel, delayed

@@ -32,6 +32,8 @@ Examples
 
 from __future__ import annotations
 
+import asyncio
+import concurrent.futures
 import contextlib
 import json
 import os
@@ -47,7 +49,7 @@ import numpy as np
 
 from unstack.atomic import atomic_save_array, atomic_write_text, check_folder_path, folder_writer
 from unstack.dataset_folders import DATASET_FORMAT, MANIFEST, TIMINGS, config_name, list_configurations, read_manifest
-from unstack.errors import UnstackError
+from unstack.errors import InvalidArgument, UnstackError
 from unstack.parameters import MAX_CONFIGS, MAX_JOBS
 from unstack.sim.configuration import SimulatedConfiguration, simulate_configuration
 from unstack.sim.settings import SimulationSettings, json_ready
@@ -56,12 +58,23 @@ __all__ = [
     "DatasetConflict",
     "DatasetSummary",
     "SchedulerUnavailable",
+    "check_jobs_or_scheduler",
+    "check_scheduler_address",
     "connect_scheduler",
     "scheduler_client",
     "simulate_dataset",
 ]
 
-SCHEDULER_ADDRESS = re.compile(r"^(?:(?:tcp|tls|ws|wss|ucx)://)?[^\s:/]+:\d+$")
+SCHEDULER_ADDRESS = re.compile(r"^(?:tcp://)?[^\s:/]+:(?P<port>\d+)$")
+#: dask's other transports and what each needs beyond an address.
+SCHEDULER_TRANSPORTS = {
+    "tls": "security settings",
+    "wss": "security settings",
+    "ws": "websocket settings",
+    "ucx": "UCX settings",
+    "inproc": "scheduler in this process",
+}
+MAX_PORT = 65535
 #: Seconds to wait for a dask scheduler before saying it does not answer.
 SCHEDULER_TIMEOUT = 5.0
 
@@ -186,14 +199,90 @@ def _run_local(todo: list[int], settings: SimulationSettings, seed: int, jobs: i
     yield from parallel(delayed(simulate_configuration)(settings, seed=seed, index=index) for index in todo)
 
 
+def check_scheduler_address(address: str) -> str:
+    """``address`` if it names a dask scheduler unstack can reach: ``tcp://HOST:PORT`` or
+    ``HOST:PORT``, the port from 1 to 65535; else :class:`~unstack.errors.InvalidArgument`.
+
+    ``tls://`` (and dask's other transports) need security or transport settings that unstack
+    does not take, so they are refused here rather than failing inside dask.
+
+    Examples
+    --------
+    >>> check_scheduler_address("tcp://10.0.0.5:8786")
+    'tcp://10.0.0.5:8786'
+    >>> try:
+    ...     check_scheduler_address("tls://10.0.0.5:8786")
+    ... except ValueError as error:
+    ...     print(error)
+    scheduler: tls:// needs dask's security settings, which unstack does not take; give a tcp://HOST:PORT address
+    """
+    scheme, separator, _ = address.partition("://")
+    if separator and scheme != "tcp" and scheme in SCHEDULER_TRANSPORTS:
+        raise InvalidArgument(
+            f"scheduler: {scheme}:// needs dask's {SCHEDULER_TRANSPORTS[scheme]}, which unstack does not take; "
+            "give a tcp://HOST:PORT address"
+        )
+    found = SCHEDULER_ADDRESS.match(address)
+    if found is None:
+        raise InvalidArgument(f"scheduler: expected an address like tcp://HOST:PORT, got {address!r}")
+    if not 1 <= int(found["port"]) <= MAX_PORT:
+        raise InvalidArgument(f"scheduler: expected a port from 1 to {MAX_PORT}, got {found['port']} in {address!r}")
+    return address
+
+
+def check_jobs_or_scheduler(jobs: int, scheduler: str | None) -> None:
+    """Refuse local processes (``jobs`` above 1) asked for beside a scheduler, whose workers run
+    the tasks: one of them would be passed over without a word.
+
+    Examples
+    --------
+    >>> check_jobs_or_scheduler(1, "tcp://10.0.0.5:8786")
+    >>> try:
+    ...     check_jobs_or_scheduler(2, "tcp://10.0.0.5:8786")
+    ... except ValueError as error:
+    ...     print(error)
+    jobs: 2 local processes and a scheduler exclude each other (its workers run the tasks); give one of them
+    """
+    if scheduler is not None and jobs != 1:
+        raise InvalidArgument(
+            f"jobs: {jobs} local processes and a scheduler exclude each other (its workers run the tasks); "
+            "give one of them"
+        )
+
+
+async def _handshake(address: str) -> None:
+    """Connect to ``address`` (within :data:`SCHEDULER_TIMEOUT`) and exchange dask's handshake
+    (within twice that in all): dask bounds the connection but waits for the handshake's answer
+    for ever."""
+    from distributed.comm.core import connect
+
+    async def exchange() -> None:
+        comm = await connect(address, timeout=SCHEDULER_TIMEOUT)  # type: ignore[no-untyped-call]
+        await comm.close()
+
+    await asyncio.wait_for(exchange(), 2 * SCHEDULER_TIMEOUT)  # dask's own time limit ends first
+
+
 def connect_scheduler(scheduler: str) -> Any:
-    """A dask.distributed client, or a one-line error within :data:`SCHEDULER_TIMEOUT`."""
-    if not SCHEDULER_ADDRESS.match(scheduler):
-        raise SchedulerUnavailable(f"scheduler: expected an address like tcp://HOST:PORT, got {scheduler!r}")
+    """A dask.distributed client, or a one-line error within :data:`SCHEDULER_TIMEOUT`: the address
+    refused (:func:`check_scheduler_address`), nothing answering there, or something answering that
+    is no dask scheduler."""
+    check_scheduler_address(scheduler)
     try:
         from distributed import Client
     except ImportError as error:  # pragma: no cover - depends on the installation
         raise UnstackError("a dask scheduler needs dask.distributed: pip install 'unstack[sim]'") from error
+    try:  # in a thread of its own: the caller may be running an event loop (a notebook)
+        with concurrent.futures.ThreadPoolExecutor(1) as pool:
+            pool.submit(asyncio.run, _handshake(scheduler)).result()
+    except TimeoutError as error:
+        raise SchedulerUnavailable(
+            f"{scheduler} answers but not as a dask scheduler (no handshake within {2 * SCHEDULER_TIMEOUT:g} s)"
+        ) from error
+    except OSError as error:
+        raise SchedulerUnavailable(
+            f"dask scheduler {scheduler} does not answer within {SCHEDULER_TIMEOUT:g} s ({type(error).__name__})"
+        ) from error
     try:
         return Client(scheduler, timeout=SCHEDULER_TIMEOUT, set_as_default=False)  # type: ignore[no-untyped-call]
     except (OSError, TimeoutError, ValueError) as error:
@@ -203,8 +292,11 @@ def connect_scheduler(scheduler: str) -> Any:
 
 
 @contextlib.contextmanager
-def scheduler_client(scheduler: str | None) -> Iterator[Any]:
+def scheduler_client(scheduler: str | None, jobs: int = 1) -> Iterator[Any]:
     """A dask.distributed client for the address ``scheduler`` (None: no client), closed on exit.
+
+    ``jobs``, the local processes asked for beside it, must be 1: the scheduler's workers run the
+    tasks (:func:`check_jobs_or_scheduler`).
 
     Connects on entry (:func:`connect_scheduler`: a one-line error within
     :data:`SCHEDULER_TIMEOUT`), so a command that enters it before writing anything fails
@@ -216,7 +308,8 @@ def scheduler_client(scheduler: str | None) -> Iterator[Any]:
     ...     client is None
     True
     """
-    client = connect_scheduler(scheduler) if scheduler else None
+    check_jobs_or_scheduler(jobs, scheduler)
+    client = connect_scheduler(scheduler) if scheduler is not None else None
     try:
         yield client
     finally:
@@ -287,7 +380,8 @@ def simulate_dataset(
     manifest = read_manifest(target) if target.is_dir() else None
     if manifest is not None and list_configurations(target):  # a manifest alone: a run stopped before its first
         _check_same_dataset(target, manifest, settings, seed)
-    client = connect_scheduler(scheduler) if scheduler else None
+    check_jobs_or_scheduler(jobs, scheduler)
+    client = connect_scheduler(scheduler) if scheduler is not None else None
     target.mkdir(parents=True, exist_ok=True)
     try:
         with folder_writer(target, "a data set", DatasetConflict):
