@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from sklearn.metrics import roc_auc_score
 
+from unstack.errors import InvalidArgument
 from unstack.learning.classifier import SupportClassifier
 from unstack.learning.holdout import evaluate_holdout, holdout_split, out_of_fold_probabilities
 
@@ -69,3 +70,14 @@ def test_evaluate_holdout_returns_out_of_fold_probabilities_of_the_training_part
 def test_a_validation_share_outside_zero_one_is_refused(size: float, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         holdout_split([0, 1] * 10, validation_size=size)
+
+
+@pytest.mark.parametrize(("size", "held_out"), [(0.001, 1), (0.99, 143)])
+def test_a_validation_share_that_leaves_a_side_without_a_class_is_refused_with_the_shares_that_work(
+    size: float, held_out: int
+) -> None:
+    with pytest.raises(InvalidArgument, match=rf"^validation_size {size:g} holds out {held_out} of the 144 relations: "
+                       r".* give from 0.014 to 0.986 \(0: no hold-out\)$"):  # fmt: skip
+        holdout_split([0, 1] * 72, validation_size=size)
+    train, held = holdout_split([0, 1] * 72, validation_size=0.014, random_state=0)
+    assert len(held) == 3 and len(train) == 141

@@ -27,6 +27,7 @@ Examples
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -93,10 +94,26 @@ def holdout_split(
         splitter = GroupShuffleSplit(n_splits=1, test_size=validation_size, random_state=random_state)
         train_rows, valid_rows = next(splitter.split(rows, labels, group_labels))
     else:
+        _require_each_class_on_each_side(labels, validation_size)
         train_rows, valid_rows = train_test_split(
             rows, test_size=validation_size, stratify=labels, random_state=random_state
         )
     return np.sort(train_rows), np.sort(valid_rows)
+
+
+def _require_each_class_on_each_side(labels: np.ndarray, validation_size: float) -> None:
+    """Raise where a stratified split of ``labels`` cannot put every class on both sides (the
+    held-out part takes ``ceil(validation_size * n)`` rows, as scikit-learn's split does)."""
+    total, classes = len(labels), len(np.unique(labels))
+    held_out = math.ceil(validation_size * total)
+    if min(held_out, total - held_out) < classes:
+        smallest = math.ceil(classes / total * 1000) / 1000
+        largest = math.floor((total - classes) / total * 1000) / 1000
+        raise InvalidArgument(
+            f"validation_size {validation_size:g} holds out {held_out} of the {total} relations: the held-out and "
+            f"the training part need one of each of the {classes} classes; give from {smallest:g} to {largest:g} "
+            "(0: no hold-out)"
+        )
 
 
 def out_of_fold_probabilities(classifier: SupportClassifier, X: Any, y: Any, groups: Any = None) -> np.ndarray:
