@@ -90,3 +90,16 @@ def test_a_class_too_thin_to_learn_from_is_refused_before_any_fit(
     labels[:supporting] = 1
     with pytest.raises(InvalidArgument, match=rf"{supporting} SUPP and {len(labels) - supporting} other relations"):
         train_support_model(replace(examples, labels=labels), FeatureSettings())
+
+
+def test_fewer_folds_than_asked_for_are_said_with_the_rarer_class(fixed_rng: np.random.Generator) -> None:
+    from unstack.learning.training import fewer_folds_warnings
+
+    examples = pooled(fixed_rng, (10,))
+    rarer = int(min(examples.labels.sum(), len(examples.labels) - examples.labels.sum()))
+    fitted = SupportClassifier(cv=500, param_grid=SMALL_GRID, random_state=0).fit(examples.features, examples.labels)
+    assert fitted.cv_folds_ == rarer
+    [warning] = fewer_folds_warnings(fitted, examples)
+    assert warning.startswith(f"{rarer} cross-validation folds were used, not the 500 asked for: ")
+    fitted = SupportClassifier(cv=3, param_grid=SMALL_GRID, random_state=0).fit(examples.features, examples.labels)
+    assert fewer_folds_warnings(fitted, examples) == ()

@@ -200,7 +200,7 @@ def train(
     console.print(
         f"{len(examples.labels)} relations ({int(examples.labels.sum())} SUPP) from "
         f"{counted(len(set(examples.configuration.tolist())), 'configuration')}; {held_out}cross-validating {learner} "
-        f"({cv} folds) on all of them ..."
+        f"({cv} folds at most) on all of them ..."
     )
     provenance = training_provenance(
         data_dirs, examples, vary_clouds=vary_clouds, pose_noise=pose_noise, seed=seed, r=r,

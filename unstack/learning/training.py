@@ -201,7 +201,34 @@ def train_support_model(
         training_features=examples.features,
         validation=validation,
     )
-    return TrainingRun(model, holdout, useless_model_warnings(classifier, examples))
+    return TrainingRun(
+        model,
+        holdout,
+        (*fewer_folds_warnings(classifier, examples, groups), *useless_model_warnings(classifier, examples)),
+    )
+
+
+def fewer_folds_warnings(classifier: Any, examples: SupportExamples, groups: Any = None) -> tuple[str, ...]:
+    """A warning when the fitted ``classifier`` cross-validated on fewer folds than its ``cv``
+    asked for: a fold needs a relation of the rarer class (and, split by configuration, a pile).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> rows = SimpleNamespace(labels=np.array([0] * 30 + [1] * 6))
+    >>> fewer_folds_warnings(SimpleNamespace(cv=10, cv_folds_=6), rows)[0]
+    '6 cross-validation folds were used, not the 10 asked for: a fold needs one relation of each class (6 SUPP)'
+    """
+    if classifier.cv_folds_ >= classifier.cv:
+        return ()
+    supporting = int(np.sum(examples.labels == 1))
+    others = len(examples.labels) - supporting
+    rarer = f"{supporting} SUPP" if supporting <= others else f"{others} other"
+    piles = f" and one pile ({len(np.unique(groups))} in all)" if groups is not None else ""
+    return (
+        f"{classifier.cv_folds_} cross-validation folds were used, not the {classifier.cv} asked for: a fold "
+        f"needs one relation of each class ({rarer}){piles}",
+    )
 
 
 #: Fewer relations of a class than this cannot be split and cross-validated at all.
