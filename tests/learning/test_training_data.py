@@ -97,3 +97,9 @@ def test_a_few_isets_of_a_large_pile_are_not_warned_about(small_dataset: Path) -
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         dataset_examples(small_dataset, r=2, isets=1, seed=0)
+
+
+def test_isets_larger_than_a_pile_can_give_are_warned_about_with_the_sizes_drawn(small_dataset: Path) -> None:
+    with pytest.warns(UserWarning, match=r"r = 100 is more than 8 of the 8 piles can give: their ISets hold \d+(-\d+)? "
+                      r"boxes \(one fewer than the pile's detected boxes\)"):  # fmt: skip
+        dataset_examples(small_dataset, r=100, isets=1, seed=0)

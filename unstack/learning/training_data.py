@@ -284,6 +284,7 @@ def dataset_examples(
         if progress is not None:
             progress(len(parts), len(files))
     examples = SupportExamples.concatenate(parts)
+    _warn_smaller_isets(examples, r, folder, len(files))
     drawn, repeated = repeated_isets(examples)
     if repeated > REPEATED_ISETS * drawn:
         warnings.warn(
@@ -293,6 +294,39 @@ def dataset_examples(
             stacklevel=2,
         )
     return examples
+
+
+def iset_boxes(examples: SupportExamples) -> dict[tuple[int, int], set[str]]:
+    """The boxes of each ISet of the examples, by ``(configuration, iset)``.
+
+    Examples
+    --------
+    >>> rows = SupportExamples(np.zeros((2, 1)), np.zeros(2, int), np.zeros(2, int), np.zeros(2, int),
+    ...                        [("a", "b"), ("b", "a")])
+    >>> {key: sorted(members) for key, members in iset_boxes(rows).items()}
+    {(0, 0): ['a', 'b']}
+    """
+    boxes: dict[tuple[int, int], set[str]] = {}
+    for configuration, iset, pair in zip(
+        examples.configuration.tolist(), examples.iset.tolist(), examples.pairs, strict=True
+    ):
+        boxes.setdefault((configuration, iset), set()).update(pair)
+    return boxes
+
+
+def _warn_smaller_isets(examples: SupportExamples, r: int, folder: str | os.PathLike[str], piles: int) -> None:
+    """Warn when piles too small for ISets of ``r`` boxes gave smaller ones (one box fewer than the
+    pile's detected boxes, as the paper draws them), so that a larger ``r`` changes nothing there."""
+    smaller = {(configuration, len(members)) for (configuration, _), members in iset_boxes(examples).items()
+               if len(members) < r}  # fmt: skip
+    if smaller:
+        sizes = sorted({size for _, size in smaller})
+        held = f"{sizes[0]}" if len(sizes) == 1 else f"{sizes[0]}-{sizes[-1]}"
+        warnings.warn(
+            f"{folder}: r = {r} is more than {len({pile for pile, _ in smaller})} of the {piles} piles can give: "
+            f"their ISets hold {held} boxes (one fewer than the pile's detected boxes)",
+            stacklevel=3,
+        )
 
 
 #: A share of ISets repeating one of their pile above which drawing them is warned about.
@@ -310,10 +344,6 @@ def repeated_isets(examples: SupportExamples) -> tuple[int, int]:
     >>> repeated_isets(rows)
     (3, 1)
     """
-    boxes: dict[tuple[int, int], set[str]] = {}
-    for configuration, iset, pair in zip(
-        examples.configuration.tolist(), examples.iset.tolist(), examples.pairs, strict=True
-    ):
-        boxes.setdefault((configuration, iset), set()).update(pair)
+    boxes = iset_boxes(examples)
     seen = {(configuration, frozenset(members)) for (configuration, _), members in boxes.items()}
     return len(boxes), len(boxes) - len(seen)
