@@ -159,6 +159,8 @@ def test_fig5a_on_simulated_piles(small_dataset: Path, tmp_path: Path, split: st
     assert matrix.sum() == document["validation"]["relations"]
     assert 0.0 < document["balanced_threshold"] <= 1.0 and 0.0 < document["paper_recall_threshold"] <= 1.0
     assert document["split_by"] == split and document["features"]["feature_set"] == features
+    assert {key: document[key] for key in ("r", "isets", "seed", "cv")} == {"r": 4, "isets": 3, "seed": 0, "cv": 3}
+    assert 2 <= document["cv_folds"] <= 3
     roc = document["validation_roc"]
     assert 0.0 <= roc["not_supp_recall_at_paper_supp_recall"] <= 1.0 and 0.0 <= roc["auc"] <= 1.0
     assert np.all(np.diff(roc["supp_recall"]) <= 0)  # a stricter not-SUPP recall never raises the SUPP recall

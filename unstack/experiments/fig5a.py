@@ -227,8 +227,13 @@ def fig5a(
     reported = ("confusion_matrix", "supp_recall", "not_supp_recall", "success_rate")
     return {
         "data": str(data_dir),
+        "r": r,
+        "isets": isets,
         "isets_from": draw,
+        "seed": seed,
         "learner": learner,
+        "cv": cv,
+        "cv_folds": int(classifier.cv_folds_),
         "split_by": split_by,
         "features": settings.to_dict(),
         "relations": len(examples.labels),
