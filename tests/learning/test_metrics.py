@@ -71,3 +71,17 @@ def test_not_supp_recall_at_matches_a_threshold_sweep(rng: np.random.Generator) 
 
 def test_not_supp_recall_at_is_nan_without_both_classes() -> None:
     assert np.isnan(not_supp_recall_at([1, 1], [0.2, 0.9], 0.5))
+
+
+@pytest.mark.parametrize(("truth", "missing"), [([0, 0, 0], "SUPP"), ([1, 1, 1], "not-SUPP"), ([0, 1, 1], None)])
+def test_relations_of_one_class_are_said_to_leave_the_recall_ber_and_roc_undefined(
+    truth: list[int], missing: str | None
+) -> None:
+    from unstack.learning.metrics import one_class_warning
+
+    warning = one_class_warning(classification_report(truth, [0.2, 0.5, 0.9]), "d")
+    if missing is None:
+        assert warning is None
+    else:
+        assert warning == (f"d: no {missing} relation among the 3 scored: the {missing} recall, the balanced error "
+                           "rate (Eq. 16) and the ROC curve are undefined")  # fmt: skip

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 from typing import Any
@@ -59,7 +60,8 @@ def metrics_view(report: dict[str, Any], title: str) -> Group:
         ("expected_calibration_error", "expected calibration error"),
     ):
         value = report[key]
-        summary.add_row(label, f"{value:.4f}" if isinstance(value, float) else str(value))
+        shown = "n/a" if value is None or (isinstance(value, float) and math.isnan(value)) else value
+        summary.add_row(label, f"{shown:.4f}" if isinstance(shown, float) else str(shown))
     return Group(confusion, summary)
 
 
@@ -267,7 +269,7 @@ def evaluate(
     """Score a model (a file or a shipped model's name) on a data set: confusion matrix,
     success rate, BER, entropy, calibration."""
     from unstack.experiments.fig5a import paper_point
-    from unstack.learning.metrics import classification_report, save_reliability_diagram
+    from unstack.learning.metrics import classification_report, one_class_warning, save_reliability_diagram
     from unstack.learning.model_file import data_set_out_of_distribution
 
     if r < 2 or isets < 1 or jobs < 1:
@@ -287,6 +289,10 @@ def evaluate(
     doubt = data_set_out_of_distribution(report["out_of_range"], len(examples.features), data_dir)
     if doubt:
         click.echo(f"unstack: warning: {doubt}", err=True)
+    one_class = one_class_warning(report, data_dir)
+    if one_class:
+        click.echo(f"unstack: warning: {one_class}", err=True)
+        report["balanced_error_rate"] = None  # Eq. 16 averages the two classes' error rates
     if reliability:
         save_reliability_diagram(report, reliability, title=f"{model_file} on {data_dir}")
     if as_json:
@@ -295,11 +301,12 @@ def evaluate(
     console = Console()
     console.print(metrics_view(report, f"{model_file} on {data_dir}: confusion matrix (Fig. 5 layout)"))
     point = report["fig5a"]
-    console.print(
-        f"ROC AUC {point['auc']:.3f}; at the paper's SUPP recall ({100 * point['supp_recall']:.1f} %) "
-        f"the best not-SUPP recall is {100 * point['not_supp_recall']:.1f} % "
-        f"(paper: {100 * point['paper_not_supp_recall']:.1f} %)"
-    )
+    if not one_class:
+        console.print(
+            f"ROC AUC {point['auc']:.3f}; at the paper's SUPP recall ({100 * point['supp_recall']:.1f} %) "
+            f"the best not-SUPP recall is {100 * point['not_supp_recall']:.1f} % "
+            f"(paper: {100 * point['paper_not_supp_recall']:.1f} %)"
+        )
     console.print(
         f"relations with a feature outside the model's training range: {report['out_of_range']['rows']:,} of "
         f"{len(examples.features):,} ({100 * report['out_of_range']['share']:.1f} %)"

@@ -167,6 +167,24 @@ def classification_report(truth: Any, probability: Any) -> dict[str, Any]:
     }
 
 
+def one_class_warning(report: dict[str, Any], source: str) -> str | None:
+    """What a :func:`classification_report` of relations of one class only cannot say, or None.
+
+    Examples
+    --------
+    >>> report = classification_report([0, 0, 0], [0.1, 0.2, 0.9])
+    >>> print(one_class_warning(report, "piles")[:60])
+    piles: no SUPP relation among the 3 scored: the SUPP recall,
+    """
+    missing = "SUPP" if report["supp"] == 0 else "not-SUPP" if report["not_supp"] == 0 else None
+    if missing is None:
+        return None
+    return (
+        f"{source}: no {missing} relation among the {report['relations']:,} scored: the {missing} recall, the "
+        "balanced error rate (Eq. 16) and the ROC curve are undefined"
+    )
+
+
 def save_reliability_diagram(report: dict[str, Any], output: str | os.PathLike[str], *, title: str = "") -> None:
     """Draw the reliability diagram of a :func:`classification_report` into a PNG (atomically)."""
 
