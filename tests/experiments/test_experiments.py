@@ -140,6 +140,10 @@ def test_experiment_commands(small_dataset: Path, tmp_path: Path) -> None:
         (["unload", "examples", "--out", "{tmp}"], "examples: expected a data set folder with config-NNNN.json"),
         (["fig5a", "{data}", "--out", "{tmp}", "--full"], "the paper's size is 200 configurations and 10 folds"),
         (["unload", "{data}", "--out", "{tmp}", "--scheduler", "nowhere"], "expected an address like tcp://HOST:PORT"),
+        (
+            ["decisions", "{data}", "--out", "{tmp}", "--pair-with", "examples/pile5.scene.json"],
+            "examples/pile5.scene.json: expected the decisions.json of an `unstack experiment decisions` run",
+        ),
     ],
 )
 def test_experiment_bad_input(arguments: list[str], message: str, tmp_path: Path, small_dataset: Path) -> None:

@@ -255,13 +255,24 @@ def decisions(
     """Fig. 4 and beyond: MSE(cost), first pick right and physical disturbance of every decision maker."""
     from unstack.cli.main import load_model_option
     from unstack.dataset_folders import require_configurations
-    from unstack.experiments.decisions import DECISION_MAKERS, PAPER_TEST_ISETS, paired_between_runs, plot_fig4
+    from unstack.experiments.decisions import (
+        DECISION_MAKERS,
+        PAPER_TEST_ISETS,
+        check_decisions_run,
+        paired_between_runs,
+        plot_fig4,
+    )
     from unstack.jsonio import read_document
 
     if full:
         isets = PAPER_TEST_ISETS
     require_configurations(data_dir)  # before any progress bar or output folder
     earlier = read_document(pair_with).data if pair_with is not None else None
+    if earlier is not None:
+        try:
+            check_decisions_run(earlier)  # before the run, not after it
+        except ValueError as error:
+            raise UnstackError(f"{pair_with}: {error}") from None
     model, name = load_model_option(model_path)
     folder = results_folder(out)
     with progress_bar("ISets") as report:

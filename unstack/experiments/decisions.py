@@ -351,6 +351,28 @@ def _iset_record(outcome: IsetOutcome, scores: dict[str, dict[str, np.ndarray]],
     }
 
 
+def check_decisions_run(run: dict[str, Any]) -> None:
+    """Raise ``ValueError`` unless ``run`` is a result of :func:`evaluate_decisions` with its
+    per-ISet records (what :func:`paired_between_runs` pairs).
+
+    Examples
+    --------
+    >>> try:
+    ...     check_decisions_run({"runs": [], "makers": []})
+    ... except ValueError as error:
+    ...     print(str(error).split(", got ")[1])
+    another document (keys makers, runs)
+    """
+    if "per_iset" in run:
+        return
+    if "against_reasoner" in run:
+        raise ValueError("a decisions run with no per-ISet records (made before they were kept): run it again")
+    keys = ", ".join(sorted(run)[:6]) + (", ..." if len(run) > 6 else "")
+    raise ValueError(
+        f"expected the decisions.json of an `unstack experiment decisions` run, got another document (keys {keys})"
+    )
+
+
 def paired_between_runs(
     first: dict[str, Any], second: dict[str, Any], *, maker: str = "reasoner"
 ) -> dict[str, float | None]:
@@ -374,8 +396,7 @@ def paired_between_runs(
     -1.0
     """
     for run in (first, second):
-        if "per_iset" not in run:
-            raise ValueError("a run has no per-ISet records (made before they were kept): run it again")
+        check_decisions_run(run)
     settings = ("data", "r", "seed", "draw")
 
     def setting(run: dict[str, Any], key: str) -> Any:
