@@ -141,6 +141,10 @@ def test_experiment_commands(small_dataset: Path, tmp_path: Path) -> None:
         (["fig5a", "{data}", "--out", "{tmp}", "--full"], "the paper's size is 200 configurations and 10 folds"),
         (["unload", "{data}", "--out", "{tmp}", "--scheduler", "nowhere"], "expected an address like tcp://HOST:PORT"),
         (
+            ["train-disturbance", "{tmp}", "--out", "{tmp}/results"],
+            "no collected states (unstack experiment pick-responses writes them)",
+        ),
+        (
             ["decisions", "{data}", "--out", "{tmp}", "--pair-with", "examples/pile5.scene.json"],
             "examples/pile5.scene.json: expected the decisions.json of an `unstack experiment decisions` run",
         ),

@@ -31,7 +31,7 @@ from unstack.experiments.disturbance_training import train_disturbance
 from unstack.experiments.fig5a import fig5a as fig5a_experiment
 from unstack.experiments.generalisation import PICKS
 from unstack.experiments.outputs import results_folder, save_results
-from unstack.experiments.pick_responses import collect_pick_responses, pick_table
+from unstack.experiments.pick_responses import collect_pick_responses, collected_piles, pick_table
 from unstack.experiments.real7 import real7 as real7_experiment
 from unstack.experiments.table1 import TABLE_SIZE
 from unstack.experiments.unloading import UNLOAD_SAMPLES, unloading_experiment
@@ -745,12 +745,12 @@ def train_disturbance_command(states: str, out: str, model_path: str | None, fol
     from unstack.cli.main import load_model_option
     from unstack.learning.disturbance import save_disturbance_model
 
+    if not collected_piles(states):  # before the results folder is made
+        raise UnstackError(f"{states}: no collected states (unstack experiment pick-responses writes them)")
     model, name = load_model_option(model_path)
     folder = results_folder(out)
     with progress_bar("piles") as report:
         records = pick_table(states, model, seed=seed, n_jobs=jobs, progress=report)
-    if not records:
-        raise click.UsageError(f"{states}: no collected states (unstack experiment pick-responses writes them)")
     disturbance, result = train_disturbance(records, random_state=seed, folds=folds)
     disturbance.metadata["training"] = {"states": str(states), "support_model": name, "seed": seed}
     save_disturbance_model(disturbance, folder / "disturbance.skops")

@@ -46,6 +46,7 @@ __all__ = [
     "VIEWS",
     "behaviour_pick",
     "collect_pick_responses",
+    "collected_piles",
     "load_states",
     "pick_table",
     "state_rows",
@@ -327,6 +328,11 @@ def state_rows(
     }
 
 
+def collected_piles(states: str | os.PathLike[str]) -> list[Path]:
+    """The piles of a collection whose states are all written (``DATA-SET/PILE/done.json``), in order."""
+    return sorted(path.parent for path in Path(states).glob("*/*/done.json"))
+
+
 @validate_params({"seed": SEED, "samples": COUNT, "n_jobs": JOBS})
 def pick_table(
     states: str | os.PathLike[str],
@@ -340,7 +346,7 @@ def pick_table(
 ) -> list[dict[str, Any]]:
     """Every saved state of a collection through every view: one record per (state, view)
     with the features, outcomes and candidates (:func:`state_rows`), pile by pile."""
-    folders = sorted(path.parent for path in Path(states).glob("*/*/done.json"))
+    folders = collected_piles(states)
     records: list[dict[str, Any]] = []
     tasks = [(folder, model, views, seed, samples) for folder in folders]
     for done, rows in enumerate(run_unordered(_pile_table_task, tasks, n_jobs=n_jobs), start=1):
