@@ -66,6 +66,7 @@ REFUSALS = [
     ([*SIMULATE, "--configs", "-3"], "Invalid value for '--configs': -3 is not in the range 1<=x<=100000"),
     ([*SIMULATE, "--configs", "10000000000"], "'--configs': 10000000000 is not in the range 1<=x<=100000"),
     ([*SIMULATE, "--jobs", "0"], "Invalid value for '--jobs': 0 is not in the range 1<=x<=256"),
+    ([*SIMULATE, "--min-pixels", "0"], "'--min-pixels': expected a number at least 1, got 0"),
     (
         [*SIMULATE, "--resolution", "96x72", "--min-pixels", "100000"],
         "settings.sensor.min_pixels: expected at most the image's 6,912 pixels (96 x 72): no box could be detected",

@@ -55,7 +55,7 @@ def parse_box_range(text: str) -> tuple[int, int]:
 @click.option("--noise/--no-noise", default=False, show_default=True, help="Kinect-like depth noise.")
 @click.option("--resolution", default="640x480", show_default=True, help="Sensor image size WIDTHxHEIGHT.")
 @click.option("--min-pixels", type=setting("SensorSettings.min_pixels", int), default=50, show_default=True,
-              help="Visible pixels that make a box detectable.")  # fmt: skip
+              help="Visible pixels that make a box detectable (at least 1).")  # fmt: skip
 @click.option("--viewpoint-jitter", type=setting("SensorSettings.position_jitter", float), default=0.0,
               show_default=True,
               help="Move the sensor of each configuration by up to this much per axis (m, 0 to 1).")  # fmt: skip

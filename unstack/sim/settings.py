@@ -328,7 +328,7 @@ FIELD_LIMITS: dict[str, Any] = {
     "SensorSettings.position": "coordinate", "SensorSettings.target": "coordinate",
     "SensorSettings.vertical_fov_deg": (1.0, 179.0), "SensorSettings.width": (1, 8192),
     "SensorSettings.height": (1, 8192), "SensorSettings.near": "positive", "SensorSettings.far": "positive",
-    "SensorSettings.min_pixels": "at least 0", "SensorSettings.position_jitter": (0.0, 1.0),
+    "SensorSettings.min_pixels": "at least 1", "SensorSettings.position_jitter": (0.0, 1.0),
     "SensorSettings.noise_coefficients": (0.0, 10.0),
     "SimulationSettings.boxes": "at least 1",
 }  # fmt: skip
