@@ -52,3 +52,12 @@ def test_a_manifest_that_is_not_a_data_sets_is_refused(tmp_path: Path, manifest:
     (folder / MANIFEST).write_text(manifest)
     with pytest.raises(UnstackError, match=message):
         require_configurations(folder)
+
+
+def test_more_piles_than_a_data_set_holds_are_all_of_them_with_a_warning(tmp_path: Path) -> None:
+    from unstack.dataset_folders import first_configurations
+
+    data_set(tmp_path, 2, None)
+    assert [path.name for path in first_configurations(tmp_path, 1)] == ["config-0000.json"]
+    with pytest.warns(UserWarning, match=r"3 configurations asked for, the data set has 2: all 2 are used"):
+        assert len(first_configurations(tmp_path, 3, "configurations")) == 2

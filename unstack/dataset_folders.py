@@ -34,6 +34,7 @@ __all__ = [
     "MANIFEST",
     "TIMINGS",
     "config_name",
+    "first_configurations",
     "list_configurations",
     "read_manifest",
     "require_configurations",
@@ -89,6 +90,33 @@ def require_configurations(folder: str | os.PathLike[str]) -> list[Path]:
             stacklevel=2,
         )
     return files
+
+
+def first_configurations(folder: str | os.PathLike[str], count: int | None, noun: str = "piles") -> list[Path]:
+    """The first ``count`` configurations of a data set folder (:func:`require_configurations`;
+    ``None``: all), with a warning when it holds fewer than asked for (all are used).
+
+    Examples
+    --------
+    >>> import warnings, tempfile
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> _ = (folder / "config-0000.json").write_text("{}")
+    >>> with warnings.catch_warnings(record=True) as said:
+    ...     warnings.simplefilter("always")
+    ...     len(first_configurations(folder, 5))
+    1
+    >>> str(said[0].message).endswith("5 piles asked for, the data set has 1: all 1 are used")
+    True
+    """
+    files = require_configurations(folder)
+    if count is not None and count > len(files):
+        import warnings
+
+        warnings.warn(
+            f"{folder}: {count} {noun} asked for, the data set has {len(files)}: all {len(files)} are used",
+            stacklevel=2,
+        )
+    return files if count is None else files[:count]
 
 
 def read_manifest(folder: str | os.PathLike[str]) -> dict[str, Any] | None:

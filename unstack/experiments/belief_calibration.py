@@ -127,11 +127,11 @@ def belief_calibration(
         ``calibration`` (Spearman, bins), ``picks`` (boxes the pick of each rule would have
         moved, summed over the states) and per pile the same.
     """
-    from unstack.dataset_folders import require_configurations
+    from unstack.dataset_folders import first_configurations
     from unstack.learning.disturbance import calibration
     from unstack.sim.belief import BELIEF_WORLDS
 
-    files = require_configurations(data_dir)[:piles]
+    files = first_configurations(data_dir, piles)
     options = {"detector_misses": detector_misses, "worlds": BELIEF_WORLDS if worlds is None else worlds,
                "max_picks": max_picks, "seed": seed, "fill": fill, "view": view}  # fmt: skip
     results: list[dict[str, Any] | None] = [None] * len(files)

@@ -113,9 +113,9 @@ def camera_roundtrip(
         of sizes right, median residual, share of piles whose decision on the built scene is
         the one on the true poses; ``piles``: every box of every pile.
     """
-    from unstack.dataset_folders import require_configurations
+    from unstack.dataset_folders import first_configurations
 
-    files = require_configurations(data_dir)[:piles]
+    files = first_configurations(data_dir, piles)
     results: list[dict[str, Any] | None] = [None] * len(files)
     tasks = [(path, number, model, samples) for number, path in enumerate(files)]
     if progress is not None:

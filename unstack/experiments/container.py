@@ -723,7 +723,7 @@ def container_experiment(
     import json
 
     from unstack.atomic import atomic_write_text
-    from unstack.dataset_folders import require_configurations
+    from unstack.dataset_folders import first_configurations
     from unstack.experiments.decisions import paired_difference
     from unstack.experiments.outputs import checkpoint_folder, stored_result
 
@@ -735,7 +735,7 @@ def container_experiment(
 
         disturbance_path = Path(default_disturbance_path() if disturbance is None else disturbance)
         disturbance_digest = hashlib.sha256(disturbance_path.read_bytes()).hexdigest()
-    files = require_configurations(data_dir)[:piles]
+    files = first_configurations(data_dir, piles)
     model_digest = hashlib.sha256(json.dumps(model.metadata, sort_keys=True, default=str).encode()).hexdigest()
     settings = {"detector_noise": detector_noise, "detector_misses": detector_misses, "reach": reach,
                 "max_picks": max_picks, "samples": samples, "occupancy": occupancy}  # fmt: skip

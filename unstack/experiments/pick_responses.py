@@ -240,7 +240,7 @@ def collect_pick_responses(
         Per pile: scene, boxes, states saved, boxes moved by the behaviour, why it stopped
         (and the behaviour, when a decision maker took the picks).
     """
-    from unstack.dataset_folders import require_configurations
+    from unstack.dataset_folders import first_configurations
     from unstack.errors import InvalidArgument
     from unstack.experiments.outputs import checkpoint_folder
 
@@ -253,8 +253,7 @@ def collect_pick_responses(
         )
     files: list[Path] = []
     for data_dir in data_dirs:
-        found = require_configurations(data_dir)
-        files += found if piles is None else found[:piles]
+        files += first_configurations(data_dir, piles)
     with checkpoint_folder(out) as held:
         assert held is not None
         return _collect_into(held, files, seed, max_picks, behaviour, model, disturbance, n_jobs, client, progress)

@@ -246,13 +246,13 @@ def unloading_experiment(
     import json
 
     from unstack.atomic import atomic_write_text
-    from unstack.dataset_folders import require_configurations
+    from unstack.dataset_folders import first_configurations
     from unstack.experiments.outputs import checkpoint_folder
 
     if samples is None and time_limit is None:
         samples = UNLOAD_SAMPLES
     settings = DecisionSettings(seed=seed, samples=samples, time_limit=time_limit, cost=cost, statics=statics)
-    files = require_configurations(data_dir)[:configs]
+    files = first_configurations(data_dir, configs, "configurations")
     per_pile_settings = [dataclasses.replace(settings, seed=seed + number) for number in range(len(files))]
     keys = [_pile_key(path, model, per_pile_settings[number], closed_loop) for number, path in enumerate(files)]
     with checkpoint_folder(checkpoints) as folder:
