@@ -175,7 +175,9 @@ def test_detections_with_a_key_twice_in_one_object_are_refused(tmp_path: Path) -
 
 
 def test_detections_are_not_read_from_standard_input() -> None:
-    with pytest.raises(InvalidFile, match=r"^-: \$: detections are read from a file, not from standard input"):
+    with pytest.raises(
+        InvalidFile, match=r"^-: \$: expected the name of the detections file: standard input is not read for it"
+    ):
         load_detections("-")
 
 

@@ -33,7 +33,7 @@ from unstack.camera.build import CameraScene
 from unstack.camera.planes import gravity_frame
 from unstack.checks import check_quaternion_xyzw, check_vector, finite_number, number_text
 from unstack.errors import InvalidFile, UnstackError
-from unstack.jsonio import parse_json, refuse_special_file
+from unstack.jsonio import refuse_special_file
 from unstack.scene import Box, Scene
 
 __all__ = ["load_cloud", "load_detections", "scene_from_cloud"]
@@ -198,18 +198,9 @@ def _in_metres(cloud: np.ndarray, file: Path) -> np.ndarray:
 def load_detections(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
     """Box detections from JSON (see the module docstring), checked field by field; keys other
     than a box's are left out (with a warning)."""
-    file = Path(path)
-    source = str(file)
-    if source == "-":
-        raise InvalidFile(source, "$", "detections are read from a file, not from standard input; give a file name")
-    refuse_special_file(file)
-    try:
-        text = file.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise InvalidFile(source, "$", "the detections file does not exist") from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise InvalidFile(source, "$", f"expected a JSON file: {error}") from None
-    data = parse_json(text, source)  # a key twice in one object refused, as in every document
+    from unstack.camera.files import read_json_file
+
+    data, source = read_json_file(path, "detections file")
     base = "$"
     if isinstance(data, dict):
         others = sorted(str(key) for key in data if key != "boxes")

@@ -70,14 +70,26 @@ class Intrinsics:
     height: int
 
 
-def _read_json(path: str | os.PathLike[str]) -> tuple[Any, str]:
+def read_json_file(path: str | os.PathLike[str], what: str = "file") -> tuple[Any, str]:
+    """The JSON value of a camera's file (``what`` it is, for the messages) and its name: read
+    as every document is (:func:`unstack.jsonio.parse_json`), in one-line errors.
+
+    Examples
+    --------
+    >>> read_json_file("missing.json", "detections file")
+    Traceback (most recent call last):
+    ...
+    unstack.errors.InvalidFile: missing.json: $: the detections file does not exist
+    """
     file = Path(path)
     source = str(file)
+    if source == "-":
+        raise InvalidFile(source, "$", f"expected the name of the {what}: standard input is not read for it")
     refuse_special_file(file)
     try:
         text = file.read_text(encoding="utf-8")
     except FileNotFoundError:
-        raise InvalidFile(source, "$", "the file does not exist") from None
+        raise InvalidFile(source, "$", f"the {what} does not exist") from None
     except (OSError, UnicodeDecodeError) as error:
         raise InvalidFile(source, "$", f"expected a JSON file: {error}") from None
     return parse_json(text, source), source
@@ -90,7 +102,7 @@ def load_intrinsics(path: str | os.PathLike[str]) -> Intrinsics:
     ``p1``, ``p2``, ``D``, ...) are refused, since nothing here would undo them; other keys
     are passed over with a warning naming them.
     """
-    data, source = _read_json(path)
+    data, source = read_json_file(path)
     if not isinstance(data, dict):
         raise InvalidFile(source, "$", "expected an object with fx, fy, cx, cy, width and height")
     _refuse_distortion(data, source)
@@ -160,7 +172,7 @@ def load_pose(path: str | os.PathLike[str]) -> np.ndarray:
     The rotation part must be a rotation (orthonormal, determinant 1, within 1e-3) and the
     last row ``0 0 0 1``.
     """
-    data, source = _read_json(path)
+    data, source = read_json_file(path)
     json_path = "$"
     if isinstance(data, dict):
         matrices = [key for key, value in data.items() if isinstance(value, list)]
