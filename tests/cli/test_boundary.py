@@ -276,7 +276,7 @@ def test_validate_checks_the_settings_of_a_data_set_manifest(tmp_path: Path) -> 
         ("--width", "1e12", "Invalid value for '--width': expected a positive extent of at most 100 m"),
         ("--horizon", "inf", "Invalid value for '--horizon': expected a finite number, got inf"),
         ("--horizon", "1e12", "Invalid value for '--horizon': expected a number from 0.001 to 10"),
-        ("--min-pixels", "-1", "Invalid value for '--min-pixels': expected a number at least 0, got -1"),
+        ("--min-pixels", "-1", "Invalid value for '--min-pixels': expected a number at least 1, got -1"),
         ("--viewpoint-jitter", "nan", "Invalid value for '--viewpoint-jitter': expected a finite number"),
         ("--resolution", "0x480", "--resolution: expected a number from 1 to 8192, got 0 in '0x480'"),
     ],
