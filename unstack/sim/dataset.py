@@ -74,6 +74,7 @@ SCHEDULER_TRANSPORTS = {
     "ucx": "UCX settings",
     "inproc": "scheduler in this process",
 }
+#: The largest TCP port.
 MAX_PORT = 65535
 #: Seconds to wait for a dask scheduler before saying it does not answer.
 SCHEDULER_TIMEOUT = 5.0
@@ -264,9 +265,9 @@ async def _handshake(address: str) -> None:
 
 
 def connect_scheduler(scheduler: str) -> Any:
-    """A dask.distributed client, or a one-line error within :data:`SCHEDULER_TIMEOUT`: the address
-    refused (:func:`check_scheduler_address`), nothing answering there, or something answering that
-    is no dask scheduler."""
+    """A dask.distributed client, or a one-line error: the address refused at once
+    (:func:`check_scheduler_address`), nothing answering there after :data:`SCHEDULER_TIMEOUT`, or
+    something answering that is no dask scheduler after twice that."""
     check_scheduler_address(scheduler)
     try:
         from distributed import Client
