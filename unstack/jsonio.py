@@ -192,7 +192,8 @@ def parse_json(text: str, source: str) -> Any:
         raise InvalidFile(
             source,
             "$",
-            f"invalid JSON: an integer of more than {sys.get_int_max_str_digits():,} digits, not a number of a scene",
+            f"invalid JSON: an integer of more than {sys.get_int_max_str_digits():,} digits, "
+            "no number an unstack file holds",
         ) from None
 
 

@@ -134,6 +134,7 @@ def test_a_bad_camera_json_file_is_refused_with_its_json_path(
 def test_an_integer_of_thousands_of_digits_is_refused_in_one_line(tmp_path: Path) -> None:
     (tmp_path / "k.json").write_text('{"fx": ' + "9" * 5000 + ', "fy": 600, "cx": 320, "cy": 240}')
     with pytest.raises(
-        InvalidFile, match=r"k.json: \$: invalid JSON: an integer of more than 4,300 digits, not a number of a scene"
+        InvalidFile,
+        match=r"k.json: \$: invalid JSON: an integer of more than 4,300 digits, no number an unstack file holds",
     ):
         load_intrinsics(tmp_path / "k.json")
