@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from unstack.camera.build import CameraScene
+from unstack.camera.files import read_json_file
 from unstack.camera.planes import gravity_frame
 from unstack.checks import check_quaternion_xyzw, check_vector, finite_number, number_text
 from unstack.errors import InvalidFile, UnstackError
@@ -198,8 +199,6 @@ def _in_metres(cloud: np.ndarray, file: Path) -> np.ndarray:
 def load_detections(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
     """Box detections from JSON (see the module docstring), checked field by field; keys other
     than a box's are left out (with a warning)."""
-    from unstack.camera.files import read_json_file
-
     data, source = read_json_file(path, "detections file")
     base = "$"
     if isinstance(data, dict):

@@ -31,7 +31,16 @@ from unstack.checks import MAX_COORDINATE, finite_number, number_text
 from unstack.errors import InvalidFile
 from unstack.jsonio import parse_json, refuse_special_file
 
-__all__ = ["DEPTH_UNITS", "MAX_DEPTH_M", "Intrinsics", "load_depth", "load_intrinsics", "load_mask", "load_pose"]
+__all__ = [
+    "DEPTH_UNITS",
+    "MAX_DEPTH_M",
+    "Intrinsics",
+    "load_depth",
+    "load_intrinsics",
+    "load_mask",
+    "load_pose",
+    "read_json_file",
+]
 
 #: Units a depth image can be declared in, and metres per unit.
 DEPTH_UNITS = {"mm": 0.001, "m": 1.0}
