@@ -48,6 +48,7 @@ True
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
@@ -59,6 +60,7 @@ import numpy as np
 from unstack.errors import InvalidArgument
 from unstack.reasoner._chain_arrays import BlockArrays, ChainArrays
 from unstack.reasoner.arguments import check_budget, check_count, check_matrix, check_samples, check_seed
+from unstack.reasoner.forced_classes import forced_classes, quotient_probabilities, spread_pairs
 from unstack.reasoner.progress import sampling_progress
 from unstack.reasoner.revisits import schedule
 from unstack.reasoner.world_masks import ONE_WORD_BOXES, mask_words, pack, unpack
@@ -573,6 +575,20 @@ def _check_sampling(
     check_count(burn_in, "burn_in", minimum=0)
 
 
+def _spread_over_boxes(merged: SampledMarginals, classes: np.ndarray) -> SampledMarginals:
+    """The result of sampling the classes of :func:`~unstack.reasoner.forced_classes.forced_classes`,
+    over the boxes: a box surely supports the others of its class, with no error."""
+    return dataclasses.replace(
+        merged,
+        marginals=spread_pairs(merged.marginals, classes, 1.0),
+        standard_errors=spread_pairs(merged.standard_errors, classes, 0.0),
+        batch_marginals=spread_pairs(merged.batch_marginals, classes, 1.0),
+        final_worlds=None,
+        block_of=None if merged.block_of is None else merged.block_of[classes],
+        schedule=None,
+    )
+
+
 def _sampled_marginals(
     p: np.ndarray,
     *,
@@ -589,8 +605,20 @@ def _sampled_marginals(
     revisits: bool = True,
 ) -> SampledMarginals:
     """:func:`sampled_marginals` on checked arguments; ``warm``: consistent starting worlds,
-    one per chain (skips the scattering sweep)."""
+    one per chain (skips the scattering sweep).
+
+    Boxes that surely support each other are sampled as one (:mod:`unstack.reasoner.forced_classes`:
+    one box's re-insertion cannot move such a class) and spread back over the boxes; such a run
+    starts cold and keeps no final worlds.
+    """
     start = time.perf_counter() if start is None else start
+    classes = forced_classes(p)
+    if classes is not None:
+        merged = _sampled_marginals(
+            quotient_probabilities(p, classes), samples=samples, time_limit=time_limit, seed=seed, chains=chains,
+            burn_in=burn_in, tries=tries, start=start, blocks=blocks, wide=wide, revisits=revisits,
+        )  # fmt: skip
+        return _spread_over_boxes(merged, classes)
     n = p.shape[0]
     if samples is None and time_limit is None:
         samples = default_samples(n)
@@ -737,6 +765,11 @@ def sample_worlds(
     check_count(worlds, "worlds", minimum=0)
     check_count(thin, "thin")
     _check_sampling(None, None, seed, burn_in=burn_in, tries=tries)
+    classes = forced_classes(p)
+    if classes is not None:  # boxes that surely support each other, drawn as one
+        merged = sample_worlds(quotient_probabilities(p, classes), worlds, seed=seed, thin=thin, burn_in=burn_in,
+                               tries=tries)  # fmt: skip
+        return spread_pairs(merged, classes, 1.0).astype(bool)
     n = p.shape[0]
     draws = np.zeros((worlds, n, n), dtype=bool)
     with _Chains(p, chains=1, seed=seed, burn_in=burn_in, tries=tries) as state:
