@@ -1,4 +1,6 @@
-"""The one-call API a planner codes against (re-exported by :mod:`unstack`).
+"""The one-call API a planner codes against (``decide``, ``plan``, ``load_model`` and
+``support_probabilities`` are re-exported by :mod:`unstack`; ``payoff`` and ``model_names``
+are called from here: ``unstack.api.payoff``).
 
 ``load_model`` names a shipped model or reads a model file; ``support_probabilities`` turns
 a scene into support probabilities with a model (the default one when none is given);

@@ -262,8 +262,10 @@ def _downward_top(box: Box) -> float:
 
 def _cloud_under(columns: CloudColumns, box: Box, bound: np.ndarray, others: Sequence[Box]) -> np.ndarray:
     """Points of the cloud just under the box's downward faces, away from its edges (its own
-    visible faces, noisy near the edges, are not taken for something under it), and not on
-    a detected box (whose contacts count already); in the order of the cloud sorted by x."""
+    visible faces, noisy near the edges, are not taken for something under it), and not within
+    :data:`CONTACT_GAP` of a detected box (whose contacts count already: a sensor's noise puts
+    points of the face a box leans on 5-10 mm off it, and those once made a leaning box's base
+    reach past its centre of mass); in the order of the cloud sorted by x."""
     low, high = bound[:3] - CONTACT_GAP, bound[3:] + CONTACT_GAP
     high[2] = min(high[2], _downward_top(box) + CONTACT_GAP + 1e-9)  # none higher lies that near a downward face
     column = columns.points[columns.indices_over(low[:2], high[:2])]
@@ -280,7 +282,7 @@ def _cloud_under(columns: CloudColumns, box: Box, bound: np.ndarray, others: Seq
     for other in others:
         if len(candidates) == 0:
             break
-        candidates = candidates[_distances(candidates, other)[0] > CONTACT_BAND]
+        candidates = candidates[_distances(candidates, other)[0] > CONTACT_GAP]
     return candidates[:, :2]
 
 
