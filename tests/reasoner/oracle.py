@@ -1,10 +1,13 @@
-"""An independent brute-force oracle: every one of the 2^(n(n-1)) worlds, checked by numpy."""
+"""An independent brute-force oracle: every one of the 2^(n(n-1)) worlds, checked by numpy; and
+the rule a sampled answer is held to against an exact one."""
 
 from __future__ import annotations
 
 from itertools import permutations
 
 import numpy as np
+
+from unstack.reasoner.sampling import SampledMarginals
 
 
 def brute_force(probabilities: np.ndarray) -> tuple[np.ndarray, int]:
@@ -25,3 +28,12 @@ def brute_force(probabilities: np.ndarray) -> tuple[np.ndarray, int]:
     for (x, y), k in index.items():
         marginals[x, y] = weights[bits[:, k]].sum() / weights.sum()
     return marginals, int(live.sum())
+
+
+def assert_within_errors(result: SampledMarginals, exact: np.ndarray) -> None:
+    """Every sampled marginal and expected cost (unit weights) within 5 of its standard errors
+    (and 2e-3) of the exact marginals ``exact``."""
+    off = ~np.eye(len(exact), dtype=bool)
+    assert np.all(np.abs(result.marginals - exact)[off] <= 5 * result.standard_errors[off] + 2e-3)
+    costs, covariance = result.errors_of(np.ones(len(exact)))
+    assert np.all(np.abs(costs - exact.sum(axis=1)) <= 5 * np.sqrt(np.diag(covariance)) + 2e-3)

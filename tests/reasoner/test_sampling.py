@@ -11,6 +11,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
+from tests.reasoner.oracle import assert_within_errors
 from unstack.errors import UnstackError
 from unstack.reasoner import sampling
 from unstack.reasoner.marginals import exact_marginals
@@ -48,11 +49,7 @@ def is_transitive(world: np.ndarray) -> bool:
 def test_marginals_agree_with_the_exact_engine(rng: np.random.Generator, n: int, kind: str) -> None:
     p = random_probabilities(rng, n, kind)
     exact = exact_marginals(p).marginals
-    result = sampled_marginals(p, samples=16_000, seed=1)
-    off = ~np.eye(n, dtype=bool)
-    assert np.all(np.abs(result.marginals - exact)[off] <= 5 * result.standard_errors[off] + 2e-3)
-    costs, covariance = result.errors_of(np.ones(n))
-    assert np.all(np.abs(costs - exact.sum(axis=1)) <= 5 * np.sqrt(np.diag(covariance)) + 2e-3)
+    assert_within_errors(sampled_marginals(p, samples=16_000, seed=1), exact)
 
 
 @pytest.mark.parametrize("moves", [1, 2])
@@ -65,10 +62,7 @@ def test_sweeps_of_a_few_re_insertions_in_turn_agree_with_the_exact_engine(
     exact = exact_marginals(p).marginals
     result = sampled_marginals(p, samples=16_000, seed=1, blocks=False)
     assert result.samples == 16_000
-    costs, covariance = result.errors_of(np.ones(6))
-    assert np.all(np.abs(costs - exact.sum(axis=1)) <= 5 * np.sqrt(np.diag(covariance)) + 2e-3)
-    off = ~np.eye(6, dtype=bool)
-    assert np.all(np.abs(result.marginals - exact)[off] <= 5 * result.standard_errors[off] + 2e-3)
+    assert_within_errors(result, exact)
 
 
 def test_independent_components_up_to_forty_boxes(rng: np.random.Generator) -> None:
