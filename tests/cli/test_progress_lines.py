@@ -57,3 +57,16 @@ def test_a_sampled_decision_says_how_many_sweeps_of_how_many_and_the_time_left(
         sampled[-1],
     )
     assert decision.to_dict() == unstack.decide(supports, samples=200_000, seed=0).to_dict()  # unwatched: the same
+
+
+def test_a_long_pile_says_which_maker_empties_it_and_how_far(capsys: pytest.CaptureFixture[str]) -> None:
+    from unstack.sim.progress import watching_picks
+
+    with watching_picks() as picks, progress._log_lines("piles", every=0.05, within=picks.line) as report:
+        report(0, 2)
+        picks.pile("config-0000", "lookahead")
+        picks.pick(12, 21)
+        time.sleep(0.12)
+    assert capsys.readouterr().err.splitlines()[-1] == (
+        "piles 0 of 2 after 0 s; config-0000, lookahead: 12 picks, 21 boxes left"
+    )

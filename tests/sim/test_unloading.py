@@ -151,6 +151,22 @@ def test_a_pick_limit_stops_the_run_and_says_so(pile: Scene) -> None:
     assert run.to_dict()["stopped"] == "pick limit"
 
 
+def test_a_watched_run_says_its_picks_and_the_boxes_left(pile: Scene) -> None:
+    from unstack.sim.progress import watching_picks
+
+    seen: list[tuple[int, int]] = []
+
+    def watched_highest(current: Scene) -> str:
+        seen.append((watch.picks, watch.left))
+        return highest_first(current)
+
+    with watching_picks() as watch:
+        unload_container(pile, watched_highest, max_picks=2)
+    assert seen[0] == (0, len(pile.boxes))  # the policy is asked with the pile whole
+    assert seen[1][0] == 1 and seen[1][1] <= len(pile.boxes) - 1  # one box out (and any lost with it)
+    assert len(seen) == 2 and watch.picks == 2
+
+
 def test_detector_noise_moves_the_reported_boxes_reproducibly(pile: Scene) -> None:
     reported: list[list[np.ndarray]] = []
 

@@ -122,10 +122,11 @@ def _run_piles(
     """Run an experiment on piles (on a dask.distributed scheduler's workers when given one) with a
     progress bar, each pile's result kept in ``OUT/checkpoints``: the results folder and the result."""
     from unstack.sim.dataset import scheduler_client
+    from unstack.sim.progress import watching_picks
 
     with scheduler_client(scheduler, arguments.get("n_jobs", 1)) as client:  # fails in seconds, before any output
         folder = results_folder(out)
-        with progress_bar("piles") as report:
+        with watching_picks() as picks, progress_bar("piles", within=picks.line) as report:
             result = run(**arguments, progress=report, checkpoints=folder / checkpoints, client=client)
     return folder, result
 
@@ -467,7 +468,8 @@ def container(
     Every decision maker unloads the same piles; boxes moved, fallen and calm picks are
     compared with unstack's (paired over piles). Resumable: OUT/container-piles keeps each
     pile's result. The default makers take minutes a pile of 30-40 boxes (the look-ahead tries
-    every candidate in the engine); --makers unstack,highest takes about 15 s.
+    every candidate in the engine); --makers unstack,highest takes about 15 s. With --jobs 1
+    the progress says which maker empties which pile, and how far.
     """
     from unstack.cli.main import load_model_option
     from unstack.dataset_folders import require_configurations

@@ -17,12 +17,16 @@ LOG_EVERY = 30.0
 
 @contextmanager
 def _log_lines(
-    description: str, every: float = LOG_EVERY, detail: Callable[[float], str | None] | None = None
+    description: str,
+    every: float = LOG_EVERY,
+    detail: Callable[[float], str | None] | None = None,
+    within: Callable[[], str | None] | None = None,
 ) -> Iterator[Callable[[int, int], None]]:
     """Yield ``report(done, total)``; while the block runs, a line on stderr every ``every``
     seconds saying the latest count reported (none before the first report: ``description after
     N s``), so that work inside one long step says it is alive too; work done sooner writes nothing.
-    ``detail(seconds)``, when it returns words, is the whole line instead.
+    ``detail(seconds)``, when it returns words, is the whole line instead; ``within()``, when it
+    returns words, says where the step under way is, after the count.
     """
     start = time.monotonic()
     latest: list[tuple[int, int]] = []
@@ -33,8 +37,10 @@ def _log_lines(
             seconds = time.monotonic() - start
             where = f" {latest[0][0]:,} of {latest[0][1]:,}" if latest else ""
             said = None if detail is None else detail(seconds)
+            inside = None if within is None else within()
+            step = f"; {inside}" if inside else ""
             try:
-                print(said or f"{description}{where} after {seconds:.0f} s", file=sys.stderr, flush=True)
+                print(said or f"{description}{where} after {seconds:.0f} s{step}", file=sys.stderr, flush=True)
             except (OSError, ValueError):  # stderr closed or gone: nothing more to say
                 return
 
@@ -73,27 +79,38 @@ def still_working(description: str, every: float = LOG_EVERY) -> Iterator[None]:
 
 
 @contextmanager
-def progress_bar(description: str) -> Iterator[Callable[[int, int], None]]:
+def progress_bar(
+    description: str, within: Callable[[], str | None] | None = None
+) -> Iterator[Callable[[int, int], None]]:
     """Yield ``report(done, total)``; the bar (with ETA) disappears when the block ends.
+    ``within()``, when it returns words, says where the step under way is (beside the bar, or
+    after the count of a plain line): ``config-0003, lookahead: 12 picks, 21 boxes left``.
 
     Drawn only when standard error is a terminal; in a pipe or a log, long work says where it
     is in a plain line every :data:`LOG_EVERY` seconds (``planning: steps 12 of 200 after 41
     s``), within a long step too, and work done sooner writes nothing.
     """
     from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, ProgressColumn, TimeRemainingColumn
+    from rich.text import Text
 
     console = Console(stderr=True)
     if not console.is_terminal:
-        with _log_lines(description) as report:
+        with _log_lines(description, within=within) as report:
             yield report
         return
+
+    class Within(ProgressColumn):
+        def render(self, task: object) -> Text:
+            return Text((within() or "") if within is not None else "", style="progress.description")
+
     with Progress(
         f"[progress.description]{description}",
         BarColumn(),
         MofNCompleteColumn(),
         "ETA",
         TimeRemainingColumn(),
+        Within(),
         console=console,
         transient=True,
     ) as bar:

@@ -656,6 +656,7 @@ def _run_pile(
 ) -> tuple[int, dict[str, Any]]:
     """Every decision maker empties one pile (``number`` comes back for the caller's order)."""
     from unstack.scene import load_scene
+    from unstack.sim.progress import pick_progress
     from unstack.sim.unloading import unload_container
 
     scene = load_scene(path)
@@ -664,7 +665,10 @@ def _run_pile(
         model, seed=options["seed"], samples=options["samples"], makers=makers, disturbance=options["disturbance"],
         occupancy=options["occupancy"],
     )  # fmt: skip
+    watch = pick_progress()
     for maker, policy in policies.items():
+        if watch is not None:
+            watch.pile(path.stem, maker)
         run = unload_container(
             scene, policy, detector_noise=options["detector_noise"], detector_misses=options["detector_misses"],
             reach=options["reach"], max_picks=options["max_picks"], seed=options["seed"],

@@ -309,6 +309,7 @@ def unload_container(
     -------
     UnloadRun
     """
+    from unstack.sim.progress import pick_progress
     from unstack.sim.sensor import scan_pile
     from unstack.understanding.detector import detector_poses
 
@@ -323,8 +324,11 @@ def unload_container(
     settings = _scene_settings(scene)
     limit = len(scene.boxes) if max_picks is None else min(max_picks, len(scene.boxes))
     stopped = ["container empty" if limit == len(scene.boxes) else "pick limit"]
+    watch = pick_progress()
 
     def sense_and_pick(number: int, world: Any, in_place: list[str]) -> str | None:
+        if watch is not None:
+            watch.pick(number, len(in_place))
         if number >= limit or not in_place:
             return None
         true_boxes = _boxes_in_place(scene, world, in_place)
