@@ -1,10 +1,11 @@
 """How far a long sampling run is, for whoever prints progress: the sweeps recorded of those
 asked in the group being sampled.
 
-Passed by a context variable rather than by argument, so that no signature grows, a call that
-does not watch pays one lookup a group, and threads (each with its own context) never see each
-other's counts. A command watches its decision with :func:`watching_sampling` and reads the
-object it yields from another thread (a ticker); the sampler writes it on the calling thread.
+Passed by a context variable rather than by argument (:mod:`unstack.watching`), so that no
+signature grows, a call that does not watch pays one lookup a group, and threads (each with its
+own context) never see each other's counts. A command watches its decision with
+``watching_sampling()`` and reads the object it yields from another thread (a ticker); the
+sampler writes it on the calling thread.
 
 Examples
 --------
@@ -20,10 +21,9 @@ Examples
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
-from contextvars import ContextVar
 from dataclasses import dataclass
+
+from unstack.watching import Watched
 
 __all__ = ["SamplingProgress", "sampling_progress", "watching_sampling"]
 
@@ -71,20 +71,8 @@ class SamplingProgress:
         return seconds * (self.total - self.done) / self.done
 
 
-_WATCH: ContextVar[SamplingProgress | None] = ContextVar("unstack_sampling_progress", default=None)
-
-
-@contextmanager
-def watching_sampling() -> Iterator[SamplingProgress]:
-    """Yield the :class:`SamplingProgress` that sampling in this block (on this thread) writes."""
-    progress = SamplingProgress()
-    token = _WATCH.set(progress)
-    try:
-        yield progress
-    finally:
-        _WATCH.reset(token)
-
-
-def sampling_progress() -> SamplingProgress | None:
-    """What sampling on this thread should write, if anybody watches."""
-    return _WATCH.get()
+_SAMPLING = Watched("sampling_progress", SamplingProgress)
+#: Yield the :class:`SamplingProgress` that sampling in this block (on this thread) writes.
+watching_sampling = _SAMPLING.watching
+#: What sampling on this thread should write, if anybody watches.
+sampling_progress = _SAMPLING.current

@@ -1,10 +1,9 @@
 """Where a long unloading run is, for whoever prints progress: the pile, the decision maker, the
 picks made and the boxes still in place.
 
-Passed by a context variable, as :mod:`unstack.reasoner.progress` passes the sampler's, so that
-no signature grows and threads never see each other's runs: a command watches with
-:func:`watching_picks` and reads the object it yields from another thread (a ticker); the
-unloading writes it on the calling thread. Piles run in other processes (``--jobs``, a dask
+Passed by a context variable (:mod:`unstack.watching`), as the sampler's progress is: a command
+watches with ``watching_picks()`` and reads the object it yields from another thread (a
+ticker); the unloading writes it on the calling thread. Piles run in other processes (``--jobs``, a dask
 cluster) are not seen.
 
 Examples
@@ -18,10 +17,9 @@ Examples
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from contextlib import contextmanager
-from contextvars import ContextVar
 from dataclasses import dataclass
+
+from unstack.watching import Watched
 
 __all__ = ["PickProgress", "pick_progress", "watching_picks"]
 
@@ -50,20 +48,8 @@ class PickProgress:
         return f"{self.name}, {self.maker}: {self.picks} picks, {self.left} boxes left"
 
 
-_WATCH: ContextVar[PickProgress | None] = ContextVar("unstack_pick_progress", default=None)
-
-
-@contextmanager
-def watching_picks() -> Iterator[PickProgress]:
-    """Yield the :class:`PickProgress` that unloading in this block (on this thread) writes."""
-    progress = PickProgress()
-    token = _WATCH.set(progress)
-    try:
-        yield progress
-    finally:
-        _WATCH.reset(token)
-
-
-def pick_progress() -> PickProgress | None:
-    """What unloading on this thread should write, if anybody watches."""
-    return _WATCH.get()
+_PICKS = Watched("pick_progress", PickProgress)
+#: Yield the :class:`PickProgress` that unloading in this block (on this thread) writes.
+watching_picks = _PICKS.watching
+#: What unloading on this thread should write, if anybody watches.
+pick_progress = _PICKS.current
