@@ -113,3 +113,50 @@ def test_more_undetected_boxes_on_a_box_than_a_stack_holds_are_warned_about_with
         "(50); a count of boxes, not kg?",
     )
     assert decide(loaded, cost="count").warnings == ()
+
+
+def _ten_boxes_with(entries: dict[tuple[int, int], float]) -> Supports:
+    """Ten weakly linked boxes (one sampled group) with ``entries`` set."""
+    probabilities = np.full((10, 10), 0.3)
+    np.fill_diagonal(probabilities, 0.0)
+    for (x, y), value in entries.items():
+        probabilities[x, y] = value
+    return Supports([f"b{k}" for k in range(10)], probabilities)
+
+
+@pytest.mark.parametrize(
+    ("entries", "named"),
+    [
+        ({(0, 1): 1 - 1e-9}, "1 relation has a probability within 0.001 of 1 but not 1 (b0 -> b1: 0.999999999)"),
+        (
+            {(0, 1): 0.9995, (2, 3): 0.99999, (4, 5): 0.9999, (6, 7): 0.9991, (3, 1): 1.0},
+            "4 relations have a probability within 0.001 of 1 but not 1 (b0 -> b1: 0.9995, b2 -> b3: 0.99999, "
+            "b4 -> b5: 0.9999 and 1 more)",
+        ),
+    ],
+    ids=["one", "four-named-three"],
+)
+def test_a_sampled_group_with_relations_near_but_not_at_1_is_warned_about(
+    entries: dict[tuple[int, int], float], named: str
+) -> None:
+    decision = decide(_ten_boxes_with(entries), seed=0, samples=200)
+    assert decision.component_methods == ("approx",)
+    [warning] = [text for text in decision.warnings if "within 0.001 of 1" in text]
+    assert warning.startswith(named) and warning.endswith(
+        "give 1 where it is meant (hard evidence is counted exactly) or compare two seeds"
+    )
+
+
+@pytest.mark.parametrize(
+    ("entries", "method"),
+    [({(0, 1): 1.0}, "auto"), ({(0, 1): 0.998}, "auto"), ({(0, 1): 1 - 1e-9}, "exact")],
+    ids=["exactly-1", "a-models-highest", "counted-exactly"],
+)
+def test_relations_at_1_far_from_it_or_counted_exactly_are_not_warned_about(
+    entries: dict[tuple[int, int], float], method: str
+) -> None:
+    supports = _ten_boxes_with(entries)
+    if method == "exact":  # a group small enough to count
+        supports = Supports(supports.objects[:6], supports.probabilities[:6, :6])
+    decision = decide(supports, seed=0, samples=200, method="auto" if method == "exact" else method)
+    assert not any("within 0.001 of 1" in text for text in decision.warnings)

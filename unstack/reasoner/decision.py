@@ -87,6 +87,12 @@ MINIMUM_SAMPLING = 0.05
 LOW_ACCEPTANCE = 0.05
 #: Above this Gelman-Rubin R-hat of any sampled EC the decision warns that the chains disagree.
 HIGH_RHAT = 1.1
+#: A probability this close to 1 but not 1, in a sampled group, pins the chains: a relation
+#: the sampler must break to move a box is almost never broken, and the standard errors do not
+#: show it (``benchmarks/near_certain.py``); the decision warns.
+NEAR_CERTAIN = 1e-3
+#: Near-certain relations named one by one in that warning, before "and N more".
+NAMED_PAIRS = 3
 #: Relative tolerance under which two expected costs count as tied.
 TIE_TOLERANCE = 1e-12
 #: Expected costs within this many boxes of the lowest count as tied when heights are known;
@@ -608,6 +614,8 @@ def decide(
     largest = int(np.argmax([len(group) for group in groups]))
     sampling = _sampling_summary(results, seed)
     sampling_warning = (sampling["warning"],) if sampling and "warning" in sampling else ()
+    sampled_groups = [group for group, used in zip(groups, methods, strict=True) if used == "approx" and len(group) > 1]
+    sampling_warning += _near_certain_doubt(supports, evidence.probabilities, sampled_groups)
     return Decision(
         objects=supports.objects,
         choice=choice,
@@ -631,6 +639,36 @@ def decide(
         sampling_seconds=sum(result.sampled.seconds for result in results if result.sampled is not None),
         near_tie_margin=margin,
         reasons=tuple(pick_reasons(supports, marginals, costs)) if cost in REASON_COSTS else (),
+    )
+
+
+def _near_certain_doubt(
+    supports: Supports, probabilities: np.ndarray, sampled_groups: list[np.ndarray]
+) -> tuple[str, ...]:
+    """A warning when a sampled group holds relations within :data:`NEAR_CERTAIN` of 1 but not 1.
+
+    Examples
+    --------
+    >>> p = np.array([[0.0, 1 - 1e-9], [0.2, 0.0]])
+    >>> [text[:50] for text in _near_certain_doubt(Supports(["a", "b"], p), p, [np.array([0, 1])])]
+    ['1 relation has a probability within 0.001 of 1 but']
+    """
+    pairs = []
+    for group in sampled_groups:
+        inside = probabilities[np.ix_(group, group)]
+        near = (inside > 1.0 - NEAR_CERTAIN) & (inside < 1.0)
+        pairs += [(int(group[x]), int(group[y])) for x, y in zip(*np.nonzero(near), strict=True)]
+    if not pairs:
+        return ()
+    named = ", ".join(
+        f"{supports.objects[x]} -> {supports.objects[y]}: {probabilities[x, y]:.9g}" for x, y in pairs[:NAMED_PAIRS]
+    )
+    more = f" and {len(pairs) - NAMED_PAIRS} more" if len(pairs) > NAMED_PAIRS else ""
+    relations = "1 relation has" if len(pairs) == 1 else f"{len(pairs)} relations have"
+    return (
+        f"{relations} a probability within {NEAR_CERTAIN:g} of 1 but not 1 ({named}{more}): the sampler "
+        "almost never breaks them to move a box, and its standard errors may be too small; give 1 where it is "
+        "meant (hard evidence is counted exactly) or compare two seeds",
     )
 
 
