@@ -613,7 +613,7 @@ def decide(
     choice, ties = choose(supports.objects, costs, heights=supports.heights, margin=margin)
     largest = int(np.argmax([len(group) for group in groups]))
     sampling = _sampling_summary(results, seed)
-    sampling_warning = (sampling["warning"],) if sampling and "warning" in sampling else ()
+    sampling_warning: tuple[str, ...] = (sampling["warning"],) if sampling and "warning" in sampling else ()
     sampled_groups = [group for group, used in zip(groups, methods, strict=True) if used == "approx" and len(group) > 1]
     sampling_warning += _near_certain_doubt(supports, evidence.probabilities, sampled_groups)
     return Decision(
