@@ -115,6 +115,33 @@ def test_a_box_with_nothing_known_under_it_is_left_to_the_floating_warning() -> 
     assert tip_supports(Scene(scene.boxes, np.zeros((0, 3)), scene.detected)) == []
 
 
+def _overhang_against_a_column(beyond: float, column: bool = True) -> Scene:
+    """An upright carton on a short box, its centre ``beyond`` metres past the short box's
+    edge towards a tall column whose side it touches (or nothing there)."""
+    short = Box("short", [0.4, 0.3, 0.2], [1.3, -0.45, 0.1])
+    width = 0.5
+    carton = Box("carton", [0.4, width, 0.25], [1.3, -0.3 + beyond, 0.2 + 0.125 + 0.001])
+    tall = Box("tall", [0.4, 0.4, 0.75], [1.3, -0.3 + beyond + width / 2 + 0.2 + 0.002, 0.375])
+    boxes = [tall, short, carton] if column else [short, carton]
+    return Scene(boxes, np.zeros((0, 3)), [box.id for box in boxes])
+
+
+@pytest.mark.parametrize("beyond", [0.04, 0.08])
+def test_an_upright_box_whose_centre_is_well_past_its_base_leans_on_the_box_beside_it(beyond: float) -> None:
+    found = tip_supports(_overhang_against_a_column(beyond))
+    assert [(f.supporter, f.held, f.on_floor) for f in found] == [("tall", "carton", False)]
+    assert found[0].overhang == pytest.approx(beyond, abs=0.011)  # the base's grid is 2 cm
+
+
+@pytest.mark.parametrize("beyond", [0.0, 0.02])
+def test_an_upright_box_within_a_pose_error_of_its_base_is_left_to_the_model(beyond: float) -> None:
+    assert tip_supports(_overhang_against_a_column(beyond)) == []
+
+
+def test_an_upright_box_past_its_base_with_nothing_beside_it_has_no_supporter_to_find() -> None:
+    assert tip_supports(_overhang_against_a_column(0.08, column=False)) == []
+
+
 @pytest.mark.parametrize("seed", range(4))
 def test_every_leaning_scene_of_the_suite_is_found_on_both_clouds(seed: int) -> None:
     case = build_case("leaning", seed=seed)

@@ -2,7 +2,7 @@
 
 Each kind builds a small scene a robot engineer might meet on the first day -- a tower, a
 bridge, a wall, a staircase, a box leaning on another, load nobody detected, boxes against
-the container's walls -- with random
+the container's walls, a carton kept from tipping by the tall box beside it -- with random
 box sizes, gaps, positions and yaw from a seed, so that a test or a check draws as many
 variants of a kind as it likes. A scene says which detected boxes may be picked (those that
 hold up nothing, detected or not) and which carry load, with how many boxes each holds up.
@@ -333,6 +333,24 @@ def _against_the_walls(builder: _Builder, in_container: bool) -> CanonicalCase:
     return builder.case("against_the_walls", in_container=in_container)
 
 
+def _overhang(builder: _Builder, in_container: bool) -> CanonicalCase:
+    """A carton upright on a short box, its centre past that box's edge, kept from tipping by a
+    tall box whose side it touches: the tall box is the highest and holds the carton up."""
+    short = builder.size((0.35, 0.25, 0.15), (0.45, 0.35, 0.25))
+    builder.place("short", short, ORIGIN_X, -0.35, yaw=0.0)
+    carton = builder.size((0.35, 0.45, 0.25), (0.45, 0.55, 0.32))
+    # past the short box's edge, by less than pushes the tall box away (physical_check: stable)
+    centre = -0.35 + short[1] / 2 + float(builder.rng.uniform(0.05, 0.065))
+    tall = np.array([0.45, 0.45, float(builder.rng.uniform(0.75, 0.9))])
+    builder.place("tall", tall, ORIGIN_X, centre + carton[1] / 2 + tall[1] / 2 + 0.002, yaw=0.0)
+    bottom = builder.tops["short"]
+    builder.boxes["carton"] = Box("carton", carton, [ORIGIN_X, centre, bottom + carton[2] / 2 + 0.001], _yaw(0.0))
+    builder.tops["carton"] = bottom + float(carton[2]) + 0.001
+    builder.rests_on["carton"] = ["short", "tall"]
+    builder.place("free", builder.size(), ORIGIN_X, -0.85)
+    return builder.case("overhang", in_container=in_container)
+
+
 #: The kinds of the suite: name -> builder (takes a seeded builder and where the scene stands).
 CANONICAL_KINDS: dict[str, Callable[[_Builder, bool], CanonicalCase]] = {
     "plain_stack": _plain_stack,
@@ -352,6 +370,7 @@ CANONICAL_KINDS: dict[str, Callable[[_Builder, bool], CanonicalCase]] = {
     "across_two": _across_two,
     "mixed_sizes": _mixed_sizes,
     "against_the_walls": _against_the_walls,
+    "overhang": _overhang,
 }
 
 

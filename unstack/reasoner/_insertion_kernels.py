@@ -171,6 +171,52 @@ def _lattice_sums2(
 
 
 @njit(cache=True, nogil=True, fastmath=True)
+def _weights_of_sets(
+    sets: np.ndarray,
+    n: int,
+    weights: np.ndarray,
+    m: int,
+    a_bit: np.int64,
+    own: np.ndarray,
+    next_own: np.ndarray,
+    next_with_a: np.ndarray,
+) -> None:
+    """For each of the ``n`` sets: its weight for box ``m`` (``own``), for box ``m + 1``
+    (``next_own``) and for box ``m + 1`` with box ``m`` added to it (``next_with_a``)."""
+    for k in range(n):
+        mask = sets[k]
+        own[k] = weights[m, mask]
+        next_own[k] = weights[m + 1, mask]
+        next_with_a[k] = weights[m + 1, mask | a_bit]
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def _sums_over_inside(
+    ups: np.ndarray, n_ups: int, above: np.ndarray, n_downs: int, up_values: np.ndarray, out: np.ndarray
+) -> None:
+    """``out[s]``: ``up_values`` summed over the up-sets inside ``A(D_s)`` (``above[s]``)."""
+    for s in range(n_downs):
+        a_s = above[s]
+        acc = 0.0
+        for t in range(n_ups):
+            acc += np.float64(ups[t] & ~a_s == 0) * up_values[t]
+        out[s] = acc
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def _sums_over_containing(
+    ups: np.ndarray, n_ups: int, above: np.ndarray, n_downs: int, down_values: np.ndarray, out: np.ndarray
+) -> None:
+    """``out[t]``: ``down_values`` summed over the down-sets ``D`` with ``ups[t]`` inside ``A(D)``."""
+    for t in range(n_ups):
+        u = ups[t]
+        acc = 0.0
+        for s in range(n_downs):
+            acc += np.float64(u & ~above[s] == 0) * down_values[s]
+        out[t] = acc
+
+
+@njit(cache=True, nogil=True, fastmath=True)
 def _last_two_levels(
     m: int,
     path_weight: float,
@@ -258,46 +304,33 @@ def _last_two_levels(
     same_down = scratch[37]
     same_up = scratch[38]
     below = index_scratch[0]
+    # the weights of a (level m) and b (m + 1, with a or without) at each set; sums cleared
+    _weights_of_sets(ups, n_ups, up_weights, m, a_bit, g1, g2, g2a)
+    _weights_of_sets(downs, n_downs, down_weights, m, a_bit, f1, f2, f2a)
     for t in range(n_ups):
-        u = ups[t]
-        g1[t] = up_weights[m, u]
-        g2[t] = up_weights[b, u]
-        g2a[t] = up_weights[b, u | a_bit]
-        x_at[u] = 0.0
-        z_at[u] = 0.0
-        up_m[t] = 0.0
-        up_ba[t] = 0.0
-        wc2[t] = 0.0
-        same_up[t] = 0.0
+        x_at[ups[t]] = 0.0
+        z_at[ups[t]] = 0.0
     for s in range(n_downs):
-        d = downs[s]
-        f1[s] = down_weights[m, d]
-        f2[s] = down_weights[b, d]
-        f2a[s] = down_weights[b, d | a_bit]
-        y_at[d] = 0.0
-        down_m[s] = 0.0
-        down_b[s] = 0.0
-        down_ba[s] = 0.0
-        wc3[s] = 0.0
-        same_down[s] = 0.0
+        y_at[downs[s]] = 0.0
+    up_m[:n_ups] = 0.0
+    up_ba[:n_ups] = 0.0
+    wc2[:n_ups] = 0.0
+    same_up[:n_ups] = 0.0
+    down_m[:n_downs] = 0.0
+    down_b[:n_downs] = 0.0
+    down_ba[:n_downs] = 0.0
+    wc3[:n_downs] = 0.0
+    same_down[:n_downs] = 0.0
     # below[t]: the largest down-set D with ups[t] inside A(D); psi[t]: sum of f2a over the
     # down-sets D with ups[t] inside A(D); psi2[s]: sum of g2a over the up-sets inside A(D_s)
     for t in range(n_ups):
         u = ups[t]
         union = np.int64(0)
-        acc = 0.0
         for s in range(n_downs):
-            fits = u & ~above[s] == 0
-            union |= downs[s] * np.int64(fits)
-            acc += np.float64(fits) * f2a[s]
+            union |= downs[s] * np.int64(u & ~above[s] == 0)
         below[t] = union
-        psi[t] = acc
-    for s in range(n_downs):
-        a_s = above[s]
-        acc = 0.0
-        for t in range(n_ups):
-            acc += np.float64(ups[t] & ~a_s == 0) * g2a[t]
-        psi2[s] = acc
+    _sums_over_containing(ups, n_ups, above, n_downs, f2a, psi)
+    _sums_over_inside(ups, n_ups, above, n_downs, g2a, psi2)
     # subset sums over the up-sets (g1, g2) and down-sets (f2), placed at their masks
     _lattice_sums2(ups, n_ups, g1, g2, t_a, t_b, False)
     for t in range(n_ups):
@@ -320,18 +353,8 @@ def _last_two_levels(
     _lattice_sums(ups, n_ups, t_c, q, False)
     _lattice_sums(downs, n_downs, s_c, q2, False)
     # r_above[s]: t_d summed over the up-sets inside A(D_s); r2_below[t]: s_d over D inside below[t]
-    for s in range(n_downs):
-        a_s = above[s]
-        acc = 0.0
-        for t in range(n_ups):
-            acc += np.float64(ups[t] & ~a_s == 0) * t_d[t]
-        r_above[s] = acc
-    for t in range(n_ups):
-        u = ups[t]
-        acc = 0.0
-        for s in range(n_downs):
-            acc += np.float64(u & ~above[s] == 0) * s_d[s]
-        r2_below[t] = acc
+    _sums_over_inside(ups, n_ups, above, n_downs, t_d, r_above)
+    _sums_over_containing(ups, n_ups, above, n_downs, s_d, r2_below)
     total = 0.0
     # a and b unrelated: any two down-sets; each box's up-sets summed by the subset sums
     for i in range(n_downs):

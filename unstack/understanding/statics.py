@@ -14,7 +14,9 @@ without a model. For each detected box ``Y``:
   tip over that edge: a detected box ``X`` that touches it at least :data:`MIN_RISE` above
   its lowest point, beyond that edge, and pushes it back (its push has a horizontal part of
   at least :data:`MIN_PUSH` against the overhang and does not press ``Y`` down) holds it up
-  -- the box it leans on;
+  -- the box it leans on. A box standing upright is examined the same way when its centre
+  lies more than :data:`UPRIGHT_OVERHANG` outside its base (a carton on a short box whose
+  centre is past that box's edge, kept from tipping by a taller box beside it);
 * a box that stands, tilted or not, is held up by a detected box of its base without whose
   contacts it would tip (the centre more than :data:`MIN_OVERHANG` outside the rest of the
   base, that box's contacts beyond its edge): a box across a gap between two, a box on its
@@ -64,6 +66,7 @@ __all__ = [
     "MIN_OVERHANG",
     "MIN_TILT_DEG",
     "TIP_SUPPORT_PROBABILITY",
+    "UPRIGHT_OVERHANG",
     "TipSupport",
     "raise_tip_supports",
     "tip_supports",
@@ -101,6 +104,14 @@ SAMPLE_SPACING = 0.02
 UPWARD = 0.7
 #: The centre of mass must lie this far outside the base for the box to tip (metres).
 MIN_OVERHANG = 0.01
+#: A box standing upright (tilted less than :data:`MIN_TILT_DEG`) is examined for leaning when
+#: its centre lies more than this outside its base (metres): its pose and the pose of the box
+#: under it, a centimetre off each, and one :data:`SAMPLE_SPACING`, the spacing of the points
+#: its base is measured on, do not make a box on a box look as if it overhangs.
+UPRIGHT_OVERHANG = 0.04
+#: Friction between two cartons (the simulator's, and cardboard's 0.4-0.6): with it, how far past
+#: its base a push from the side can hold an upright box (:func:`_held_overhang`).
+FRICTION = 0.5
 #: A box holding the leaning one pushes back against the overhang by at least this share.
 MIN_PUSH = 0.3
 #: ... and touches it at least this high above its lowest point (metres).
@@ -314,31 +325,16 @@ def tip_supports(
     found: list[TipSupport] = []
     for row, box in enumerate(boxes):
         tilted = tilt_deg(box) >= MIN_TILT_DEG
-        samples, normals, on_bounds, rotation = _face_samples(box, downward_only=not tilted)
-        base: dict[int, np.ndarray] = {_FLOOR: samples[samples[:, 2] <= CONTACT_GAP, :2]}
-        beside: dict[int, tuple[np.ndarray, np.ndarray]] = {}
-        for other in np.flatnonzero(_near(bounds, row, CONTACT_GAP)).tolist():
-            if other == row:
-                continue
-            distance, other_normals, other_bounds, other_rotation = _distances(samples, boxes[other])
-            closest = float(distance.min())
-            if closest > CONTACT_GAP:
-                continue
-            touching = distance <= max(closest, 0.0) + CONTACT_BAND
-            pushes = _pushes(
-                normals[touching], on_bounds[touching], rotation,
-                other_normals[touching], other_bounds[touching], other_rotation,
-            )  # fmt: skip
-            base[other] = samples[touching][pushes[:, 2] >= UPWARD, :2]
-            side = np.abs(pushes[:, 2]) < UPWARD
-            if np.any(side):
-                beside[other] = (samples[touching][side], pushes[side])
+        neighbours = [other for other in np.flatnonzero(_near(bounds, row, CONTACT_GAP)).tolist() if other != row]
+        base, beside, lowest = _contacts(box, boxes, neighbours, downward_only=not tilted)
         touched = [boxes[key] for key in base if key >= 0]
         base[_CLOUD] = _cloud_under(cloud, box, bounds[row], touched)
-        lowest = float(samples[:, 2].min())
-        tipping = _tipping(box, base, exclude=None) if tilted else None
-        if tipping is not None:  # it cannot stand on its base: what it leans on holds it
+        tipping = _tipping(box, base, exclude=None)
+        if tipping is not None and (tilted or tipping[0] > UPRIGHT_OVERHANG):  # it cannot stand on its base
+            if not tilted:  # upright, its centre well beyond its base: its sides were not sampled
+                _, beside, lowest = _contacts(box, boxes, neighbours, downward_only=False)
             overhang, edge, direction, on_floor = tipping
+            leant_on = []  # what it leans on holds it
             for supporter, (contacts, pushes) in beside.items():
                 holds = (
                     (pushes[:, :2] @ direction <= -MIN_PUSH)
@@ -346,9 +342,11 @@ def tip_supports(
                     & (contacts[:, 2] >= lowest + MIN_RISE)
                     & ((contacts[:, :2] - edge) @ direction > 0.0)
                 )
-                if np.any(holds):
-                    found.append(TipSupport(names[row], names[supporter], overhang, on_floor))
-            continue
+                if np.any(holds) and (tilted or overhang <= _held_overhang(contacts[holds], edge, direction, lowest)):
+                    leant_on.append(supporter)
+            found += [TipSupport(names[row], names[supporter], overhang, on_floor) for supporter in leant_on]
+            if tilted:
+                continue  # an upright box may also stand on boxes it needs each of: examined below
         for supporter in (key for key, part in base.items() if key >= 0 and len(part)):
             # it stands, but would it without this box? (a box on its edge resting on another's top edge)
             if not any(len(part) for key, part in base.items() if key not in (supporter, _CLOUD)):
@@ -365,6 +363,51 @@ def tip_supports(
 
 #: Keys of the floor's and the cloud's part of a base (boxes are keyed by their index).
 _FLOOR, _CLOUD = -1, -2
+
+
+def _contacts(
+    box: Box, boxes: Sequence[Box], neighbours: Sequence[int], *, downward_only: bool
+) -> tuple[dict[int, np.ndarray], dict[int, tuple[np.ndarray, np.ndarray]], float]:
+    """Where the floor and each neighbouring box hold ``box`` from below (points seen from
+    above, keyed by the neighbour's index, the floor's :data:`_FLOOR`), where each pushes it
+    sideways (the points and the pushes), and the box's lowest sampled point; sampled over its
+    downward faces only, or over all six."""
+    samples, normals, on_bounds, rotation = _face_samples(box, downward_only=downward_only)
+    base: dict[int, np.ndarray] = {_FLOOR: samples[samples[:, 2] <= CONTACT_GAP, :2]}
+    beside: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+    for other in neighbours:
+        distance, other_normals, other_bounds, other_rotation = _distances(samples, boxes[other])
+        closest = float(distance.min())
+        if closest > CONTACT_GAP:
+            continue
+        touching = distance <= max(closest, 0.0) + CONTACT_BAND
+        pushes = _pushes(
+            normals[touching], on_bounds[touching], rotation,
+            other_normals[touching], other_bounds[touching], other_rotation,
+        )  # fmt: skip
+        base[other] = samples[touching][pushes[:, 2] >= UPWARD, :2]
+        side = np.abs(pushes[:, 2]) < UPWARD
+        if np.any(side):
+            beside[other] = (samples[touching][side], pushes[side])
+    return base, beside, float(samples[:, 2].min())
+
+
+def _held_overhang(contacts: np.ndarray, edge: np.ndarray, direction: np.ndarray, lowest: float) -> float:
+    """The largest overhang (metres) a push at ``contacts`` can keep an upright box from tipping over
+    ``edge``, with :data:`FRICTION` at that push and at the edge: about the edge, the weight's
+    moment ``m g d`` against the push ``N`` at height ``h`` and its friction ``mu N`` at reach ``w``,
+    and the push no more than the edge's friction holds, ``N <= mu m g / (1 + mu^2)``, so
+    ``d <= mu (h + mu w) / (1 + mu^2)``. A larger one rests on something nobody detected.
+
+    Examples
+    --------
+    >>> contacts = np.array([[0.3, 0.0, 0.45]])  # 0.25 m above the edge, 0.3 m beyond it
+    >>> round(_held_overhang(contacts, np.zeros(2), np.array([1.0, 0.0]), 0.2), 3)
+    0.16
+    """
+    height = float(contacts[:, 2].max()) - lowest
+    reach = float(((contacts[:, :2] - edge) @ direction).max())
+    return FRICTION * (height + FRICTION * reach) / (1.0 + FRICTION**2)
 
 
 def _tipping(
