@@ -10,7 +10,7 @@ import pytest
 from PIL import Image
 
 from unstack.camera import load_depth, load_intrinsics, load_mask, load_pose
-from unstack.errors import InvalidFile
+from unstack.errors import InvalidArgument, InvalidFile
 
 
 def _png(path: Path, array: np.ndarray) -> Path:
@@ -50,11 +50,23 @@ def test_a_depth_image_without_readings_is_refused(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     "value, question",
     [(65535, r"every reading is 65535, the largest the image holds: a code for no reading\?"),
-     (52000, r"are the values in a finer unit than millimetres \(a depth scale of 0.25 mm, say\)\?")],
+     (52000, r"are the values in a finer unit than millimetres \(a depth scale of 0.1 mm, say: --depth-units 0.0001\)\?")],
 )  # fmt: skip
 def test_a_png_of_readings_beyond_any_camera_asks_the_right_question(tmp_path: Path, value: int, question: str) -> None:
     with pytest.raises(InvalidFile, match=f"declared in mm but the median reading is [0-9.]+ m: {question}"):
         load_depth(_png(tmp_path / "d.png", np.full((4, 5), value, dtype=np.uint16)))
+
+
+@pytest.mark.parametrize("units", ["0.0001", 0.0001])
+def test_a_depth_scale_in_metres_per_unit_reads_a_finer_unit(tmp_path: Path, units: str | float) -> None:
+    depth = load_depth(_png(tmp_path / "d.png", np.full((4, 5), 12500, dtype=np.uint16)), units=units)
+    assert depth[0, 0] == pytest.approx(1.25)
+
+
+@pytest.mark.parametrize("units", ["0.1mm", "cm", "0", "-0.001", "2", "nan", True])
+def test_depth_units_that_are_no_unit_nor_a_scale_are_refused(tmp_path: Path, units: object) -> None:
+    with pytest.raises(InvalidArgument, match=r"depth units: expected mm, m or the metres of one unit .* got "):
+        load_depth(_png(tmp_path / "d.png", np.full((4, 5), 1250, dtype=np.uint16)), units=units)  # type: ignore[arg-type]
 
 
 def test_a_pose_inside_an_object_is_read(tmp_path: Path) -> None:
@@ -132,6 +144,49 @@ def test_intrinsics_with_zero_distortion_and_other_keys_are_read_with_a_warning(
             _intrinsics(tmp_path, D=[0, 0, 0, 0, 0], distortion_model="plumb_bob", camera_name="front")
         )
     assert intrinsics.fx == 600.0
+
+
+@pytest.mark.parametrize(
+    "given",
+    [
+        {"cx": None, "cy": None, "ppx": 320.0, "ppy": 240.0},
+        {"fx": None, "fy": None, "cx": None, "cy": None, "K": [600.0, 0, 320.0, 0, 600.0, 240.0, 0, 0, 1]},
+        {"fx": None, "fy": None, "cx": None, "cy": None, "k": [600.0, 0, 320.0, 0, 600.0, 240.0, 0, 0, 1]},
+    ],
+    ids=["realsense-ppx-ppy", "ros-K", "ros2-k"],
+)
+def test_realsense_and_ros_intrinsics_are_read_as_a_pinholes(tmp_path: Path, given: dict[str, object]) -> None:
+    intrinsics = load_intrinsics(_intrinsics(tmp_path, **given))
+    assert (intrinsics.fx, intrinsics.fy, intrinsics.cx, intrinsics.cy) == (600.0, 600.0, 320.0, 240.0)
+
+
+@pytest.mark.parametrize(
+    ("given", "message"),
+    [
+        ({"ppx": 320.0}, r"\$\.ppx: expected cx or ppx \(RealSense's name for it\), not both"),
+        (
+            {"K": [600.0, 0, 320.0, 0, 600.0, 240.0, 0, 0, 1]},
+            r"\$\.K: expected the camera matrix K or fx, fy, cx, cy, not both",
+        ),
+        ({"fx": None, "fy": None, "cx": None, "cy": None, "K": [600.0, 0, 320.0]}, r"\$\.K: expected 9 numbers"),
+        (
+            {"fx": None, "fy": None, "cx": None, "cy": None, "K": [600.0, 3.0, 320.0, 0, 600.0, 240.0, 0, 0, 1]},
+            r"\$\.K: expected a pinhole camera matrix \[fx, 0, cx, 0, fy, cy, 0, 0, 1\]",
+        ),
+    ],
+    ids=["cx-and-ppx", "K-and-fx", "K-short", "K-skewed"],
+)
+def test_intrinsics_under_two_names_or_a_matrix_no_pinhole_has_are_refused(
+    tmp_path: Path, given: dict[str, object], message: str
+) -> None:
+    with pytest.raises(InvalidFile, match=message):
+        load_intrinsics(_intrinsics(tmp_path, **given))
+
+
+def test_a_bare_camera_matrix_is_refused_for_want_of_the_image_size(tmp_path: Path) -> None:
+    (tmp_path / "k.json").write_text(json.dumps([[600, 0, 320], [0, 600, 240], [0, 0, 1]]))
+    with pytest.raises(InvalidFile, match="a bare 3 x 3 matrix gives no image size"):
+        load_intrinsics(tmp_path / "k.json")
 
 
 def test_depth_readings_no_camera_gives_are_no_readings_with_a_warning(tmp_path: Path) -> None:

@@ -50,6 +50,7 @@ REFUSALS = [
     ([*SCENE, "--sizes", "0.4x0.3"], "--sizes: expected three edges"),
     ([*SCENE, "--ids", "a"], "--ids names 1 boxes but 2 masks"),
     ([*SCENE, "--depth-units", "m"], "declared in m but the median reading is"),
+    ([*SCENE, "--depth-units", "0.1mm"], "'--depth-units': expected mm, m or the metres of one unit (1e-06 to 1;"),
     ([*SCENE, "--ids", "a,"], "--ids: expected 2 non-empty box ids separated by commas, got 'a,'"),
     ([*SCENE, "--sizes", ""], "--sizes: expected sizes like 0.4x0.3x0.3 separated by commas, got ''"),
     ([*SCENE, "--sizes", "0.4x0.3x0.3,"], "separated by commas, got '' in '0.4x0.3x0.3,'"),

@@ -35,6 +35,7 @@ __all__ = [
     "DEPTH_UNITS",
     "MAX_DEPTH_M",
     "Intrinsics",
+    "depth_scale",
     "load_depth",
     "load_intrinsics",
     "load_mask",
@@ -44,6 +45,8 @@ __all__ = [
 
 #: Units a depth image can be declared in, and metres per unit.
 DEPTH_UNITS = {"mm": 0.001, "m": 1.0}
+#: The finest depth unit taken (metres): a micrometre; depth cameras' scales are 0.1-1 mm.
+MIN_DEPTH_SCALE = 1e-6
 #: No depth camera in a container or a cell reads further than this (metres).
 MAX_DEPTH_M = 20.0
 #: The fields of view (degrees, across the image's width and height) a pinhole camera's
@@ -107,14 +110,22 @@ def read_json_file(path: str | os.PathLike[str], what: str = "file") -> tuple[An
 def load_intrinsics(path: str | os.PathLike[str]) -> Intrinsics:
     """Read ``{"fx", "fy", "cx", "cy", "width", "height"}`` (pixels) from a JSON file.
 
+    RealSense's names (``ppx``, ``ppy`` for ``cx``, ``cy``) and a ROS ``CameraInfo``'s camera
+    matrix (``K`` or ``k``, with its ``width`` and ``height``) are read as well.
+
     The camera is a pinhole: distortion coefficients other than 0 (``k1`` ... ``k6``,
     ``p1``, ``p2``, ``D``, ...) are refused, since nothing here would undo them; other keys
     are passed over with a warning naming them.
     """
     data, source = read_json_file(path)
     if not isinstance(data, dict):
-        raise InvalidFile(source, "$", "expected an object with fx, fy, cx, cy, width and height")
+        bare = (
+            isinstance(data, list) and len(data) == 3 and all(isinstance(row, list) and len(row) == 3 for row in data)
+        )
+        size = ": a bare 3 x 3 matrix gives no image size" if bare else ""
+        raise InvalidFile(source, "$", f"expected an object with fx, fy, cx, cy, width and height{size}")
     _refuse_distortion(data, source)
+    data = _pinhole_keys(data, source)
     values = {}
     for name in INTRINSICS_KEYS:
         if name not in data:
@@ -159,6 +170,53 @@ def load_intrinsics(path: str | os.PathLike[str]) -> Intrinsics:
     return Intrinsics(
         values["fx"], values["fy"], values["cx"], values["cy"], int(values["width"]), int(values["height"])
     )
+
+
+def _pinhole_keys(data: dict[str, Any], source: str) -> dict[str, Any]:
+    """The intrinsics under :data:`INTRINSICS_KEYS`: RealSense's ``ppx``, ``ppy`` are ``cx``, ``cy``;
+    a ROS ``CameraInfo``'s ``K`` (``k`` in ROS 2; nine numbers, row by row) gives ``fx``,
+    ``fy``, ``cx``, ``cy``. Keys under both names, or a camera matrix that is not a pinhole's, are refused.
+
+    Examples
+    --------
+    >>> realsense = {"width": 640, "height": 480, "ppx": 321.5, "ppy": 240.2, "fx": 615.0, "fy": 615.1}
+    >>> _pinhole_keys(realsense, "rs.json")["cx"]
+    321.5
+    >>> ros = {"width": 640, "height": 480, "K": [615.0, 0, 321.5, 0, 615.1, 240.2, 0, 0, 1]}
+    >>> [_pinhole_keys(ros, "info.json")[key] for key in ("fx", "fy", "cx", "cy")]
+    [615.0, 615.1, 321.5, 240.2]
+    """
+    given = dict(data)
+    for vendor, ours in (("ppx", "cx"), ("ppy", "cy")):
+        if vendor in given:
+            if ours in given:
+                raise InvalidFile(
+                    source, f"$.{vendor}", f"expected {ours} or {vendor} (RealSense's name for it), not both"
+                )
+            given[ours] = given.pop(vendor)
+    matrix_key = next((key for key in ("K", "k") if key in given), None)
+    if matrix_key is None:
+        return given
+    clash = [key for key in ("fx", "fy", "cx", "cy") if key in given]
+    if clash:
+        raise InvalidFile(
+            source, f"$.{matrix_key}", f"expected the camera matrix {matrix_key} or {', '.join(clash)}, not both"
+        )
+    matrix = given.pop(matrix_key)
+    numbers = [finite_number(entry) for entry in matrix] if isinstance(matrix, list) else []
+    if len(numbers) != 9 or any(number is None for number in numbers):
+        raise InvalidFile(
+            source, f"$.{matrix_key}", f"expected 9 numbers (a 3 x 3 camera matrix, row by row), got {matrix!r}"
+        )
+    fx, skew, cx, low, fy, cy, bottom_x, bottom_y, one = numbers
+    if skew != 0 or low != 0 or bottom_x != 0 or bottom_y != 0 or one != 1:
+        raise InvalidFile(
+            source,
+            f"$.{matrix_key}",
+            f"expected a pinhole camera matrix [fx, 0, cx, 0, fy, cy, 0, 0, 1], got {matrix!r}",
+        )
+    given.update(fx=fx, fy=fy, cx=cx, cy=cy)
+    return given
 
 
 def _refuse_distortion(data: dict[str, Any], source: str) -> None:
@@ -241,15 +299,46 @@ def _read_png(file: Path, what: str) -> np.ndarray:
         return np.array(image)
 
 
-def load_depth(path: str | os.PathLike[str], *, units: str | None = None) -> np.ndarray:
+def depth_scale(units: str | float) -> float:
+    """Metres per unit of a depth image: ``"mm"``, ``"m"``, or the metres of one unit (a
+    camera's depth scale: RealSense's 0.0001 for 0.1 mm), as a number or its text.
+
+    Raises
+    ------
+    InvalidArgument
+        Anything else, or a scale outside 1 micrometre to 1 metre.
+
+    Examples
+    --------
+    >>> depth_scale("mm"), depth_scale("0.0001"), depth_scale(0.00025)
+    (0.001, 0.0001, 0.00025)
+    """
+    from unstack.errors import InvalidArgument
+
+    if isinstance(units, str) and units in DEPTH_UNITS:
+        return DEPTH_UNITS[units]
+    try:
+        scale = float(units) if not isinstance(units, bool) else math.nan
+    except (TypeError, ValueError):
+        scale = math.nan
+    if not MIN_DEPTH_SCALE <= scale <= 1.0:
+        raise InvalidArgument(
+            f"depth units: expected mm, m or the metres of one unit ({MIN_DEPTH_SCALE:g} to 1; a camera's depth scale, "
+            f"0.0001 for 0.1 mm), got {units!r}"
+        )
+    return scale
+
+
+def load_depth(path: str | os.PathLike[str], *, units: str | float | None = None) -> np.ndarray:
     """Read a depth image as float64 metres along the optical axis; 0 where there is no reading.
 
     Parameters
     ----------
     path : path-like
         A 16-bit PNG (default units ``mm``) or a ``.npy`` array of floats (default units ``m``).
-    units : {"mm", "m"}, optional
-        What the values are; checked against the readings.
+    units : {"mm", "m"} or float, optional
+        What the values are (a number: the metres of one unit, :func:`depth_scale`); checked
+        against the readings.
     """
     file = Path(path)
     source = str(file)
@@ -274,23 +363,25 @@ def load_depth(path: str | os.PathLike[str], *, units: str | None = None) -> np.
         raise InvalidFile(
             source, "$", "expected a 16-bit PNG of depths, got an 8-bit image (at most 255 mm: a picture, not depth)"
         )
-    declared = units or ("m" if np.issubdtype(raw.dtype, np.floating) else "mm")
-    if declared not in DEPTH_UNITS:
-        raise InvalidFile(source, "$", f"unknown depth units {declared!r}; expected one of {', '.join(DEPTH_UNITS)}")
+    given = ("m" if np.issubdtype(raw.dtype, np.floating) else "mm") if units is None else units
+    scale = depth_scale(given)
+    declared = given if isinstance(given, str) and given in DEPTH_UNITS else f"units of {scale:g} m"
     values = raw.astype(np.float64)
     valid = np.isfinite(values) & (values > 0)
     if not valid.any():
         negative = bool((np.isfinite(values) & (values < 0)).any())
         what = "every pixel is 0, negative or not a number" if negative else "every pixel is 0 or not a number"
         raise InvalidFile(source, "$", f"the depth image holds no reading ({what})")
-    metres = np.where(valid, values, 0.0) * DEPTH_UNITS[declared]
+    metres = np.where(valid, values, 0.0) * scale
     median = float(np.median(metres[valid]))
     if median > MAX_DEPTH_M:
         readings = values[valid]
         if np.issubdtype(raw.dtype, np.integer) and readings.min() == np.iinfo(raw.dtype).max:
             question = f"every reading is {readings[0]:g}, the largest the image holds: a code for no reading?"
         elif declared == "mm":
-            question = "are the values in a finer unit than millimetres (a depth scale of 0.25 mm, say)?"
+            question = (
+                "are the values in a finer unit than millimetres (a depth scale of 0.1 mm, say: --depth-units 0.0001)?"
+            )
         else:
             question = "are the values millimetres?"
         raise InvalidFile(source, "$", f"declared in {declared} but the median reading is {median:g} m: {question}")

@@ -112,13 +112,27 @@ def _door(text: str | None) -> list[float] | None:
     return [value / largest for value in values]
 
 
+def _depth_units(context: click.Context, parameter: click.Parameter, value: str | None) -> str | None:
+    """``--depth-units`` checked by :func:`unstack.camera.files.depth_scale`."""
+    if value is None:
+        return None
+    from unstack.camera.files import depth_scale
+    from unstack.errors import InvalidArgument
+
+    try:
+        depth_scale(value)
+    except InvalidArgument as error:
+        raise click.BadParameter(str(error).removeprefix("depth units: "), context, parameter) from None
+    return value
+
+
 @click.command()
 @click.argument("mask_files", nargs=-1, type=click.Path(dir_okay=False))
 @click.option("--depth", "depth_file", default=None, type=click.Path(dir_okay=False),
               help="Depth image: a 16-bit PNG (mm) or a .npy of floats (m).")  # fmt: skip
-@click.option("--depth-units", type=click.Choice(["mm", "m"]), default=None,
-              help="Units of the depth values (default: mm for a PNG or a .npy of integers, m for a .npy of "
-              "floats); checked.")  # fmt: skip
+@click.option("--depth-units", default=None, callback=_depth_units,
+              help="Units of the depth values: mm, m, or the metres of one unit (a camera's depth scale, 0.0001 "
+              "for 0.1 mm; default: mm for a PNG or a .npy of integers, m for a .npy of floats); checked.")  # fmt: skip
 @click.option("--intrinsics", "intrinsics_file", default=None, type=click.Path(dir_okay=False),
               help='JSON {"fx", "fy", "cx", "cy", "width", "height"} in pixels.')  # fmt: skip
 @click.option("--pose", "pose_file", default=None, type=click.Path(dir_okay=False),
