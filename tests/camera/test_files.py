@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from unstack.camera import load_depth, load_intrinsics, load_mask, load_pose
+from unstack.camera import load_depth, load_intrinsics, load_label_masks, load_mask, load_pose
 from unstack.errors import InvalidArgument, InvalidFile
 
 
@@ -219,3 +219,30 @@ def test_a_depth_file_that_is_no_npy_array_is_refused_without_numpys_pickle_advi
     with pytest.raises(InvalidFile, match=r"d.npy: \$: expected a depth image as a .npy array of numbers") as refused:
         load_depth(tmp_path / "d.npy")
     assert "pickle" not in str(refused.value)
+
+
+@pytest.mark.parametrize(
+    ("labels", "message"),
+    [
+        (np.zeros((4, 5), dtype=np.uint16), r"the label image is empty \(every pixel is 0\)"),
+        (np.full((4, 5), 1.5), "expected whole numbers in a label image"),
+        (np.full((4, 5), -1, dtype=np.int32), "got negative values"),
+        (np.ones((4, 5), dtype=bool), "got true/false values: a single mask"),
+        (
+            np.arange(2000, dtype=np.uint16).reshape(40, 50) + 1,
+            r"expected at most 1,000 labels .* got 2,000: a depth image\?",
+        ),
+        (np.ones((4, 5, 3), dtype=np.uint8), r"expected a single-channel label image, got shape \(4, 5, 3\)"),
+    ],
+    ids=["empty", "fractions", "negative", "boolean", "depth-image", "colour"],
+)
+def test_what_is_no_label_image_is_refused(tmp_path: Path, labels: np.ndarray, message: str) -> None:
+    np.save(tmp_path / "labels.npy", labels)
+    with pytest.raises(InvalidFile, match=message):
+        load_label_masks(tmp_path / "labels.npy")
+
+
+def test_a_label_image_of_another_size_than_the_depth_image_is_refused(tmp_path: Path) -> None:
+    np.save(tmp_path / "labels.npy", np.ones((4, 5), dtype=np.uint8))
+    with pytest.raises(InvalidFile, match="expected a label image of 6 x 4 pixels like the depth image, got 5 x 4"):
+        load_label_masks(tmp_path / "labels.npy", (4, 6))

@@ -101,3 +101,49 @@ def test_a_mask_file_that_names_no_box_is_refused(camera_files: list[str], tmp_p
     run = unstack("scene", *camera_files[:-1], str(unnamed), "--out", str(tmp_path / "scene.json"))
     assert run.returncode == 2 and f"{unnamed}: the file name gives an empty box id" in run.stderr
     assert not (tmp_path / "scene.json").exists()
+
+
+def _as_label_image(camera_files: list[str], tmp_path: Path, labels: tuple[int, ...]) -> list[str]:
+    """The fixture's masks written as one 16-bit label image (the k-th mask as ``labels[k]``)."""
+    from PIL import Image
+
+    masks = [path for path in camera_files if Path(path).name.startswith("mask-")]
+    image = np.zeros(np.asarray(Image.open(masks[0])).shape, dtype=np.uint16)
+    for label, path in zip(labels, masks, strict=True):
+        image[np.asarray(Image.open(path)) != 0] = label
+    Image.fromarray(image).save(tmp_path / "labels.png")
+    return [*(argument for argument in camera_files if argument not in masks), str(tmp_path / "labels.png")]
+
+
+def test_a_label_image_makes_the_same_boxes_as_one_mask_per_box(camera_files: list[str], tmp_path: Path) -> None:
+    sizes = ("--sizes", "0.6x0.4x0.4,0.4x0.3x0.3")
+    by_masks = unstack("scene", *camera_files, *sizes, "--out", str(tmp_path / "masks.json"))
+    by_labels = unstack("scene", *_as_label_image(camera_files, tmp_path, (7, 300)), "--labels", *sizes,
+                        "--out", str(tmp_path / "labels.json"))  # fmt: skip
+    assert by_masks.returncode == 0 and by_labels.returncode == 0, by_labels.stderr
+    boxes = {box["id"]: box for box in json.loads((tmp_path / "labels.json").read_text())["boxes"]}
+    assert sorted(boxes) == ["label-300", "label-7"]
+    for box in json.loads((tmp_path / "masks.json").read_text())["boxes"]:
+        twin = boxes[{"b00": "label-7", "b01": "label-300"}[box["id"]]]
+        assert twin["position"] == box["position"] and twin["size"] == box["size"]
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--ids", "a"], "--ids names 1 boxes but 2 labels in "),
+        (
+            ["--detections", "boxes.json"],
+            "--labels reads one label image and a depth image; got 1 mask files and --detections",
+        ),
+    ],
+    ids=["ids-count", "with-detections"],
+)
+def test_a_label_image_with_arguments_it_cannot_take_is_refused(
+    camera_files: list[str], tmp_path: Path, extra: list[str], message: str
+) -> None:
+    arguments = _as_label_image(camera_files, tmp_path, (1, 2))
+    extra = [str(tmp_path / part) if part.endswith(".json") else part for part in extra]
+    run = unstack("scene", *arguments, "--labels", *extra, "--out", str(tmp_path / "scene.json"))
+    assert run.returncode == 2 and message in run.stderr and run.stderr.count("\n") == 1, run.stderr
+    assert not (tmp_path / "scene.json").exists()

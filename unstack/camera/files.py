@@ -38,6 +38,7 @@ __all__ = [
     "depth_scale",
     "load_depth",
     "load_intrinsics",
+    "load_label_masks",
     "load_mask",
     "load_pose",
     "read_json_file",
@@ -47,6 +48,8 @@ __all__ = [
 DEPTH_UNITS = {"mm": 0.001, "m": 1.0}
 #: The finest depth unit taken (metres): a micrometre; depth cameras' scales are 0.1-1 mm.
 MIN_DEPTH_SCALE = 1e-6
+#: The most labels a label image may hold: more boxes than a container holds is another image.
+MAX_LABELS = 1000
 #: No depth camera in a container or a cell reads further than this (metres).
 MAX_DEPTH_M = 20.0
 #: The fields of view (degrees, across the image's width and height) a pinhole camera's
@@ -402,31 +405,83 @@ def load_depth(path: str | os.PathLike[str], *, units: str | float | None = None
     return metres
 
 
-def load_mask(path: str | os.PathLike[str], shape: tuple[int, int] | None = None) -> np.ndarray:
-    """Read an instance mask (a PNG, or a ``.npy`` array): True where the box is, of ``shape`` if given."""
+def _mask_pixels(path: str | os.PathLike[str], what: str) -> tuple[np.ndarray, str]:
+    """A mask file's pixels (a PNG, or a ``.npy`` array of numbers) and the file's name."""
     file = Path(path)
     source = str(file)
     refuse_special_file(file)
     if not file.is_file():
-        raise InvalidFile(source, "$", "the mask does not exist")
+        raise InvalidFile(source, "$", f"the {what} does not exist")
     try:
         suffix = file.suffix.lower()
         if suffix not in (".png", ".npy"):
-            raise InvalidFile(source, "$", f"expected a mask .png or .npy, got {file.name!r}")
-        raw = _load_npy(file, source, "mask") if suffix == ".npy" else _read_png(file, "mask")
+            raise InvalidFile(source, "$", f"expected a {what} .png or .npy, got {file.name!r}")
+        raw = _load_npy(file, source, what) if suffix == ".npy" else _read_png(file, what)
     except InvalidFile:
         raise
     except Exception as error:  # noqa: BLE001 - any reader failure is the file's fault
-        raise InvalidFile(source, "$", f"cannot read the mask: {error}") from None
+        raise InvalidFile(source, "$", f"cannot read the {what}: {error}") from None
     if not (np.issubdtype(raw.dtype, np.integer) or np.issubdtype(raw.dtype, np.floating) or raw.dtype == bool):
-        raise InvalidFile(source, "$", f"expected a mask of numbers (0 outside the box), got values of {raw.dtype}")
+        outside = "the box" if what == "mask" else "the boxes"
+        raise InvalidFile(source, "$", f"expected a {what} of numbers (0 outside {outside}), got values of {raw.dtype}")
+    return raw, source
+
+
+def _check_mask_shape(raw: np.ndarray, shape: tuple[int, int] | None, source: str, what: str) -> None:
+    if raw.ndim != 2:
+        image = what if what.endswith("image") else f"{what} image"
+        raise InvalidFile(source, "$", f"expected a single-channel {image}, got shape {raw.shape}")
+    if shape is not None and raw.shape != shape:
+        raise InvalidFile(source, "$", f"expected a {what} of {shape[1]} x {shape[0]} pixels like the depth image, "
+                          f"got {raw.shape[1]} x {raw.shape[0]}")  # fmt: skip
+
+
+def load_label_masks(path: str | os.PathLike[str], shape: tuple[int, int] | None = None) -> dict[int, np.ndarray]:
+    """Read a label image (a single-channel PNG, or a ``.npy`` array, of whole numbers) as one
+    mask per box: 0 where no box is, each other value one box, as instance-segmentation
+    detectors write them; the masks by value, ascending, of ``shape`` if given.
+
+    Raises
+    ------
+    InvalidFile
+        Not a label image: colour, fractions or negative values, no label, or more labels
+        than :data:`MAX_LABELS` (a depth image, say).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> labels = np.zeros((4, 6), dtype=np.uint16); labels[:2, :2] = 3; labels[2:, 3:] = 7
+    >>> path = Path(tempfile.mkdtemp()) / "labels.npy"; np.save(path, labels)
+    >>> {value: int(mask.sum()) for value, mask in load_label_masks(path).items()}
+    {3: 4, 7: 6}
+    """
+    raw, source = _mask_pixels(path, "label image")
+    _check_mask_shape(raw, shape, source, "label image")
+    values = np.asarray(raw)
+    if np.issubdtype(values.dtype, np.floating):
+        finite = np.isfinite(values)
+        if np.any(finite & (values != np.round(values))):
+            raise InvalidFile(source, "$", "expected whole numbers in a label image (one per box), got fractions")
+        values = np.where(finite, values, 0).astype(np.int64)
+    if values.dtype == bool or np.any(values < 0):
+        got = "true/false values: a single mask" if values.dtype == bool else "negative values"
+        raise InvalidFile(source, "$", f"expected a label image of whole numbers from 0 (one per box), got {got}")
+    labels = np.unique(values[values != 0])
+    if len(labels) == 0:
+        raise InvalidFile(source, "$", "the label image is empty (every pixel is 0)")
+    if len(labels) > MAX_LABELS:
+        raise InvalidFile(
+            source, "$", f"expected at most {MAX_LABELS:,} labels (one per box), got {len(labels):,}: a depth image?"
+        )
+    return {int(label): values == label for label in labels}
+
+
+def load_mask(path: str | os.PathLike[str], shape: tuple[int, int] | None = None) -> np.ndarray:
+    """Read an instance mask (a PNG, or a ``.npy`` array): True where the box is, of ``shape`` if given."""
+    raw, source = _mask_pixels(path, "mask")
     if raw.ndim == 3 and raw.shape[-1] >= 1:
         raw = raw[..., :3].max(axis=-1)  # a colour mask: any non-black pixel
-    if raw.ndim != 2:
-        raise InvalidFile(source, "$", f"expected a single-channel mask image, got shape {raw.shape}")
-    if shape is not None and raw.shape != shape:
-        raise InvalidFile(source, "$", f"expected a mask of {shape[1]} x {shape[0]} pixels like the depth image, "
-                          f"got {raw.shape[1]} x {raw.shape[0]}")  # fmt: skip
+    _check_mask_shape(raw, shape, source, "mask")
     values = np.asarray(raw)
     mask: np.ndarray = np.asarray(values != 0)
     if np.issubdtype(values.dtype, np.floating):

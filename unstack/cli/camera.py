@@ -143,6 +143,9 @@ def _depth_units(context: click.Context, parameter: click.Parameter, value: str 
               help='Instead of masks: JSON boxes [{"id", "center", "size", "yaw_deg"}] (world frame).')  # fmt: skip
 @click.option("--ids", default=None,
               help="Comma-separated box ids, one per mask (default: the file names without mask-).")  # fmt: skip
+@click.option("--labels", is_flag=True,
+              help="MASK_FILES is one label image (PNG or .npy of whole numbers): 0 where no box is, each other "
+              "value one box (ids label-VALUE, or --ids in the values' order).")  # fmt: skip
 @click.option("--sizes", default=None, help="Known carton sizes, e.g. 0.255x0.155x0.1,0.34x0.25x0.095 (metres).")
 @click.option("--door", default=None,
               help="Direction x,y,z (pose frame) out through the door; default: towards the camera.")  # fmt: skip
@@ -152,11 +155,12 @@ def _depth_units(context: click.Context, parameter: click.Parameter, value: str 
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Seeds the RANSAC fits.")
 def scene(
     mask_files: tuple[str, ...], depth_file: str | None, depth_units: str | None, intrinsics_file: str | None,
-    pose_file: str | None, cloud_file: str | None, detections_file: str | None, ids: str | None,
+    pose_file: str | None, cloud_file: str | None, detections_file: str | None, ids: str | None, labels: bool,
     sizes: str | None, door: str | None, out: str, report_file: str | None, seed: int,
 ) -> None:  # fmt: skip
     """Build a scene from a depth camera's files and one mask per detected box (MASK_FILES: PNG or
-    .npy, non-zero where the box is), or from a point cloud and box detections.
+    .npy, non-zero where the box is; or one label image with --labels), or from a point cloud and
+    box detections.
 
     Gravity and the floor come from the cloud's horizontal planes; each box from its mask's top
     face (or front face) matched to the known sizes, or from its detection levelled in the
@@ -165,7 +169,7 @@ def scene(
     from rich.console import Console
 
     from unstack.atomic import atomic_write_text
-    from unstack.camera import load_depth, load_intrinsics, load_mask, load_pose, scene_from_depth
+    from unstack.camera import load_depth, load_intrinsics, load_label_masks, load_mask, load_pose, scene_from_depth
     from unstack.cli.text import number_table
 
     known = _sizes(sizes)
@@ -175,6 +179,10 @@ def scene(
     _check_outputs(target, report_file, [*mask_files, depth_file, intrinsics_file, pose_file, cloud_file,
                                          detections_file])  # fmt: skip
     direction = _door(door)
+    if labels and (detections_file is not None or cloud_file is not None or len(mask_files) != 1):
+        extra = "".join(f" and {name}" for name, value in (("--detections", detections_file), ("--cloud", cloud_file))
+                        if value)  # fmt: skip
+        raise UnstackError(f"--labels reads one label image and a depth image; got {len(mask_files)} mask files{extra}")
     if detections_file is not None:  # boxes a detector found: the cloud, or the depth image's points, gives gravity
         if mask_files:
             raise UnstackError("give masks or --detections, not both")
@@ -211,15 +219,19 @@ def scene(
         if not mask_files:
             raise UnstackError("give one mask file per detected box, or --detections")
         assert depth_file is not None and intrinsics_file is not None and pose_file is not None
-        names = [name.strip() for name in ids.split(",")] if ids is not None else [_mask_id(p) for p in mask_files]
-        if len(names) != len(mask_files):
-            raise UnstackError(f"--ids names {len(names)} boxes but {len(mask_files)} masks were given")
+        label_masks = load_label_masks(mask_files[0]) if labels else {}
+        sources = [f"{mask_files[0]} label {value}" for value in label_masks] if labels else list(mask_files)
+        default = [f"label-{value}" for value in label_masks] if labels else [_mask_id(p) for p in mask_files]
+        names = [name.strip() for name in ids.split(",")] if ids is not None else default
+        given = f"{len(sources)} labels in {mask_files[0]}" if labels else f"{len(mask_files)} masks"
+        if len(names) != len(sources):
+            raise UnstackError(f"--ids names {len(names)} boxes but {given} were given")
         if ids is not None and not all(names):
-            raise UnstackError(f"--ids: expected {len(mask_files)} non-empty box ids separated by commas, got {ids!r}")
-        for path, name in zip(mask_files, names, strict=True):
+            raise UnstackError(f"--ids: expected {len(sources)} non-empty box ids separated by commas, got {ids!r}")
+        for path, name in zip(sources, names, strict=True):
             if len(name) > MAX_ID_LENGTH:  # before any fitting: an id no scene holds
                 raise UnstackError(f"{'--ids' if ids is not None else path}: {long_id(name)}")
-        unnamed = [path for path, name in zip(mask_files, names, strict=True) if not name]
+        unnamed = [path for path, name in zip(sources, names, strict=True) if not name]
         if unnamed:
             raise UnstackError(
                 f"{unnamed[0]}: the file name gives an empty box id; rename it (mask-ID.png) or give --ids"
@@ -234,7 +246,9 @@ def scene(
             given = f"{intrinsics.width} x {intrinsics.height}"
             raise InvalidFile(intrinsics_file, "$.width", f"expected the depth image's {pixels}, got {given}")
         pose = load_pose(pose_file)
-        masks = [load_mask(path, depth.shape) for path in mask_files]
+        if labels and next(iter(label_masks.values())).shape != depth.shape:
+            load_label_masks(mask_files[0], depth.shape)  # refused: the label image's size is not the depth image's
+        masks = list(label_masks.values()) if labels else [load_mask(path, depth.shape) for path in mask_files]
         with _naming(f"{depth_file} seen from {pose_file}"):
             built = scene_from_depth(
                 depth, intrinsics, pose, masks, ids=names, known_sizes=known, door=direction, seed=seed
