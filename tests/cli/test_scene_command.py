@@ -147,3 +147,9 @@ def test_a_label_image_with_arguments_it_cannot_take_is_refused(
     run = unstack("scene", *arguments, "--labels", *extra, "--out", str(tmp_path / "scene.json"))
     assert run.returncode == 2 and message in run.stderr and run.stderr.count("\n") == 1, run.stderr
     assert not (tmp_path / "scene.json").exists()
+
+
+def test_a_label_image_given_as_one_mask_is_warned_about(camera_files: list[str], tmp_path: Path) -> None:
+    run = unstack("scene", *_as_label_image(camera_files, tmp_path, (1, 2)), "--out", str(tmp_path / "scene.json"))
+    assert "labels.png: the mask holds 2 values that each cover a large part of it (1: " in run.stderr
+    assert "a label image, a value per box? (unstack scene --labels" in run.stderr

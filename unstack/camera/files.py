@@ -48,6 +48,9 @@ __all__ = [
 DEPTH_UNITS = {"mm": 0.001, "m": 1.0}
 #: The finest depth unit taken (metres): a micrometre; depth cameras' scales are 0.1-1 mm.
 MIN_DEPTH_SCALE = 1e-6
+#: A mask of whole numbers in which two values or more each cover this share of its pixels
+#: looks like a label image (a value per box), and the reading warns.
+LABEL_SHARE = 0.1
 #: The most labels a label image may hold: more boxes than a container holds is another image.
 MAX_LABELS = 1000
 #: No depth camera in a container or a cell reads further than this (metres).
@@ -488,4 +491,18 @@ def load_mask(path: str | os.PathLike[str], shape: tuple[int, int] | None = None
         mask &= np.isfinite(values)
     if not mask.any():
         raise InvalidFile(source, "$", "the mask is empty (every pixel is 0 or not a number)")
+    if np.issubdtype(values.dtype, np.integer) and raw.ndim == 2:
+        labels, counts = np.unique(values[mask], return_counts=True)
+        large = counts >= LABEL_SHARE * mask.sum()
+        if large.sum() >= 2:
+            shares = ", ".join(
+                f"{label}: {100 * count / mask.sum():.0f} %"
+                for label, count in zip(labels[large], counts[large], strict=True)
+            )
+            warnings.warn(
+                f"{source}: the mask holds {int(large.sum())} values that each cover a large part of it ({shares}): "
+                "a label image, a value per box? (unstack scene --labels, unstack.camera.load_label_masks, read one "
+                "box per value; as a mask it is one box)",
+                stacklevel=2,
+            )
     return mask

@@ -250,9 +250,15 @@ def scene(
             load_label_masks(mask_files[0], depth.shape)  # refused: the label image's size is not the depth image's
         masks = list(label_masks.values()) if labels else [load_mask(path, depth.shape) for path in mask_files]
         with _naming(f"{depth_file} seen from {pose_file}"):
-            built = scene_from_depth(
-                depth, intrinsics, pose, masks, ids=names, known_sizes=known, door=direction, seed=seed
-            )
+            try:
+                built = scene_from_depth(
+                    depth, intrinsics, pose, masks, ids=names, known_sizes=known, door=direction, seed=seed
+                )
+            except UnstackError as error:
+                if len(mask_files) == 1 and not labels and str(error).startswith("no box could be fitted"):
+                    hint = "one mask file given: if it is a label image, a value per box, give --labels"
+                    raise UnstackError(f"{error} ({hint})") from None
+                raise
     built.scene.save(target, points_file=cloud_beside(target).name)
     if report_file is not None:
         atomic_write_text(Path(report_file), report_text(built.report()))
