@@ -63,7 +63,7 @@ def test_a_depth_scale_in_metres_per_unit_reads_a_finer_unit(tmp_path: Path, uni
     assert depth[0, 0] == pytest.approx(1.25)
 
 
-@pytest.mark.parametrize("units", ["0.1mm", "cm", "0", "-0.001", "2", "nan", True])
+@pytest.mark.parametrize("units", ["0.1mm", "cm", "0", "-0.001", "2", "nan", True, np.bool_(True), b"0.001"])
 def test_depth_units_that_are_no_unit_nor_a_scale_are_refused(tmp_path: Path, units: object) -> None:
     with pytest.raises(InvalidArgument, match=r"depth units: expected mm, m or the metres of one unit .* got "):
         load_depth(_png(tmp_path / "d.png", np.full((4, 5), 1250, dtype=np.uint16)), units=units)  # type: ignore[arg-type]
@@ -246,3 +246,73 @@ def test_a_label_image_of_another_size_than_the_depth_image_is_refused(tmp_path:
     np.save(tmp_path / "labels.npy", np.ones((4, 5), dtype=np.uint8))
     with pytest.raises(InvalidFile, match="expected a label image of 6 x 4 pixels like the depth image, got 5 x 4"):
         load_label_masks(tmp_path / "labels.npy", (4, 6))
+
+
+@pytest.mark.parametrize(
+    ("labels", "message"),
+    [
+        (np.array([[1.0, np.inf], [2.0, 0.0]]), r"got 1 infinite ones \(the first at row 0, column 1\)"),
+        (np.array([[1.0, 1e20], [2.0, 0.0]]), r"expected labels up to 9,007,199,254,740,992, got 1e\+20"),
+        (
+            np.pad(np.full((4, 4), 3, dtype=np.uint8), 8, constant_values=255),
+            r"label 255 covers 96 % of the image and reaches all four of its edges: the background\?",
+        ),
+    ],
+    ids=["infinite", "huge", "background-255"],
+)
+def test_label_values_no_box_has_are_refused(tmp_path: Path, labels: np.ndarray, message: str) -> None:
+    np.save(tmp_path / "labels.npy", labels)
+    with pytest.raises(InvalidFile, match=message):
+        load_label_masks(tmp_path / "labels.npy")
+
+
+def test_labels_a_pixel_thick_between_others_are_left_out_with_a_warning(tmp_path: Path) -> None:
+    labels = np.zeros((12, 12), dtype=np.uint8)
+    labels[1:6, 1:11], labels[7:11, 1:11] = 10, 20
+    labels[6, 1:11] = 15  # the edge between the two, as smoothing leaves it
+    np.save(tmp_path / "labels.npy", labels)
+    with pytest.warns(UserWarning, match=r"1 labels are lines a pixel or two thick \(15\).*: left out"):
+        assert sorted(load_label_masks(tmp_path / "labels.npy")) == [10, 20]
+    np.save(tmp_path / "lines.npy", np.eye(12, dtype=np.uint8))
+    with pytest.raises(InvalidFile, match="every label is a line a pixel or two thick"):
+        load_label_masks(tmp_path / "lines.npy")
+
+
+def _one_block(tmp_path: Path) -> Path:
+    """A 5 x 6 label image of one label over 3 x 4 pixels."""
+    labels = np.zeros((5, 6), dtype=np.uint8)
+    labels[1:4, 1:5] = 1
+    np.save(tmp_path / "labels.npy", labels)
+    return tmp_path / "labels.npy"
+
+
+@pytest.mark.parametrize(
+    "shape", [[5, 6], np.array([5, 6]), (np.int64(5), np.int64(6))], ids=["list", "array", "numpy-ints"]
+)
+def test_a_label_images_shape_may_be_any_pair_of_whole_numbers(tmp_path: Path, shape: object) -> None:
+    assert list(load_label_masks(_one_block(tmp_path), shape)) == [1]  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("shape", [[5], [5.0, 6.0], [0, 6]], ids=["one-number", "floats", "zero"])
+def test_a_shape_that_is_no_image_size_is_refused(tmp_path: Path, shape: object) -> None:
+    with pytest.raises(InvalidArgument, match=r"shape: expected \(rows, columns\) of an image in pixels"):
+        load_label_masks(_one_block(tmp_path), shape)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("reader", [load_depth, load_intrinsics, load_label_masks, load_mask, load_pose])
+@pytest.mark.parametrize("path", [b"/tmp/x.png", None, 3], ids=["bytes", "none", "number"])
+def test_a_file_name_that_is_no_text_nor_path_is_refused(reader: object, path: object) -> None:
+    with pytest.raises(InvalidArgument, match=r"expected a file name \(text or a path\), got "):
+        reader(path)  # type: ignore[operator]
+
+
+def test_a_camera_matrix_given_as_three_rows_is_read(tmp_path: Path) -> None:
+    matrix = [[600.0, 0, 320.0], [0, 600.0, 240.0], [0, 0, 1]]
+    intrinsics = load_intrinsics(_intrinsics(tmp_path, fx=None, fy=None, cx=None, cy=None, K=matrix))
+    assert (intrinsics.fx, intrinsics.cy) == (600.0, 240.0)
+
+
+def test_a_camera_matrix_given_as_both_K_and_k_is_refused(tmp_path: Path) -> None:
+    flat = [600.0, 0, 320.0, 0, 600.0, 240.0, 0, 0, 1]
+    with pytest.raises(InvalidFile, match=r"\$\.k: expected the camera matrix once, as K \(ROS\) or k \(ROS 2\)"):
+        load_intrinsics(_intrinsics(tmp_path, fx=None, fy=None, cx=None, cy=None, K=flat, k=flat))

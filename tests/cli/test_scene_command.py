@@ -153,3 +153,8 @@ def test_a_label_image_given_as_one_mask_is_warned_about(camera_files: list[str]
     run = unstack("scene", *_as_label_image(camera_files, tmp_path, (1, 2)), "--out", str(tmp_path / "scene.json"))
     assert "labels.png: the mask holds 2 values that each cover a large part of it (1: " in run.stderr
     assert "a label image, a value per box? (unstack scene --labels" in run.stderr
+
+
+def test_an_id_given_to_two_boxes_is_named_with_its_option(camera_files: list[str], tmp_path: Path) -> None:
+    run = unstack("scene", *camera_files, "--ids", "a,a", "--out", str(tmp_path / "scene.json"))
+    assert run.returncode == 2 and "--ids: the box id 'a' is given to two boxes; ids must differ" in run.stderr

@@ -232,3 +232,25 @@ def test_noise_on_the_face_leant_on_is_not_taken_for_a_box_under_the_leaning_one
     cloud = surface_cloud([tall, lean], seed=seed, depth_noise=0.005, missing_faces=0.15, spacing=0.03)
     found = tip_supports(Scene([tall, lean], cloud, ["tall", "lean"]))
     assert [(f.supporter, f.held) for f in found] == [("tall", "lean")]
+
+
+@pytest.mark.parametrize(
+    ("objects", "message"),
+    [
+        (["upright", "nope"], "objects: 'nope' is not one of the scene's boxes"),
+        ("lean", "objects: expected a sequence"),
+    ],
+    ids=["unknown-id", "a-string"],
+)
+def test_boxes_the_scene_does_not_hold_are_refused_by_name(objects: object, message: str) -> None:
+    from unstack.errors import InvalidArgument
+
+    with pytest.raises(InvalidArgument, match=message):
+        tip_supports(_leaning_scene(22.0), objects)  # type: ignore[arg-type]
+
+
+def test_a_finding_about_a_box_not_among_the_objects_is_refused() -> None:
+    from unstack.errors import InvalidArgument
+
+    with pytest.raises(InvalidArgument, match="found: 'zz' is not one of objects"):
+        raise_tip_supports(np.zeros((2, 2)), ["a", "b"], [TipSupport("a", "zz", 0.05, True)])

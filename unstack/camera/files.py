@@ -51,6 +51,12 @@ MIN_DEPTH_SCALE = 1e-6
 #: A mask of whole numbers in which two values or more each cover this share of its pixels
 #: looks like a label image (a value per box), and the reading warns.
 LABEL_SHARE = 0.1
+#: A label covering more than this share of a label image and reaching all its edges is its background.
+BACKGROUND_SHARE = 0.5
+#: The largest label value read (a float image's whole numbers are exact up to 2^53).
+MAX_LABEL_VALUE = 2**53
+#: Thin labels named one by one in the warning that leaves them out, before "and N more".
+NAMED_SLIVERS = 5
 #: The most labels a label image may hold: more boxes than a container holds is another image.
 MAX_LABELS = 1000
 #: No depth camera in a container or a cell reads further than this (metres).
@@ -88,6 +94,15 @@ class Intrinsics:
     height: int
 
 
+def _file_path(path: Any) -> Path:
+    """``path`` (text or a path-like object) as a :class:`~pathlib.Path`; anything else is refused."""
+    from unstack.errors import InvalidArgument
+
+    if not isinstance(path, str | os.PathLike) or isinstance(os.fspath(path), bytes):
+        raise InvalidArgument(f"expected a file name (text or a path), got {type(path).__name__} {path!r}")
+    return Path(path)
+
+
 def read_json_file(path: str | os.PathLike[str], what: str = "file") -> tuple[Any, str]:
     """The JSON value of a camera's file (``what`` it is, for the messages) and its name: read
     as every document is (:func:`unstack.jsonio.parse_json`), in one-line errors.
@@ -99,7 +114,7 @@ def read_json_file(path: str | os.PathLike[str], what: str = "file") -> tuple[An
     ...
     unstack.errors.InvalidFile: missing.json: $: the detections file does not exist
     """
-    file = Path(path)
+    file = _file_path(path)
     source = str(file)
     if source == "-":
         raise InvalidFile(source, "$", f"expected the name of the {what}: standard input is not read for it")
@@ -200,16 +215,21 @@ def _pinhole_keys(data: dict[str, Any], source: str) -> dict[str, Any]:
                     source, f"$.{vendor}", f"expected {ours} or {vendor} (RealSense's name for it), not both"
                 )
             given[ours] = given.pop(vendor)
-    matrix_key = next((key for key in ("K", "k") if key in given), None)
-    if matrix_key is None:
+    keys = [key for key in ("K", "k") if key in given]
+    if len(keys) == 2:
+        raise InvalidFile(source, "$.k", "expected the camera matrix once, as K (ROS) or k (ROS 2), not both")
+    if not keys:
         return given
+    matrix_key = keys[0]
     clash = [key for key in ("fx", "fy", "cx", "cy") if key in given]
     if clash:
         raise InvalidFile(
             source, f"$.{matrix_key}", f"expected the camera matrix {matrix_key} or {', '.join(clash)}, not both"
         )
     matrix = given.pop(matrix_key)
-    numbers = [finite_number(entry) for entry in matrix] if isinstance(matrix, list) else []
+    rows = isinstance(matrix, list) and len(matrix) == 3 and all(isinstance(row, list) for row in matrix)
+    entries = [entry for row in matrix for entry in row] if rows else matrix  # 3 x 3 nested, or 9 flat
+    numbers = [finite_number(entry) for entry in entries] if isinstance(entries, list) else []
     if len(numbers) != 9 or any(number is None for number in numbers):
         raise InvalidFile(
             source, f"$.{matrix_key}", f"expected 9 numbers (a 3 x 3 camera matrix, row by row), got {matrix!r}"
@@ -324,7 +344,7 @@ def depth_scale(units: str | float) -> float:
     if isinstance(units, str) and units in DEPTH_UNITS:
         return DEPTH_UNITS[units]
     try:
-        scale = float(units) if not isinstance(units, bool) else math.nan
+        scale = float(units) if not isinstance(units, bool | np.bool_ | bytes) else math.nan
     except (TypeError, ValueError):
         scale = math.nan
     if not MIN_DEPTH_SCALE <= scale <= 1.0:
@@ -346,7 +366,7 @@ def load_depth(path: str | os.PathLike[str], *, units: str | float | None = None
         What the values are (a number: the metres of one unit, :func:`depth_scale`); checked
         against the readings.
     """
-    file = Path(path)
+    file = _file_path(path)
     source = str(file)
     refuse_special_file(file)
     if not file.is_file():
@@ -410,7 +430,7 @@ def load_depth(path: str | os.PathLike[str], *, units: str | float | None = None
 
 def _mask_pixels(path: str | os.PathLike[str], what: str) -> tuple[np.ndarray, str]:
     """A mask file's pixels (a PNG, or a ``.npy`` array of numbers) and the file's name."""
-    file = Path(path)
+    file = _file_path(path)
     source = str(file)
     refuse_special_file(file)
     if not file.is_file():
@@ -430,10 +450,22 @@ def _mask_pixels(path: str | os.PathLike[str], what: str) -> tuple[np.ndarray, s
     return raw, source
 
 
-def _check_mask_shape(raw: np.ndarray, shape: tuple[int, int] | None, source: str, what: str) -> None:
+def _image_shape(shape: Any) -> tuple[int, int]:
+    """``shape`` as a (rows, columns) tuple of whole numbers (a list or an array of two serves)."""
+    from unstack.errors import InvalidArgument
+
+    values = np.asarray(shape)
+    if values.shape != (2,) or not np.issubdtype(values.dtype, np.integer) or np.any(values < 1):
+        raise InvalidArgument(f"shape: expected (rows, columns) of an image in pixels, got {shape!r}")
+    return int(values[0]), int(values[1])
+
+
+def _check_mask_shape(raw: np.ndarray, shape: Any, source: str, what: str) -> None:
     if raw.ndim != 2:
         image = what if what.endswith("image") else f"{what} image"
         raise InvalidFile(source, "$", f"expected a single-channel {image}, got shape {raw.shape}")
+    if shape is not None:
+        shape = _image_shape(shape)
     if shape is not None and raw.shape != shape:
         raise InvalidFile(source, "$", f"expected a {what} of {shape[1]} x {shape[0]} pixels like the depth image, "
                           f"got {raw.shape[1]} x {raw.shape[0]}")  # fmt: skip
@@ -462,9 +494,18 @@ def load_label_masks(path: str | os.PathLike[str], shape: tuple[int, int] | None
     _check_mask_shape(raw, shape, source, "label image")
     values = np.asarray(raw)
     if np.issubdtype(values.dtype, np.floating):
+        infinite = np.isinf(values)
+        if infinite.any():
+            rows, columns = np.nonzero(infinite)
+            first = f"the first at row {rows[0]}, column {columns[0]}"
+            raise InvalidFile(source, "$", "expected whole numbers in a label image (one per box, 0 or NaN where no "
+                              f"box is), got {int(infinite.sum()):,} infinite ones ({first})")  # fmt: skip
         finite = np.isfinite(values)
         if np.any(finite & (values != np.round(values))):
             raise InvalidFile(source, "$", "expected whole numbers in a label image (one per box), got fractions")
+        if np.any(finite & (np.abs(values) > MAX_LABEL_VALUE)):
+            largest = float(np.max(np.abs(values[finite])))
+            raise InvalidFile(source, "$", f"expected labels up to {MAX_LABEL_VALUE:,}, got {largest:g}")
         values = np.where(finite, values, 0).astype(np.int64)
     if values.dtype == bool or np.any(values < 0):
         got = "true/false values: a single mask" if values.dtype == bool else "negative values"
@@ -476,7 +517,35 @@ def load_label_masks(path: str | os.PathLike[str], shape: tuple[int, int] | None
         raise InvalidFile(
             source, "$", f"expected at most {MAX_LABELS:,} labels (one per box), got {len(labels):,}: a depth image?"
         )
-    return {int(label): values == label for label in labels}
+    masks = {int(label): values == label for label in labels}
+    for label, mask in masks.items():
+        edges = (mask[0], mask[-1], mask[:, 0], mask[:, -1])
+        if mask.mean() > BACKGROUND_SHARE and all(edge.any() for edge in edges):
+            share = f"{100 * mask.mean():.0f} %"
+            raise InvalidFile(source, "$", f"label {label} covers {share} of the image and reaches all four of its "
+                              "edges: the background? (--labels reads 0, or NaN, as no box)")  # fmt: skip
+    return _without_edge_slivers(masks, source)
+
+
+def _without_edge_slivers(masks: dict[int, np.ndarray], source: str) -> dict[int, np.ndarray]:
+    """The labels of ``masks`` that are areas: a label no pixel of which has all four neighbours
+    of its own label is a line a pixel or two thick -- the edge between two others, as a label
+    image resized or drawn with smoothing leaves them -- and is left out with a warning."""
+    from scipy.ndimage import binary_erosion
+
+    slivers = [label for label, mask in masks.items() if not binary_erosion(mask).any()]
+    if slivers and len(slivers) == len(masks):
+        raise InvalidFile(source, "$", "every label is a line a pixel or two thick, no area a box could show")
+    if slivers:
+        named = ", ".join(str(label) for label in slivers[:NAMED_SLIVERS])
+        more = f" and {len(slivers) - NAMED_SLIVERS} more" if len(slivers) > NAMED_SLIVERS else ""
+        warnings.warn(
+            f"{source}: {len(slivers)} labels are lines a pixel or two thick ({named}{more}), as the edges of the "
+            "others are in a label image resized or drawn with smoothing: left out (save label images with "
+            "nearest-neighbour sampling)",
+            stacklevel=3,
+        )
+    return {label: mask for label, mask in masks.items() if label not in slivers}
 
 
 def load_mask(path: str | os.PathLike[str], shape: tuple[int, int] | None = None) -> np.ndarray:

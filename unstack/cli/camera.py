@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
+import warnings
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -126,6 +127,18 @@ def _depth_units(context: click.Context, parameter: click.Parameter, value: str 
     return value
 
 
+def _holds_labels(path: str) -> bool:
+    """Whether a mask file holds two non-zero values or more, as a label image does."""
+    from unstack.camera import load_label_masks
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return len(load_label_masks(path)) >= 2
+    except UnstackError:
+        return False
+
+
 @click.command()
 @click.argument("mask_files", nargs=-1, type=click.Path(dir_okay=False))
 @click.option("--depth", "depth_file", default=None, type=click.Path(dir_okay=False),
@@ -239,6 +252,11 @@ def scene(
         repeated = sorted({path for path in mask_files if mask_files.count(path) > 1})
         if repeated:
             raise UnstackError(f"{repeated[0]}: the same mask file is given twice")
+        twice = next((name for name in names if names.count(name) > 1), None)
+        if twice is not None:
+            named_by = [path for path, name in zip(sources, names, strict=True) if name == twice]
+            where = "--ids" if ids is not None else f"{named_by[0]} and {named_by[1]}"
+            raise UnstackError(f"{where}: the box id {twice!r} is given to two boxes; ids must differ")
         depth = load_depth(depth_file, units=depth_units)
         intrinsics = load_intrinsics(intrinsics_file)
         if (intrinsics.width, intrinsics.height) != (depth.shape[1], depth.shape[0]):
@@ -255,7 +273,12 @@ def scene(
                     depth, intrinsics, pose, masks, ids=names, known_sizes=known, door=direction, seed=seed
                 )
             except UnstackError as error:
-                if len(mask_files) == 1 and not labels and str(error).startswith("no box could be fitted"):
+                if (
+                    len(mask_files) == 1
+                    and not labels
+                    and str(error).startswith("no box could be fitted")
+                    and _holds_labels(mask_files[0])
+                ):
                     hint = "one mask file given: if it is a label image, a value per box, give --labels"
                     raise UnstackError(f"{error} ({hint})") from None
                 raise

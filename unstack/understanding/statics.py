@@ -54,6 +54,7 @@ from __future__ import annotations
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -317,8 +318,8 @@ def tip_supports(
     list of TipSupport
         In the order of ``objects`` (leaning box first, then its supporters).
     """
-    names = list(scene.detected if objects is None else objects)
     index = {box_id: k for k, box_id in enumerate(scene.box_ids)}
+    names = _known_ids(scene.detected if objects is None else objects, index, "objects", "the scene's boxes")
     boxes = [scene.boxes[index[name]] for name in names]
     bounds = bounding_boxes(boxes) if boxes else np.zeros((0, 6))
     cloud = columns_of(scene.points, columns)  # binned once, looked up per box
@@ -359,6 +360,19 @@ def tip_supports(
             if np.any((contacts - edge) @ direction > 0.0):
                 found.append(TipSupport(names[row], names[supporter], overhang, on_floor))
     return found
+
+
+def _known_ids(ids: Any, known: dict[str, int], name: str, among: str) -> list[str]:
+    """``ids`` as a list of box ids, each among ``known`` (when ``among`` names them)."""
+    from unstack.errors import InvalidArgument
+
+    if isinstance(ids, str) or not isinstance(ids, Sequence | np.ndarray):
+        raise InvalidArgument(f"{name}: expected a sequence of box ids, got {type(ids).__name__} {ids!r}")
+    listed = [str(box_id) if isinstance(box_id, np.str_) else box_id for box_id in ids]
+    unknown = [box_id for box_id in listed if not isinstance(box_id, str) or (among and box_id not in known)]
+    if unknown:
+        raise InvalidArgument(f"{name}: {unknown[0]!r} is not one of {among or 'the box ids (strings)'}")
+    return listed
 
 
 #: Keys of the floor's and the cloud's part of a base (boxes are keyed by their index).
@@ -438,7 +452,9 @@ def raise_tip_supports(
     >>> raised[0, 1], said[0].endswith("raised from 0.05 to 0.65")
     (np.float64(0.65), True)
     """
-    position = {name: k for k, name in enumerate(objects)}
+    position = {name: k for k, name in enumerate(_known_ids(objects, {}, "objects", ""))}
+    for finding in found:
+        _known_ids([finding.supporter, finding.held], position, "found", "objects")
     raised = np.array(probabilities, dtype=np.float64, copy=True)
     said: list[str] = []
     for finding in found:
