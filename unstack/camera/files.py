@@ -485,10 +485,10 @@ def load_label_masks(path: str | os.PathLike[str], shape: tuple[int, int] | None
     Examples
     --------
     >>> import tempfile
-    >>> labels = np.zeros((4, 6), dtype=np.uint16); labels[:2, :2] = 3; labels[2:, 3:] = 7
+    >>> labels = np.zeros((5, 8), dtype=np.uint16); labels[:3, :3] = 3; labels[1:4, 4:8] = 7
     >>> path = Path(tempfile.mkdtemp()) / "labels.npy"; np.save(path, labels)
     >>> {value: int(mask.sum()) for value, mask in load_label_masks(path).items()}
-    {3: 4, 7: 6}
+    {3: 9, 7: 12}
     """
     raw, source = _mask_pixels(path, "label image")
     _check_mask_shape(raw, shape, source, "label image")
