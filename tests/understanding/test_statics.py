@@ -138,6 +138,19 @@ def test_an_upright_box_within_a_pose_error_of_its_base_is_left_to_the_model(bey
     assert tip_supports(_overhang_against_a_column(beyond)) == []
 
 
+@pytest.mark.parametrize("seed", range(3))
+def test_an_upright_box_over_something_the_cloud_shows_and_nobody_detected_leans_on_nothing(seed: int) -> None:
+    scene = _overhang_against_a_column(0.08)
+    boxes = list(scene.boxes)
+    cloud = surface_cloud(boxes, seed=seed)  # the detected boxes and the floor
+    found = tip_supports(Scene(boxes, cloud, scene.detected))
+    assert [(f.supporter, f.held) for f in found] == [("tall", "carton")]  # nothing under it: it leans
+    # the front face of a box nobody detected under the carton, past the short box (its top hidden by the carton)
+    y, z = np.meshgrid(np.linspace(-0.29, -0.16, 8), np.linspace(0.03, 0.17, 8))
+    face = np.column_stack([np.full(y.size, 1.099), y.ravel(), z.ravel()])
+    assert tip_supports(Scene(boxes, np.vstack([cloud, face]), scene.detected)) == []
+
+
 def test_an_upright_box_past_its_base_with_nothing_beside_it_has_no_supporter_to_find() -> None:
     assert tip_supports(_overhang_against_a_column(0.08, column=False)) == []
 

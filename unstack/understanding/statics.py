@@ -16,7 +16,9 @@ without a model. For each detected box ``Y``:
   at least :data:`MIN_PUSH` against the overhang and does not press ``Y`` down) holds it up
   -- the box it leans on. A box standing upright is examined the same way when its centre
   lies more than :data:`UPRIGHT_OVERHANG` outside its base (a carton on a short box whose
-  centre is past that box's edge, kept from tipping by a taller box beside it);
+  centre is past that box's edge, kept from tipping by a taller box beside it), by no more
+  than a push from the side can hold, and the cloud shows nothing nobody detected under the
+  part of it beyond its base (what stands there may hold it);
 * a box that stands, tilted or not, is held up by a detected box of its base without whose
   contacts it would tip (the centre more than :data:`MIN_OVERHANG` outside the rest of the
   base, that box's contacts beyond its edge): a box across a gap between two, a box on its
@@ -110,6 +112,9 @@ MIN_OVERHANG = 0.01
 #: under it, a centimetre off each, and one :data:`SAMPLE_SPACING`, the spacing of the points
 #: its base is measured on, do not make a box on a box look as if it overhangs.
 UPRIGHT_OVERHANG = 0.04
+#: Points of the cloud, near no detected box, under the part of an upright box beyond its base
+#: that show something nobody detected standing there: the rule for upright boxes then finds nothing.
+SEEN_UNDER_POINTS = 3
 #: Friction between two cartons (the simulator's, and cardboard's 0.4-0.6): with it, how far past
 #: its base a push from the side can hold an upright box (:func:`_held_overhang`).
 FRICTION = 0.5
@@ -331,6 +336,8 @@ def tip_supports(
         touched = [boxes[key] for key in base if key >= 0]
         base[_CLOUD] = _cloud_under(cloud, box, bounds[row], touched)
         tipping = _tipping(box, base, exclude=None)
+        if tipping is not None and not tilted and _seen_under(cloud, box, tipping[1], tipping[2], boxes):
+            tipping = None  # upright over something nobody detected: what stands there may hold it
         if tipping is not None and (tilted or tipping[0] > UPRIGHT_OVERHANG):  # it cannot stand on its base
             if not tilted:  # upright, its centre well beyond its base: its sides were not sampled
                 _, beside, lowest = _contacts(box, boxes, neighbours, downward_only=False)
@@ -404,6 +411,30 @@ def _contacts(
         if np.any(side):
             beside[other] = (samples[touching][side], pushes[side])
     return base, beside, float(samples[:, 2].min())
+
+
+def _seen_under(columns: CloudColumns, box: Box, edge: np.ndarray, direction: np.ndarray, boxes: Sequence[Box]) -> bool:
+    """Whether the cloud shows something nobody detected under the part of ``box`` beyond its
+    base's ``edge``: at least :data:`SEEN_UNDER_POINTS` points over that part of its footprint,
+    between the floor and its bottom (a :data:`CONTACT_GAP` off each), near no detected box."""
+    rotation = rotation_matrix(box.orientation_xyzw)
+    half = box.size / 2.0
+    reach = np.abs(rotation[:2, :2]) @ half[:2] + CONTACT_GAP
+    points = columns.points[columns.indices_over(box.position[:2] - reach, box.position[:2] + reach)]
+    lowest = float(box.position[2] - np.abs(rotation[2]) @ half)
+    local = (points[:, :2] - box.position[:2]) @ rotation[:2, :2]
+    under = (
+        (points[:, 2] > CONTACT_GAP)
+        & (points[:, 2] < lowest - CONTACT_GAP)
+        & np.all(np.abs(local) <= half[:2] + CONTACT_GAP, axis=1)
+        & ((points[:, :2] - edge) @ direction > 0.0)
+    )
+    candidates = points[under]
+    for other in boxes:
+        if len(candidates) < SEEN_UNDER_POINTS:
+            return False
+        candidates = candidates[_distances(candidates, other)[0] > CONTACT_GAP]
+    return len(candidates) >= SEEN_UNDER_POINTS
 
 
 def _held_overhang(contacts: np.ndarray, edge: np.ndarray, direction: np.ndarray, lowest: float) -> float:
