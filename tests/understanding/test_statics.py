@@ -151,6 +151,15 @@ def test_an_upright_box_over_something_the_cloud_shows_and_nobody_detected_leans
     assert tip_supports(Scene(boxes, np.vstack([cloud, face]), scene.detected)) == []
 
 
+def test_a_neighbour_whose_pose_reaches_into_a_boxs_side_is_no_support_from_below() -> None:
+    """Poses 1-2 cm off, as a detector's are: the tall box reaches 3 cm into the carton's side,
+    which stands on the short box alone (its centre inside the short box's edge)."""
+    sizes = {"tall": [0.4, 0.4, 0.75], "short": [0.4, 0.3, 0.2], "carton": [0.4, 0.5, 0.25]}
+    seen = {"tall": [1.306, 0.126, 0.385], "short": [1.304, -0.453, 0.11], "carton": [1.304, -0.291, 0.334]}
+    scene = Scene([Box(name, sizes[name], seen[name]) for name in sizes], np.zeros((0, 3)), list(sizes))
+    assert tip_supports(scene) == []
+
+
 def test_an_upright_box_past_its_base_with_nothing_beside_it_has_no_supporter_to_find() -> None:
     assert tip_supports(_overhang_against_a_column(0.08, column=False)) == []
 

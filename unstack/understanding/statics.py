@@ -30,8 +30,9 @@ without a model. For each detected box ``Y``:
 Contacts are found on a grid of points over ``Y``'s faces: a point touches ``X`` when it
 lies within :data:`CONTACT_GAP` of ``X`` and within :data:`CONTACT_BAND` of the closest
 approach of the two boxes. The push at a point is along the normal of ``Y``'s face there,
-along ``X``'s face normal where an edge or corner of ``Y`` meets a face of ``X``, and
-across both edges where two edges cross. The measured precision of the rule on simulated
+along ``X``'s face normal where an edge or corner of ``Y`` meets a face of ``X`` or where the
+two faces do not face each other (poses that overlap: a box reaching into another's side does
+not hold it from below), and across both edges where two edges cross. The measured precision of the rule on simulated
 piles (how often the box leant on really holds the leaning one up when removed) and its
 effect on the suite are on the generalisation page.
 
@@ -225,6 +226,8 @@ def _pushes(
     pushes = -own_normals.copy()  # a face of this box: the push is along its normal
     own_count, other_count = own_bounds.sum(axis=1), other_bounds.sum(axis=1)
     other_face = (own_count >= 3) | ((own_count == 2) & (other_count < 2))  # a corner or edge on a face
+    # a face against a face of the other that does not face it back (poses that overlap): the other's face pushes
+    other_face |= (own_count == 1) & (other_count <= 1) & (np.einsum("ij,ij->i", own_normals, other_normals) > -UPWARD)
     pushes[other_face] = other_normals[other_face]
     crossing = (own_count == 2) & (other_count == 2)  # two edges cross: the push is across both
     if np.any(crossing):
