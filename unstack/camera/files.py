@@ -533,7 +533,11 @@ def _without_edge_slivers(masks: dict[int, np.ndarray], source: str) -> dict[int
     image resized or drawn with smoothing leaves them -- and is left out with a warning."""
     from scipy.ndimage import binary_erosion
 
-    slivers = [label for label, mask in masks.items() if not binary_erosion(mask).any()]
+    def is_line(mask: np.ndarray) -> bool:  # eroded within its bounding box: outside it is no label anyway
+        rows, columns = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+        return not binary_erosion(mask[rows[0] : rows[-1] + 1, columns[0] : columns[-1] + 1]).any()
+
+    slivers = [label for label, mask in masks.items() if is_line(mask)]
     if slivers and len(slivers) == len(masks):
         raise InvalidFile(source, "$", "every label is a line a pixel or two thick, no area a box could show")
     if slivers:
