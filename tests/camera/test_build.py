@@ -138,3 +138,35 @@ def test_boxes_no_carton_is_are_named_with_what_was_fitted(three_cartons) -> Non
     depth, masks, pose = render_tops(three_cartons)
     with pytest.raises(UnstackError, match=r"no box could be fitted: b00: the fitted box's size\[0\]: expected a box"):
         scene_from_depth(depth / 100.0, INTRINSICS, pose, masks)  # metres read as hundredths
+
+
+@pytest.fixture(scope="module")
+def example_frame() -> tuple[np.ndarray, object, np.ndarray, list[np.ndarray], list[str]]:
+    """The bundled camera example's depth, intrinsics, pose, masks and ids (29 boxes, many seen in part)."""
+    from pathlib import Path
+
+    from unstack.camera import load_depth, load_intrinsics, load_mask, load_pose
+
+    folder = Path(__file__).parents[2] / "examples" / "camera"
+    files = sorted(folder.glob("mask-*.png"))
+    return (
+        load_depth(folder / "depth.png"),
+        load_intrinsics(folder / "intrinsics.json"),
+        load_pose(folder / "pose.json"),
+        [load_mask(path) for path in files],
+        [path.stem.removeprefix("mask-") for path in files],
+    )
+
+
+def test_the_masks_order_changes_no_box(example_frame) -> None:
+    """Part-seen boxes' fits hang on RANSAC's draws: each mask draws from its own generator."""
+    depth, intrinsics, pose, masks, ids = example_frame
+    forward = scene_from_depth(depth, intrinsics, pose, masks, ids=ids, known_sizes=SIZES, seed=0)
+    reverse = scene_from_depth(depth, intrinsics, pose, masks[::-1], ids=ids[::-1], known_sizes=SIZES, seed=0)
+    boxes = {box.id: box for box in reverse.scene.boxes}
+    assert sorted(boxes) == sorted(box.id for box in forward.scene.boxes)
+    assert reverse.unfitted == {key: forward.unfitted[key] for key in reversed(forward.unfitted)}
+    for box in forward.scene.boxes:
+        assert np.array_equal(boxes[box.id].position, box.position)
+        assert np.array_equal(boxes[box.id].orientation_xyzw, box.orientation_xyzw)
+        assert np.array_equal(boxes[box.id].size, box.size)

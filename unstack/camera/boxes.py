@@ -32,6 +32,7 @@ Examples
 
 from __future__ import annotations
 
+import zlib
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -46,6 +47,7 @@ __all__ = [
     "DUPLICATE_SHARE",
     "FittedBox",
     "boxes_from_masks",
+    "content_rng",
     "duplicate_masks",
     "fit_box",
     "merged_masks",
@@ -416,6 +418,22 @@ class _Containment:
         return bool(shared >= DUPLICATE_SHARE * self.areas[k]) and self.areas[k] > 0
 
 
+def content_rng(seed: int, values: np.ndarray) -> np.random.Generator:
+    """A generator seeded by ``seed`` and the bytes of ``values``: the same values draw the same
+    numbers wherever they stand among others.
+
+    Examples
+    --------
+    >>> points = np.arange(6.0).reshape(2, 3)
+    >>> content_rng(0, points).random() == content_rng(0, points.copy()).random()
+    True
+    >>> content_rng(0, points).random() == content_rng(0, points + 1.0).random()
+    False
+    """
+    key = zlib.crc32(np.ascontiguousarray(values).tobytes())
+    return np.random.default_rng([int(seed), key])
+
+
 def boxes_from_masks(
     mask_points: Sequence[np.ndarray],
     ids: Sequence[str],
@@ -425,9 +443,11 @@ def boxes_from_masks(
 ) -> tuple[list[FittedBox], dict[str, str]]:
     """Fit a box to each mask's points (gravity frame); bottoms land on the floor or other tops.
 
-    Returns the fitted boxes and, for each mask that could not be fitted, why.
+    Returns the fitted boxes and, for each mask that could not be fitted, why. Each mask's
+    RANSAC draws from its own generator, seeded by ``seed`` and the mask's points
+    (:func:`content_rng`): a box's fit depends on its own points only, not on the masks given
+    before it or their order.
     """
-    rng = np.random.default_rng(seed)
     if len(mask_points) != len(ids):
         raise UnstackError(f"{len(mask_points)} masks but {len(ids)} ids")
     tops = [float(np.percentile(points[:, 2], 95)) if len(points) else 0.0 for points in mask_points]
@@ -436,6 +456,7 @@ def boxes_from_masks(
     for k, (box_id, points) in enumerate(zip(ids, mask_points, strict=True)):
         surfaces = [0.0, *(top for j, top in enumerate(tops) if j != k)]
         try:
+            rng = content_rng(seed, points)
             fitted.append(fit_box(box_id, points, known_sizes=known_sizes, surfaces=surfaces, rng=rng))
         except InvalidFile as error:  # a box no carton is: say so of the fit, not of an array
             unfitted[box_id] = f"the fitted box's {error.json_path[2:]}: {error.message}"

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from unstack.camera.boxes import FittedBox, boxes_from_masks, duplicate_masks, merged_masks
+from unstack.camera.boxes import FittedBox, boxes_from_masks, content_rng, duplicate_masks, merged_masks
 from unstack.camera.files import Intrinsics
 from unstack.camera.planes import GravityFrame, depth_points, gravity_frame
 from unstack.errors import UnstackError
@@ -212,8 +212,9 @@ def scene_from_depth(
     mask_points = []
     for k in kept:
         points = frame.apply(depth_points(depth_m, intrinsics, pose, masks[k]))
-        if len(points) > MAX_MASK_POINTS:
-            points = points[rng.choice(len(points), MAX_MASK_POINTS, replace=False)]
+        if len(points) > MAX_MASK_POINTS:  # a subset drawn from the mask's own pixels, whatever its place
+            subset = content_rng(seed, np.flatnonzero(masks[k])).choice(len(points), MAX_MASK_POINTS, replace=False)
+            points = points[subset]
         mask_points.append(points)
     fitted, unfitted = boxes_from_masks(mask_points, [names[k] for k in kept], known_sizes=known_sizes, seed=seed)
     for j, held in merged.items():
