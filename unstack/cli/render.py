@@ -224,7 +224,9 @@ def plan_view(result: Plan) -> Group:
 def _tie_rule(margin: float, free_cost: float) -> str:
     """How the choice was made among the tied boxes, in words."""
     if free_cost:
-        return f"EC below {free_cost:g}, so more likely than not holding nothing up; the highest wins"
+        return (
+            f"EC below {free_cost:g}, so more likely than not holding nothing up; the box whose centre is highest wins"
+        )
     if margin:
         return f"EC within {margin:g} of the lowest; the box resting highest wins, on one layer the lowest EC"
     return "smallest id wins"
