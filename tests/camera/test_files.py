@@ -10,6 +10,7 @@ import pytest
 from PIL import Image
 
 from unstack.camera import load_depth, load_intrinsics, load_label_masks, load_mask, load_pose
+from unstack.camera.files import line_labels
 from unstack.errors import InvalidArgument, InvalidFile
 
 
@@ -271,7 +272,7 @@ def test_labels_a_pixel_thick_between_others_are_left_out_with_a_warning(tmp_pat
     labels[1:6, 1:11], labels[7:11, 1:11] = 10, 20
     labels[6, 1:11] = 15  # the edge between the two, as smoothing leaves it
     np.save(tmp_path / "labels.npy", labels)
-    with pytest.warns(UserWarning, match=r"1 labels are lines a pixel or two thick \(15\).*: left out"):
+    with pytest.warns(UserWarning, match=r"1 labels are lines a pixel or two thick \(15\), too thin .*: left out"):
         assert sorted(load_label_masks(tmp_path / "labels.npy")) == [10, 20]
     np.save(tmp_path / "lines.npy", np.eye(12, dtype=np.uint8))
     with pytest.raises(InvalidFile, match="every label is a line a pixel or two thick"):
@@ -316,3 +317,13 @@ def test_a_camera_matrix_given_as_both_K_and_k_is_refused(tmp_path: Path) -> Non
     flat = [600.0, 0, 320.0, 0, 600.0, 240.0, 0, 0, 1]
     with pytest.raises(InvalidFile, match=r"\$\.k: expected the camera matrix once, as K \(ROS\) or k \(ROS 2\)"):
         load_intrinsics(_intrinsics(tmp_path, fx=None, fy=None, cx=None, cy=None, K=flat, k=flat))
+
+
+def test_lines_kept_on_request_are_found_by_line_labels(tmp_path: Path) -> None:
+    labels = np.zeros((12, 12), dtype=np.uint8)
+    labels[1:6, 1:11], labels[7:11, 1:11] = 10, 20
+    labels[6, 1:11] = 15
+    np.save(tmp_path / "labels.npy", labels)
+    masks = load_label_masks(tmp_path / "labels.npy", lines=True)
+    assert sorted(masks) == [10, 15, 20]
+    assert line_labels(masks) == [15]

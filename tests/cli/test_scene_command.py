@@ -158,3 +158,32 @@ def test_a_label_image_given_as_one_mask_is_warned_about(camera_files: list[str]
 def test_an_id_given_to_two_boxes_is_named_with_its_option(camera_files: list[str], tmp_path: Path) -> None:
     run = unstack("scene", *camera_files, "--ids", "a,a", "--out", str(tmp_path / "scene.json"))
     assert run.returncode == 2 and "--ids: the box id 'a' is given to two boxes; ids must differ" in run.stderr
+
+
+def test_ids_name_every_value_of_a_label_image_and_a_line_left_out_is_named_by_its_id(
+    camera_files: list[str], tmp_path: Path
+) -> None:
+    from PIL import Image
+
+    arguments = _as_label_image(camera_files, tmp_path, (1, 2))
+    image = np.asarray(Image.open(tmp_path / "labels.png")).copy()
+    image[0, :] = 9  # a line a pixel thick along the top: a third value in the file
+    Image.fromarray(image).save(tmp_path / "labels.png")
+    run = unstack("scene", *arguments, "--labels", "--ids", "near,far,edge", "--out", str(tmp_path / "scene.json"))
+    assert run.returncode == 0, run.stderr
+    assert "1 labels are lines a pixel or two thick (9 (edge)), too thin to show a box: left out" in run.stderr
+    boxes = [box["id"] for box in json.loads((tmp_path / "scene.json").read_text())["boxes"]]
+    assert sorted(boxes) == ["far", "near"]
+
+
+def test_a_label_image_of_another_size_than_the_depth_is_refused_before_the_ids_are_counted(
+    camera_files: list[str], tmp_path: Path
+) -> None:
+    from PIL import Image
+
+    arguments = _as_label_image(camera_files, tmp_path, (1, 2))
+    image = np.asarray(Image.open(tmp_path / "labels.png"))
+    Image.fromarray(image[::2, ::2]).save(tmp_path / "labels.png")  # nearest-neighbour, half the size
+    run = unstack("scene", *arguments, "--labels", "--ids", "a,b,c", "--out", str(tmp_path / "scene.json"))
+    assert run.returncode == 2 and run.stderr.count("\n") == 1, run.stderr
+    assert "labels.png: $: expected a label image of " in run.stderr and "like the depth image, got " in run.stderr

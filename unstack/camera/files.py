@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 import os
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -471,10 +472,16 @@ def _check_mask_shape(raw: np.ndarray, shape: Any, source: str, what: str) -> No
                           f"got {raw.shape[1]} x {raw.shape[0]}")  # fmt: skip
 
 
-def load_label_masks(path: str | os.PathLike[str], shape: tuple[int, int] | None = None) -> dict[int, np.ndarray]:
+def load_label_masks(
+    path: str | os.PathLike[str], shape: tuple[int, int] | None = None, *, lines: bool = False
+) -> dict[int, np.ndarray]:
     """Read a label image (a single-channel PNG, or a ``.npy`` array, of whole numbers) as one
     mask per box: 0 where no box is, each other value one box, as instance-segmentation
     detectors write them; the masks by value, ascending, of ``shape`` if given.
+
+    A label that is a line a pixel or two thick (:func:`line_labels`: the edge between two
+    others, as a label image resized or drawn with smoothing leaves them) is left out with a
+    warning, or kept with ``lines`` (for a caller that names the labels first).
 
     Raises
     ------
@@ -524,29 +531,46 @@ def load_label_masks(path: str | os.PathLike[str], shape: tuple[int, int] | None
             share = f"{100 * mask.mean():.0f} %"
             raise InvalidFile(source, "$", f"label {label} covers {share} of the image and reaches all four of its "
                               "edges: the background? (--labels reads 0, or NaN, as no box)")  # fmt: skip
-    return _without_edge_slivers(masks, source)
+    return masks if lines else without_line_labels(masks, source)
 
 
-def _without_edge_slivers(masks: dict[int, np.ndarray], source: str) -> dict[int, np.ndarray]:
-    """The labels of ``masks`` that are areas: a label no pixel of which has all four neighbours
-    of its own label is a line a pixel or two thick -- the edge between two others, as a label
-    image resized or drawn with smoothing leaves them -- and is left out with a warning."""
+def line_labels(masks: Mapping[Any, np.ndarray]) -> list[Any]:
+    """The keys of ``masks`` whose mask is a line a pixel or two thick: no pixel of it has all
+    four neighbours in it.
+
+    Examples
+    --------
+    >>> area, line = np.zeros((6, 6), dtype=bool), np.zeros((6, 6), dtype=bool)
+    >>> area[1:5, 1:4] = True; line[:, 5] = True
+    >>> line_labels({"area": area, "line": line})
+    ['line']
+    """
     from scipy.ndimage import binary_erosion
 
     def is_line(mask: np.ndarray) -> bool:  # eroded within its bounding box: outside it is no label anyway
         rows, columns = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
         return not binary_erosion(mask[rows[0] : rows[-1] + 1, columns[0] : columns[-1] + 1]).any()
 
-    slivers = [label for label, mask in masks.items() if is_line(mask)]
+    return [key for key, mask in masks.items() if is_line(mask)]
+
+
+def without_line_labels(
+    masks: Mapping[Any, np.ndarray], source: str, names: Mapping[Any, str] | None = None
+) -> dict[Any, np.ndarray]:
+    """The labels of ``masks`` that are areas; the lines (:func:`line_labels`: the edges between
+    others, as a label image resized or drawn with smoothing leaves them) are left out with a
+    warning that names them (by ``names`` where given: the box ids)."""
+    slivers = line_labels(masks)
     if slivers and len(slivers) == len(masks):
         raise InvalidFile(source, "$", "every label is a line a pixel or two thick, no area a box could show")
     if slivers:
-        named = ", ".join(str(label) for label in slivers[:NAMED_SLIVERS])
+        shown = [str(label) if names is None else f"{label} ({names[label]})" for label in slivers]
+        named = ", ".join(shown[:NAMED_SLIVERS])
         more = f" and {len(slivers) - NAMED_SLIVERS} more" if len(slivers) > NAMED_SLIVERS else ""
         warnings.warn(
-            f"{source}: {len(slivers)} labels are lines a pixel or two thick ({named}{more}), as the edges of the "
-            "others are in a label image resized or drawn with smoothing: left out (save label images with "
-            "nearest-neighbour sampling)",
+            f"{source}: {len(slivers)} labels are lines a pixel or two thick ({named}{more}), too thin to show a box: "
+            "left out (a label image resized or drawn with smoothing leaves such lines between the others: save "
+            "label images with nearest-neighbour sampling)",
             stacklevel=3,
         )
     return {label: mask for label, mask in masks.items() if label not in slivers}

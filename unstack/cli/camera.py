@@ -183,6 +183,7 @@ def scene(
 
     from unstack.atomic import atomic_write_text
     from unstack.camera import load_depth, load_intrinsics, load_label_masks, load_mask, load_pose, scene_from_depth
+    from unstack.camera.files import without_line_labels
     from unstack.cli.text import number_table
 
     known = _sizes(sizes)
@@ -232,7 +233,12 @@ def scene(
         if not mask_files:
             raise UnstackError("give one mask file per detected box, or --detections")
         assert depth_file is not None and intrinsics_file is not None and pose_file is not None
-        label_masks = load_label_masks(mask_files[0]) if labels else {}
+        # a label image is read whole at the depth image's size (refused first when it is another),
+        # its lines kept until the ids are matched to every value the file holds
+        depth = load_depth(depth_file, units=depth_units) if labels else None
+        label_masks = (
+            load_label_masks(mask_files[0], None if depth is None else depth.shape, lines=True) if labels else {}
+        )
         sources = [f"{mask_files[0]} label {value}" for value in label_masks] if labels else list(mask_files)
         default = [f"label-{value}" for value in label_masks] if labels else [_mask_id(p) for p in mask_files]
         names = [name.strip() for name in ids.split(",")] if ids is not None else default
@@ -257,15 +263,17 @@ def scene(
             named_by = [path for path, name in zip(sources, names, strict=True) if name == twice]
             where = "--ids" if ids is not None else f"{named_by[0]} and {named_by[1]}"
             raise UnstackError(f"{where}: the box id {twice!r} is given to two boxes; ids must differ")
-        depth = load_depth(depth_file, units=depth_units)
+        depth = load_depth(depth_file, units=depth_units) if depth is None else depth
         intrinsics = load_intrinsics(intrinsics_file)
         if (intrinsics.width, intrinsics.height) != (depth.shape[1], depth.shape[0]):
             pixels = f"{depth.shape[1]} x {depth.shape[0]} pixels ({depth_file})"
             given = f"{intrinsics.width} x {intrinsics.height}"
             raise InvalidFile(intrinsics_file, "$.width", f"expected the depth image's {pixels}, got {given}")
         pose = load_pose(pose_file)
-        if labels and next(iter(label_masks.values())).shape != depth.shape:
-            load_label_masks(mask_files[0], depth.shape)  # refused: the label image's size is not the depth image's
+        if labels:  # the lines left out, named by their ids
+            id_of = dict(zip(label_masks, names, strict=True))
+            label_masks = without_line_labels(label_masks, mask_files[0], id_of)
+            names = [id_of[value] for value in label_masks]
         masks = list(label_masks.values()) if labels else [load_mask(path, depth.shape) for path in mask_files]
         with _naming(f"{depth_file} seen from {pose_file}"):
             try:
