@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 from unstack.geometry import (
     box_corners,
     convex_hull_2d,
+    convex_overlap,
     footprint,
     footprint_overlap_area,
     points_in_box,
@@ -41,6 +42,27 @@ def test_footprint_overlap_matches_a_monte_carlo_estimate(yaw_a: float, yaw_b: f
     exact = footprint_overlap_area(footprint(first), footprint(second))
     assert exact == pytest.approx(estimate, abs=0.01)
     assert exact <= min(polygon_area(footprint(first)), polygon_area(footprint(second))) + 1e-12
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.floats(-45, 45), st.floats(-45, 45), st.floats(-0.6, 0.6), st.floats(-0.6, 0.6))
+def test_the_overlap_polygon_lies_in_both_and_has_the_overlap_area(
+    yaw_a: float, yaw_b: float, dx: float, dy: float
+) -> None:
+    first = footprint(_yawed([0.6, 0.4, 0.3], [0.0, 0.0, 0.15], yaw_a))
+    second = footprint(_yawed([0.5, 0.3, 0.3], [dx, dy, 0.45], yaw_b))
+    overlap = convex_overlap(first, second)
+    assert polygon_area(overlap) == pytest.approx(footprint_overlap_area(second, first), abs=1e-12)
+    for polygon in (first, second):  # every corner of the overlap is in (or on) both polygons
+        edges = np.roll(polygon, -1, axis=0) - polygon
+        for corner in overlap:
+            offsets = corner - polygon
+            assert np.all(edges[:, 0] * offsets[:, 1] - edges[:, 1] * offsets[:, 0] >= -1e-9)
+
+
+def test_polygons_that_do_not_meet_overlap_in_no_corner() -> None:
+    square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float)
+    assert convex_overlap(square, square + 2.0).shape == (0, 2)
 
 
 def test_polygon_distance_of_separated_squares_is_the_gap() -> None:

@@ -30,6 +30,7 @@ __all__ = [
     "bounding_boxes",
     "box_corners",
     "convex_hull_2d",
+    "convex_overlap",
     "footprint",
     "footprint_overlap_area",
     "overlap_share",
@@ -211,6 +212,24 @@ def _clip(subject: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.array(output).reshape(-1, 2)
 
 
+def convex_overlap(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """The intersection of two convex counter-clockwise polygons, counter-clockwise, shape (k, 2)
+    (no rows where they do not meet).
+
+    Examples
+    --------
+    >>> square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float)
+    >>> convex_overlap(square, square + 0.5).tolist()
+    [[1.0, 0.5], [1.0, 1.0], [0.5, 1.0], [0.5, 0.5]]
+    """
+    clipped = np.asarray(first, dtype=np.float64).reshape(-1, 2)
+    for k in range(len(second)):
+        clipped = _clip(clipped, second[k - 1], second[k])
+        if len(clipped) == 0:
+            break
+    return clipped
+
+
 def footprint_overlap_area(first: np.ndarray, second: np.ndarray) -> float:
     """Area of the intersection of two convex counter-clockwise polygons.
 
@@ -220,12 +239,7 @@ def footprint_overlap_area(first: np.ndarray, second: np.ndarray) -> float:
     >>> footprint_overlap_area(square, square + 0.5)
     0.25
     """
-    clipped = np.asarray(first, dtype=np.float64)
-    for k in range(len(second)):
-        clipped = _clip(clipped, second[k - 1], second[k])
-        if len(clipped) == 0:
-            return 0.0
-    return polygon_area(clipped)
+    return polygon_area(convex_overlap(first, second))
 
 
 def _point_segment_distances(points: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:

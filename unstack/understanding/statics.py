@@ -15,7 +15,8 @@ without a model. For each detected box ``Y``:
   its lowest point, beyond that edge, and pushes it back (its push has a horizontal part of
   at least :data:`MIN_PUSH` against the overhang and does not press ``Y`` down) holds it up
   -- the box it leans on. A box standing upright is examined the same way when its centre
-  lies more than :data:`UPRIGHT_OVERHANG` outside its base (a carton on a short box whose
+  lies more than :data:`UPRIGHT_OVERHANG` outside its base, measured to the edges of where its
+  bottom and the tops of the upright boxes under it overlap (a carton on a short box whose
   centre is past that box's edge, kept from tipping by a taller box beside it), by no more
   than a push from the side can hold, and the cloud shows nothing nobody detected under the
   part of it beyond its base (what stands there may hold it);
@@ -61,7 +62,7 @@ from typing import Any
 
 import numpy as np
 
-from unstack.geometry import bounding_boxes, convex_hull_2d, rotation_matrix, tilt_deg
+from unstack.geometry import bounding_boxes, convex_hull_2d, convex_overlap, rotation_matrix, tilt_deg
 from unstack.scene import Box, Scene
 from unstack.understanding.cloud_columns import CloudColumns, columns_of
 
@@ -110,9 +111,9 @@ UPWARD = 0.7
 MIN_OVERHANG = 0.01
 #: A box standing upright (tilted less than :data:`MIN_TILT_DEG`) is examined for leaning when
 #: its centre lies more than this outside its base (metres): its pose and the pose of the box
-#: under it, a centimetre off each, and one :data:`SAMPLE_SPACING`, the spacing of the points
-#: its base is measured on, do not make a box on a box look as if it overhangs.
-UPRIGHT_OVERHANG = 0.04
+#: under it, a centimetre off each, do not make a box on a box look as if it overhangs (its base
+#: on an upright box is measured to the edges of the two faces' overlap, not to the grid).
+UPRIGHT_OVERHANG = 0.02
 #: Points of the cloud, near no detected box, under the part of an upright box beyond its base
 #: that show something nobody detected standing there: the rule for upright boxes then finds nothing.
 SEEN_UNDER_POINTS = 3
@@ -339,6 +340,8 @@ def tip_supports(
         touched = [boxes[key] for key in base if key >= 0]
         base[_CLOUD] = _cloud_under(cloud, box, bounds[row], touched)
         tipping = _tipping(box, base, exclude=None)
+        if tipping is not None and not tilted:  # upright: how far past the edges of the faces under it
+            tipping = _tipping(box, _to_overlap_edges(base, box, boxes), exclude=None)
         if tipping is not None and not tilted and _seen_under(cloud, box, tipping[1], tipping[2], boxes):
             tipping = None  # upright over something nobody detected: what stands there may hold it
         if tipping is not None and (tilted or tipping[0] > UPRIGHT_OVERHANG):  # it cannot stand on its base
@@ -414,6 +417,39 @@ def _contacts(
         if np.any(side):
             beside[other] = (samples[touching][side], pushes[side])
     return base, beside, float(samples[:, 2].min())
+
+
+def _face_outline(box: Box, *, upward: bool) -> np.ndarray:
+    """The corners of the box's face whose outward normal points most nearly up (``upward``)
+    or down, seen from above, counter-clockwise."""
+    rotation = rotation_matrix(box.orientation_xyzw)
+    axis = int(np.argmax(np.abs(rotation[2])))
+    half = box.size / 2.0
+    first, second = (other for other in range(3) if other != axis)
+    local = np.zeros((4, 3))
+    local[:, first] = half[first] * np.array([-1.0, 1.0, 1.0, -1.0])
+    local[:, second] = half[second] * np.array([-1.0, -1.0, 1.0, 1.0])
+    local[:, axis] = half[axis] * np.sign(rotation[2, axis]) * (1.0 if upward else -1.0)
+    return convex_hull_2d((local @ rotation.T + box.position)[:, :2])
+
+
+#: The corners of a square of half-side 1 (a grid step around a sampled contact).
+_SQUARE = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
+
+
+def _to_overlap_edges(base: dict[int, np.ndarray], box: Box, boxes: Sequence[Box]) -> dict[int, np.ndarray]:
+    """An upright box's base with its contacts on each upright box under it extended to the
+    edges of where the two faces overlap, as far as they lie within one :data:`SAMPLE_SPACING`
+    of a contact: the grid stops up to a step short of the overlap's edge, and a base measured
+    on it puts the centre up to a step too far out."""
+    extended = dict(base)
+    for key, contacts in base.items():
+        if key < 0 or len(contacts) == 0 or tilt_deg(boxes[key]) >= MIN_TILT_DEG:
+            continue
+        overlap = convex_overlap(_face_outline(box, upward=False), _face_outline(boxes[key], upward=True))
+        around = convex_hull_2d((contacts[:, None, :] + SAMPLE_SPACING * _SQUARE[None]).reshape(-1, 2))
+        extended[key] = np.concatenate([contacts, convex_overlap(overlap, around)])
+    return extended
 
 
 def _seen_under(columns: CloudColumns, box: Box, edge: np.ndarray, direction: np.ndarray, boxes: Sequence[Box]) -> bool:
