@@ -49,11 +49,11 @@ def _check_upright(frame: GravityFrame, pose: np.ndarray) -> None:
 
 
 #: A median summed edge error of the fitted boxes above this (metres) says the depth's units or
-#: the known sizes are wrong: the camera example's 23 boxes, 13 seen in part, err by a median
+#: the known sizes are wrong: the camera example's 22 boxes, many seen in part, err by a median
 #: 0.09 m; depth in centimetres read as millimetres by 0.53 m, sizes of 1.5 m by 2.4 m.
 SIZE_DOUBT_M = 0.25
 #: Fitted boxes whose longest edges' median is above this (metres) are no cartons: the depth is
-#: in a finer unit than declared (the camera example's 23 boxes: 0.40 m; read at 4 times the
+#: in a finer unit than declared (the camera example's 22 boxes: 0.40 m; read at 4 times the
 #: depth, 1.29 m).
 LARGE_FIT_M = 1.0
 #: A camera further in than the boxes' median by more than this (metres) stands beyond the pile
