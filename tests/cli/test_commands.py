@@ -246,7 +246,9 @@ def test_decide_says_why_for_the_pick_and_the_runner_up(tmp_path: Path) -> None:
     )
     result = unstack("decide", str(path))
     assert result.returncode == 0, result.stderr
-    assert "pick top: expected to move 0.10 boxes (it rests on bottom: P 0.90)" in result.stdout
+    assert "pick top: expected to move 0.10 boxes (top may hold up bottom: P 0.10; held up by bottom: P 0.90)" in (
+        result.stdout.replace("\n", " ").replace("  ", " ")
+    )
     assert "runner-up bottom: expected to move 0.90 boxes (bottom holds up top: P 0.90)" in result.stdout
 
 

@@ -10,7 +10,7 @@ import pytest
 
 from unstack.jsonio import load_schema
 from unstack.reasoner.decision import decide
-from unstack.reasoner.reasons import REASON_MIN_PROBABILITY, REASONS_PER_BOX, pick_reasons
+from unstack.reasoner.reasons import MAY_HOLD_PROBABILITY, REASON_MIN_PROBABILITY, REASONS_PER_BOX, pick_reasons
 from unstack.supports import Supports
 
 
@@ -42,6 +42,33 @@ def test_the_relations_named_are_the_strongest_conditional_ones(random_supports:
             assert p == pytest.approx(row[box], abs=1e-3) and p >= REASON_MIN_PROBABILITY
         strong = sorted(value for value in row.values() if value >= REASON_MIN_PROBABILITY)
         assert [p for _, p in named] == pytest.approx(sorted(strong, reverse=True)[:REASONS_PER_BOX], abs=1e-3)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_box_with_no_relation_to_name_names_its_likeliest_and_how_many(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n = 7
+    marginals = rng.uniform(0.0, 0.19, (n, n)) * (rng.uniform(size=(n, n)) < 0.5)
+    np.fill_diagonal(marginals, 0.0)
+    marginals[0] = 0.0  # a box that holds nothing up at all
+    reasons = pick_reasons(Supports([f"b{k}" for k in range(n)], marginals), marginals, marginals.sum(axis=1))
+    assert "may_hold_up" not in reasons[0] and reasons[0]["holds_up"] == []
+    for k, reason in enumerate(reasons[1:], start=1):
+        row = np.delete(marginals[k], k)
+        others = [f"b{j}" for j in range(n) if j != k]
+        if row.max() < MAY_HOLD_PROBABILITY:
+            assert "may_hold_up" not in reason
+            continue
+        box, p, count = reason["may_hold_up"]
+        assert box == others[int(np.argmax(row))] and p == pytest.approx(row.max(), abs=1e-3)
+        assert count == int(np.sum(row >= MAY_HOLD_PROBABILITY))
+
+
+def test_a_box_with_a_relation_to_name_has_no_likeliest_besides() -> None:
+    marginals = np.array([[0.0, 0.5], [0.1, 0.0]])
+    reasons = pick_reasons(Supports(["a", "b"], marginals), marginals, np.array([0.5, 0.1]))
+    assert reasons[0]["holds_up"] == [["b", 0.5]] and "may_hold_up" not in reasons[0]
+    assert reasons[1]["may_hold_up"] == ["a", 0.1, 1]
 
 
 def test_the_mass_cost_counts_kilograms_and_gives_no_reasons() -> None:

@@ -146,16 +146,22 @@ def _physics(record: dict[str, Any], choice: str) -> Text:
 def _why(decision: Decision) -> Text:
     """Why the pick and the runner-up cost what they cost: what each is expected to move and
     the relations that drive it."""
+    from unstack.reasoner.reasons import MAY_HOLD_PROBABILITY
+
     by_box = {reason["box"]: reason for reason in decision.reasons}
     ranked = sorted(decision.objects, key=lambda box: (box != decision.choice, by_box[box]["expected_moves"], box))
     text = Text()
     for label, box in zip(("pick", "runner-up"), ranked[:2], strict=False):
         reason = by_box[box]
         drivers = [f"{printable(box)} holds up {printable(other)}: P {p:.2f}" for other, p in reason["holds_up"]]
+        if "may_hold_up" in reason:  # none named: the likeliest, and how many make the cost together
+            other, p, count = reason["may_hold_up"]
+            among = f", one of {count} at P {MAY_HOLD_PROBABILITY:.2f} or more" if count > 1 else ""
+            drivers.append(f"{printable(box)} may hold up {printable(other)}: P {p:.2f}{among}")
         if reason["hidden_load"] >= 0.05:
             drivers.append(f"the cloud shows {reason['hidden_load']:.2f} undetected boxes on it")
         if reason["held_by"] is not None and reason["held_by"][1] >= 0.5:
-            drivers.append(f"it rests on {printable(reason['held_by'][0])}: P {reason['held_by'][1]:.2f}")
+            drivers.append(f"held up by {printable(reason['held_by'][0])}: P {reason['held_by'][1]:.2f}")
         because = "; ".join(drivers) if drivers else "it holds up no detected box and the cloud shows no load on it"
         text.append(f"{label} {printable(box)}: expected to move {reason['expected_moves']:.2f} boxes ({because})\n")
     return text

@@ -23,10 +23,13 @@ import numpy as np
 
 from unstack.supports import Supports
 
-__all__ = ["REASONS_PER_BOX", "REASON_COSTS", "REASON_MIN_PROBABILITY", "pick_reasons"]
+__all__ = ["MAY_HOLD_PROBABILITY", "REASONS_PER_BOX", "REASON_COSTS", "REASON_MIN_PROBABILITY", "pick_reasons"]
 
 #: Support relations below this conditional probability are not named as a reason.
 REASON_MIN_PROBABILITY = 0.2
+#: A box none of whose relations is named still names its likeliest one at or above this
+#: probability (``may_hold_up``), with how many are: together they may make its cost.
+MAY_HOLD_PROBABILITY = 0.05
 #: At most this many relations are named per box.
 REASONS_PER_BOX = 3
 #: The costs whose expected cost counts boxes (the reasons' ``expected_moves``); ``mass`` counts
@@ -51,7 +54,9 @@ def pick_reasons(supports: Supports, marginals: np.ndarray, expected: np.ndarray
     list of dict
         Per object: ``box``, ``expected_moves``, ``holds_up`` (up to :data:`REASONS_PER_BOX`
         ``[box, P]`` pairs with P at least :data:`REASON_MIN_PROBABILITY`, largest first),
-        ``hidden_load`` and ``held_by`` (the box most likely holding it up, with P).
+        ``hidden_load`` and ``held_by`` (the box most likely holding it up, with P); a box with
+        none to name has ``may_hold_up`` (``[box, P, count]``: its likeliest relation and how
+        many are at least :data:`MAY_HOLD_PROBABILITY`) where one is.
 
     Examples
     --------
@@ -71,13 +76,16 @@ def pick_reasons(supports: Supports, marginals: np.ndarray, expected: np.ndarray
     for k, box_id in enumerate(objects):
         named = [j for j in strongest[k] if others[k, j] >= REASON_MIN_PROBABILITY]
         holder = int(holders[k])
-        reasons.append(
-            {
-                "box": box_id,
-                "expected_moves": round(max(float(expected[k]), 0.0), 4),
-                "holds_up": [[objects[j], round(float(others[k, j]), 3)] for j in named],
-                "hidden_load": round(float(hidden[k]), 3),
-                "held_by": None if n < 2 else [objects[holder], round(float(others[holder, k]), 3)],
-            }
-        )
+        reason = {
+            "box": box_id,
+            "expected_moves": round(max(float(expected[k]), 0.0), 4),
+            "holds_up": [[objects[j], round(float(others[k, j]), 3)] for j in named],
+            "hidden_load": round(float(hidden[k]), 3),
+            "held_by": None if n < 2 else [objects[holder], round(float(others[holder, k]), 3)],
+        }
+        if not named and n > 1 and others[k, strongest[k][0]] >= MAY_HOLD_PROBABILITY:
+            likeliest = int(strongest[k][0])  # each relation under the naming bound: the likeliest, and how many
+            count = int(np.sum(others[k] >= MAY_HOLD_PROBABILITY))
+            reason["may_hold_up"] = [objects[likeliest], round(float(others[k, likeliest]), 3), count]
+        reasons.append(reason)
     return reasons
