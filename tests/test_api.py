@@ -93,6 +93,26 @@ def test_statics_raises_the_box_leant_on_and_can_be_turned_off(examples: Path) -
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize(("found_probability", "warned"), [(0.3, True), (0.9, False)])
+def test_a_statics_finding_the_consistent_worlds_make_unlikely_is_warned_about(
+    found_probability: float, warned: bool
+) -> None:
+    finding = {"held": "top", "supporter": "side", "overhang_m": 0.03, "on_floor": False}
+    supports = unstack.Supports(
+        ["top", "side", "floor"],
+        [[0.0, 0.2, 0.05], [found_probability, 0.0, 0.05], [0.9, 0.9, 0.0]],
+        metadata={"tip_supports": [finding]},
+    )
+    decision = unstack.decide(supports, seed=0)
+    said = [
+        warning for warning in decision.warnings if "statics found that 'top' cannot stand without 'side'" in warning
+    ]
+    assert bool(said) == warned
+    if warned:
+        final = decision.marginals[1, 0]
+        assert f"P(side supports top) is {final:.2f}" in said[0] and final < 0.5
+
+
 def test_plan_from_a_scene_and_from_supports(examples: Path) -> None:
     plan = unstack.plan(unstack.load_scene(examples / "pile5.scene.json"), seed=0)
     assert sorted(plan.order) == sorted(plan.objects)

@@ -425,6 +425,7 @@ def decide(
         )
         decision = _free_highest(decision, scene_or_supports, free_cost, near_tie_margin)
         decision = _doubting_free_cost(decision, supports, free_cost)
+        decision = _statics_outweighed(decision, supports)
     if veto_scene is not None:
         from unstack.height_veto import FREE_COST
         from unstack.physics_veto import physics_veto as vetoed
@@ -475,6 +476,31 @@ def _doubting_free_cost(decision: Decision, supports: Supports, free_cost: float
     if doubt is None:
         return decision
     return dataclasses.replace(decision, warnings=(*decision.warnings, supports.named(doubt)))
+
+
+def _statics_outweighed(decision: Decision, supports: Supports) -> Decision:
+    """The decision warning where statics found a box holding another up that the consistent
+    worlds then make unlikely: the raise said 0.65, the decision rests on the lower figure."""
+    import dataclasses
+
+    position = {box_id: k for k, box_id in enumerate(decision.objects)}
+    said = []
+    for found in supports.metadata.get("tip_supports", []):
+        supporter, held = str(found["supporter"]), str(found["held"])
+        if supporter not in position or held not in position:
+            continue
+        final = float(decision.marginals[position[supporter], position[held]])
+        if final < 0.5:
+            reverse = float(decision.marginals[position[held], position[supporter]])
+            said.append(
+                supports.named(
+                    f"statics found that {held!r} cannot stand without {supporter!r}, but over the consistent worlds "
+                    f"P({supporter} supports {held}) is {final:.2f} (raised to 0.65 before; P({held} supports "
+                    f"{supporter}) {reverse:.2f}): the decision takes the lower figure; {supporter!r} may hold "
+                    f"{held!r} up"
+                )
+            )
+    return dataclasses.replace(decision, warnings=(*decision.warnings, *said)) if said else decision
 
 
 def _described(decision: Decision, given: Scene | Supports, supports: Supports) -> Decision:
