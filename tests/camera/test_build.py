@@ -170,3 +170,32 @@ def test_the_masks_order_changes_no_box(example_frame) -> None:
         assert np.array_equal(boxes[box.id].position, box.position)
         assert np.array_equal(boxes[box.id].orientation_xyzw, box.orientation_xyzw)
         assert np.array_equal(boxes[box.id].size, box.size)
+
+
+def test_a_few_pixels_of_a_mask_on_another_box_are_left_out_with_a_warning(three_cartons) -> None:
+    depth, masks, pose = render_tops(three_cartons)
+    clean = scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES)
+    speckled = [mask.copy() for mask in masks]
+    rows, columns = np.nonzero(masks[1])
+    speckled[0][
+        rows[len(rows) // 2] : rows[len(rows) // 2] + 2, columns[len(rows) // 2] : columns[len(rows) // 2] + 2
+    ] = True
+    with pytest.warns(
+        UserWarning, match=r"mask b00: 1 piece\(s\) of 4 pixels apart from its main region of \d+ left out"
+    ):
+        built = scene_from_depth(depth, INTRINSICS, pose, speckled, known_sizes=SIZES)
+    for before, after in zip(clean.scene.boxes, built.scene.boxes, strict=True):
+        assert np.array_equal(before.position, after.position) and np.array_equal(before.size, after.size)
+
+
+def test_a_box_cut_in_two_by_something_thin_keeps_both_pieces(three_cartons) -> None:
+    depth, masks, pose = render_tops(three_cartons)
+    cut = [mask.copy() for mask in masks]
+    columns = np.flatnonzero(cut[1].any(axis=0))
+    cut[1][:, columns[len(columns) // 2]] = False  # a strap a pixel wide across the box
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no speck warning
+        built = scene_from_depth(depth, INTRINSICS, pose, cut, known_sizes=SIZES)
+    assert len(built.fitted) == 3

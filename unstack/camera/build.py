@@ -14,6 +14,7 @@ Examples
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -156,6 +157,38 @@ def _without_overlaps(fitted: list[FittedBox], unfitted: dict[str, str]) -> list
     return sorted(accepted, key=lambda item: order[item.box.id])
 
 
+#: A piece of a mask (8-connected) smaller than this share of its largest piece is a speck a
+#: detector left on something else (a few pixels on the box beside): left out with a warning.
+#: Two pieces of a box a thin thing in front cuts apart are each far larger.
+SPECK_SHARE = 0.05
+
+
+def _without_specks(mask: np.ndarray, name: str) -> np.ndarray:
+    """``mask`` without its specks (:data:`SPECK_SHARE`), with a warning naming them."""
+    from scipy.ndimage import label
+
+    rows, columns = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    if len(rows) == 0:
+        return mask
+    window = (slice(rows[0], rows[-1] + 1), slice(columns[0], columns[-1] + 1))
+    pieces, count = label(mask[window], structure=np.ones((3, 3), dtype=bool))
+    if count < 2:
+        return mask
+    sizes = np.bincount(pieces.ravel())[1:]
+    specks = np.flatnonzero(sizes < SPECK_SHARE * sizes.max())
+    if len(specks) == 0:
+        return mask
+    kept = mask.copy()
+    kept[window] &= ~np.isin(pieces, specks + 1)
+    pixels = ", ".join(str(int(sizes[k])) for k in specks[:5]) + (" ..." if len(specks) > 5 else "")
+    warnings.warn(
+        f"mask {name}: {len(specks)} piece(s) of {pixels} pixels apart from its main region of "
+        f"{int(sizes.max())} left out (a detector's specks on something else)",
+        stacklevel=3,
+    )
+    return kept
+
+
 def scene_from_depth(
     depth_m: np.ndarray,
     intrinsics: Intrinsics,
@@ -206,6 +239,7 @@ def scene_from_depth(
         door = list(toward_camera if horizontal > 0.3 * np.linalg.norm(toward_camera) else [-1.0, 0.0, 0.0])
     frame = gravity_frame(cloud, door=np.asarray(door, dtype=np.float64), seed=seed)
     _check_upright(frame, pose)
+    masks = [_without_specks(mask, name) for mask, name in zip(masks, names, strict=True)]
     duplicates = duplicate_masks(masks)
     merged = merged_masks(masks)
     kept = [k for k in range(len(masks)) if k not in duplicates and k not in merged]
