@@ -124,7 +124,7 @@ def test_a_sampled_plan_says_what_its_error_and_probability_columns_mean() -> No
     result = unstack.plan(Supports([f"b{i}" for i in range(12)], probabilities), method="approx", samples=200, seed=0)
     text = plan_text(result)
     assert "± s.e.: its standard error" in text
-    assert "P(minimum): the probability that the pick truly has the lowest EC at its step" in text
+    assert "P(minimum): the probability that the pick truly has the lowest EC at its step (the sampler" in text
 
 
 def test_expected_costs_too_small_for_four_decimals_keep_three_significant_digits() -> None:

@@ -219,7 +219,8 @@ def plan_view(result: Plan) -> Group:
     if sampled:
         note += (
             "; ± s.e.: its standard error (the step was sampled); P(minimum): the probability that the pick "
-            "truly has the lowest EC at its step"
+            "truly has the lowest EC at its step (the sampler's certainty of the ranking, not that the pick moves "
+            "nothing: that is what the EC says)"
         )
         free = {step.decision.free_cost for step in result.steps if step.decision.free_cost}
         if free:
