@@ -197,3 +197,14 @@ def test_the_constructors_refuse_what_is_not_theirs_with_the_path() -> None:
         unstack.Supports(["a", "b"], [[0, 0.1], [0.2, 0]], metadata=[1, 2])  # type: ignore[arg-type]
     with pytest.raises(InvalidScene, match=r"\$\.boxes\[0\]: expected a Box, got dict"):
         unstack.Scene([{"id": "a"}], [], ["a"])  # type: ignore[list-item]
+
+
+def test_an_out_of_distribution_warning_names_the_boxes_in_most_of_its_pairs() -> None:
+    rng = np.random.default_rng(0)
+    boxes = [unstack.Box(f"b{k}", [0.4, 0.3, 0.3], [1.0 + 0.45 * k, 0.0, 0.15]) for k in range(3)]
+    boxes.append(unstack.Box("tower", [0.4, 0.4, 4.0], [1.0, 0.6, 2.0]))  # a 4 m box: no training pile has one
+    cloud = rng.uniform([0.5, -0.5, 0.0], [2.5, 1.0, 1.0], (500, 3))
+    supports = unstack.support_probabilities(unstack.Scene(boxes, cloud, [box.id for box in boxes]))
+    [warning] = [text for text in supports.metadata["warnings"] if "out of distribution" in text]
+    assert "The boxes in most of those pairs: 'tower' (" in warning
+    assert "check their poses and sizes" in warning and "unstack train" in warning

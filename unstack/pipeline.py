@@ -21,6 +21,7 @@ Examples
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Sequence
 
 import numpy as np
@@ -53,9 +54,14 @@ def _out_of_distribution(
         for row, name, value, low, high in outside[:NAMED_OUT_OF_RANGE]
     )
     more = f" and {len(outside) - NAMED_OUT_OF_RANGE} more" if len(outside) > NAMED_OUT_OF_RANGE else ""
+    rows = sorted({row for row, *_ in outside})
+    counts = Counter(box for row in rows for box in pairs[row])
+    boxes = ", ".join(f"{box!r} ({count})" for box, count in counts.most_common(3))
     return [
-        f"{source}: out of distribution: features of {len({row for row, *_ in outside})} of {len(pairs)} box pairs "
-        f"lie outside the model's training range: {named}{more}; the probabilities there are extrapolated"
+        f"{source}: out of distribution: features of {len(rows)} of {len(pairs)} box pairs lie outside the model's "
+        f"training range: {named}{more}; the probabilities there are extrapolated. The boxes in most of those pairs: "
+        f"{boxes}: check their poses and sizes; if they are right, the piles are unlike the model's (unstack train "
+        "makes a model of piles like yours)"
     ]
 
 
