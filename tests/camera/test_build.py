@@ -199,3 +199,10 @@ def test_a_box_cut_in_two_by_something_thin_keeps_both_pieces(three_cartons) -> 
         warnings.simplefilter("error")  # no speck warning
         built = scene_from_depth(depth, INTRINSICS, pose, cut, known_sizes=SIZES)
     assert len(built.fitted) == 3
+
+
+def test_two_boxes_under_one_mask_are_warned_about(three_cartons) -> None:
+    depth, masks, pose = render_tops(three_cartons)
+    with pytest.warns(UserWarning, match=r"mask b00 is 2 pieces apart and the box fitted to it holds 0 % of one piece"):
+        built = scene_from_depth(depth, INTRINSICS, pose, [masks[0] | masks[1], masks[2]], known_sizes=SIZES)
+    assert len(built.fitted) == 2  # fitted as one box: the warning is what tells

@@ -25,6 +25,7 @@ from unstack.camera.boxes import FittedBox, boxes_from_masks, content_rng, dupli
 from unstack.camera.files import Intrinsics
 from unstack.camera.planes import GravityFrame, depth_points, gravity_frame
 from unstack.errors import UnstackError
+from unstack.geometry import points_in_box
 from unstack.scene import Box, Scene
 
 __all__ = ["CameraScene", "scene_from_depth"]
@@ -163,6 +164,34 @@ def _without_overlaps(fitted: list[FittedBox], unfitted: dict[str, str]) -> list
 SPECK_SHARE = 0.05
 
 
+#: Pieces of a mask more than twice this many pixels apart are apart (a strap in front of a
+#: box cuts it into pieces closer than that).
+PIECES_GAP = 3
+
+
+#: A piece of a fitted mask with less than this share of its points in (or within 3 cm of) the
+#: fitted box belongs to another box.
+PIECE_INSIDE_SHARE = 0.5
+
+
+def _pieces(mask: np.ndarray) -> list[np.ndarray]:
+    """The pieces of ``mask`` that lie apart (:data:`PIECES_GAP`), each as a mask."""
+    from scipy.ndimage import binary_dilation, label
+
+    rows, columns = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    if len(rows) == 0:
+        return []
+    window = (slice(rows[0], rows[-1] + 1), slice(columns[0], columns[-1] + 1))
+    grown = binary_dilation(mask[window], structure=np.ones((3, 3), dtype=bool), iterations=PIECES_GAP, border_value=0)
+    labels, count = label(grown, structure=np.ones((3, 3), dtype=bool))
+    pieces = []
+    for piece in range(1, count + 1):
+        whole = np.zeros_like(mask)
+        whole[window] = mask[window] & (labels == piece)
+        pieces.append(whole)
+    return pieces
+
+
 def _without_specks(mask: np.ndarray, name: str) -> np.ndarray:
     """``mask`` without its specks (:data:`SPECK_SHARE`), with a warning naming them."""
     from scipy.ndimage import label
@@ -251,6 +280,29 @@ def scene_from_depth(
             points = points[subset]
         mask_points.append(points)
     fitted, unfitted = boxes_from_masks(mask_points, [names[k] for k in kept], known_sizes=known_sizes, seed=seed)
+    by_id = {item.box.id: item.box for item in fitted}
+    for k in kept:  # a mask of pieces apart: two boxes under one label, fitted as one or not at all
+        pieces = _pieces(masks[k])
+        if len(pieces) > 1 and names[k] in unfitted:
+            unfitted[names[k]] += f" (its mask is {len(pieces)} pieces apart: two boxes under one label?)"
+        elif len(pieces) > 1:  # one box seen on both sides of something in front: every piece on the fitted box
+            inside = [
+                float(
+                    np.mean(
+                        points_in_box(
+                            frame.apply(depth_points(depth_m, intrinsics, pose, piece)), by_id[names[k]], margin=0.03
+                        )
+                    )
+                )
+                for piece in pieces
+            ]
+            if min(inside) < PIECE_INSIDE_SHARE:
+                warnings.warn(
+                    f"mask {names[k]} is {len(pieces)} pieces apart and the box fitted to it holds "
+                    f"{100 * min(inside):.0f} % of one piece's points: two boxes under one label, or one box seen "
+                    "on both sides of something in front and fitted to one side; check its pose",
+                    stacklevel=2,
+                )
     for j, held in merged.items():
         named = [names[k] for k in held[:3]]
         others = (
