@@ -43,6 +43,23 @@ def test_a_box_at_the_free_cost_is_not_free(tall_and_low: Scene) -> None:
     assert free_highest(reasoned([FREE_COST, 0.0]), tall_and_low).choice == "low"
 
 
+def test_a_box_statics_found_holding_another_is_not_free_while_another_is(tall_and_low: Scene) -> None:
+    decision = free_highest(reasoned([0.3, 0.0]), tall_and_low, holding={"tall"})
+    assert (decision.choice, decision.ties) == ("low", ("low",))
+    only = free_highest(reasoned([0.3, 0.9]), tall_and_low, holding={"tall"})  # no other free box: as before
+    assert (only.choice, only.ties) == ("tall", ("tall",))
+
+
+def test_decide_on_a_scene_does_not_take_the_box_statics_found_holding_another() -> None:
+    """'lean' leans on 'upright' (statics finds it); 'upright' is the highest box: never taken free."""
+    scene = unstack.load("examples/leaning.scene.json")
+    supports = unstack.support_probabilities(scene)
+    assert {(found["supporter"], found["held"]) for found in supports.metadata["tip_supports"]} == {("upright", "lean")}
+    for free_cost in (0.5, 0.7, 0.9):
+        decision = unstack.decide(scene, seed=0, free_cost=free_cost)
+        assert decision.choice != "upright" and "upright" not in decision.ties
+
+
 def test_no_free_box_keeps_the_reasoners_choice(tall_and_low: Scene) -> None:
     decision = reasoned([0.9, 0.7])
     assert free_highest(decision, tall_and_low) is decision

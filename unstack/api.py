@@ -423,7 +423,7 @@ def decide(
             time_limit=time_limit,
             near_tie_margin=near_tie_margin,
         )
-        decision = _free_highest(decision, scene_or_supports, free_cost, near_tie_margin)
+        decision = _free_highest(decision, scene_or_supports, supports, free_cost, near_tie_margin)
         decision = _doubting_free_cost(decision, supports, free_cost)
         decision = _statics_outweighed(decision, supports)
     if veto_scene is not None:
@@ -449,9 +449,14 @@ def _physics_veto_scene(given: Scene | Supports, cost: str) -> Scene:
 
 
 def _free_highest(
-    decision: Decision, given: Scene | Supports, free_cost: float | None, near_tie_margin: float | None
+    decision: Decision,
+    given: Scene | Supports,
+    supports: Supports,
+    free_cost: float | None,
+    near_tie_margin: float | None,
 ) -> Decision:
-    """The default pick on a scene: the highest free box (:func:`unstack.height_veto.free_highest`)."""
+    """The default pick on a scene: the highest free box (:func:`unstack.height_veto.free_highest`),
+    a box statics found holding another up not counted free."""
     from unstack.height_veto import FREE_COST, free_highest
 
     if not isinstance(given, Scene):
@@ -463,7 +468,12 @@ def _free_highest(
         return decision
     if free_cost is None:
         free_cost = 0.0 if near_tie_margin == 0 else FREE_COST
-    return free_highest(decision, given, free_cost=free_cost)
+    holding = {  # of the boxes still in place (a plan's later steps)
+        str(found["supporter"])
+        for found in supports.metadata.get("tip_supports", [])
+        if {found["supporter"], found["held"]} <= set(decision.objects)
+    }
+    return free_highest(decision, given, free_cost=free_cost, holding=holding)
 
 
 def _doubting_free_cost(decision: Decision, supports: Supports, free_cost: float | None) -> Decision:
@@ -580,6 +590,6 @@ def plan(
         progress=progress,
         near_tie_margin=near_tie_margin,
         choose_step=lambda decision: _doubting_free_cost(
-            _free_highest(decision, scene_or_supports, free_cost, near_tie_margin), supports, free_cost
+            _free_highest(decision, scene_or_supports, supports, free_cost, near_tie_margin), supports, free_cost
         ),
     )

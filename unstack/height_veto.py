@@ -25,7 +25,7 @@ Examples
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from unstack.errors import InvalidArgument
@@ -103,7 +103,9 @@ def hybrid_choice(scene: Scene, decision: Any, *, candidates: Sequence[str] | No
     return highest_free_box(scene, costs, candidates=candidates)
 
 
-def free_highest(decision: Decision, scene: Scene, *, free_cost: float = FREE_COST) -> Decision:
+def free_highest(
+    decision: Decision, scene: Scene, *, free_cost: float = FREE_COST, holding: Collection[str] = ()
+) -> Decision:
     """The decision with its choice the highest box whose expected cost is below ``free_cost``.
 
     Parameters
@@ -114,6 +116,9 @@ def free_highest(decision: Decision, scene: Scene, *, free_cost: float = FREE_CO
         Where the boxes are: a box's height is its centre's z.
     free_cost : float
         Boxes below it count as holding nothing up; 0 keeps the decision as it is.
+    holding : collection of str
+        Boxes known to hold another up whatever their expected cost (statics' findings:
+        ``supports.metadata["tip_supports"]``): not free while another box is.
 
     Returns
     -------
@@ -148,6 +153,7 @@ def free_highest(decision: Decision, scene: Scene, *, free_cost: float = FREE_CO
         raise InvalidArgument(f"{scene.source}: the decision's boxes {unknown} are not in the scene")
     costs = {box_id: float(cost) for box_id, cost in zip(decision.objects, decision.expected_costs, strict=True)}
     free = sorted(box_id for box_id in decision.objects if costs[box_id] < free_cost)
+    free = [box_id for box_id in free if box_id not in holding] or free
     if not free:
         return decision
     choice = highest_free_box(scene, costs, max_cost=free_cost, candidates=free)
