@@ -220,7 +220,7 @@ def convex_overlap(first: np.ndarray, second: np.ndarray) -> np.ndarray:
     --------
     >>> square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float)
     >>> convex_overlap(square, square + 0.5).tolist()
-    [[1.0, 0.5], [1.0, 1.0], [0.5, 1.0], [0.5, 0.5]]
+    [[0.5, 0.5], [1.0, 0.5], [1.0, 1.0], [0.5, 1.0]]
     """
     clipped = np.asarray(first, dtype=np.float64).reshape(-1, 2)
     for k in range(len(second)):
