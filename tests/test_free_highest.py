@@ -46,8 +46,25 @@ def test_a_box_at_the_free_cost_is_not_free(tall_and_low: Scene) -> None:
 def test_a_box_statics_found_holding_another_is_not_free_while_another_is(tall_and_low: Scene) -> None:
     decision = free_highest(reasoned([0.3, 0.0]), tall_and_low, holding={"tall"})
     assert (decision.choice, decision.ties) == ("low", ("low",))
+    assert decision.warnings[-1].endswith(
+        "'tall' (EC 0.30) below 0.5 but found by statics holding another box up: not taken as free"
+    )
     only = free_highest(reasoned([0.3, 0.9]), tall_and_low, holding={"tall"})  # no other free box: as before
     assert (only.choice, only.ties) == ("tall", ("tall",))
+
+
+@pytest.mark.parametrize(
+    ("found", "ties"), [([("tall", "low")], ("low",)), ([("tall", "low"), ("low", "tall")], ("low", "tall"))]
+)
+def test_two_boxes_found_holding_each_other_up_are_both_free(
+    tall_and_low: Scene, found: list[tuple[str, str]], ties: tuple[str, ...]
+) -> None:
+    """Findings that contradict each other come of poses off: neither keeps a box from being free."""
+    from unstack.api import _free_highest
+
+    findings = [{"supporter": supporter, "held": held} for supporter, held in found]
+    supports = Supports(["tall", "low"], [[0.0, 0.3], [0.0, 0.0]], metadata={"tip_supports": findings})
+    assert _free_highest(reasoned([0.3, 0.2]), tall_and_low, supports, None, None).ties == ties
 
 
 def test_decide_on_a_scene_does_not_take_the_box_statics_found_holding_another() -> None:

@@ -468,11 +468,13 @@ def _free_highest(
         return decision
     if free_cost is None:
         free_cost = 0.0 if near_tie_margin == 0 else FREE_COST
-    holding = {  # of the boxes still in place (a plan's later steps)
-        str(found["supporter"])
-        for found in supports.metadata.get("tip_supports", [])
-        if {found["supporter"], found["held"]} <= set(decision.objects)
+    found = {  # of the boxes still in place (a plan's later steps)
+        (str(finding["supporter"]), str(finding["held"]))
+        for finding in supports.metadata.get("tip_supports", [])
+        if {finding["supporter"], finding["held"]} <= set(decision.objects)
     }
+    # two boxes found holding each other up contradict each other (poses off): neither is taken as held
+    holding = {supporter for supporter, held in found if (held, supporter) not in found}
     return free_highest(decision, given, free_cost=free_cost, holding=holding)
 
 

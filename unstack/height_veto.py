@@ -153,12 +153,22 @@ def free_highest(
         raise InvalidArgument(f"{scene.source}: the decision's boxes {unknown} are not in the scene")
     costs = {box_id: float(cost) for box_id, cost in zip(decision.objects, decision.expected_costs, strict=True)}
     free = sorted(box_id for box_id in decision.objects if costs[box_id] < free_cost)
-    free = [box_id for box_id in free if box_id not in holding] or free
+    held = [box_id for box_id in free if box_id in holding]
+    said = decision.warnings
+    if held and len(held) < len(free):  # another box is free: those statics found holding a box up are not
+        free = [box_id for box_id in free if box_id not in holding]
+        said = (
+            *said,
+            f"{scene.source}: {', '.join(f'{box_id!r} (EC {costs[box_id]:.2f})' for box_id in held)} below "
+            f"{free_cost:g} but found by statics holding another box up: not taken as free",
+        )
     if not free:
         return decision
     choice = highest_free_box(scene, costs, max_cost=free_cost, candidates=free)
     below = probability_below(decision, choice, free_cost)
-    return dataclasses.replace(decision, choice=choice, ties=tuple(free), free_cost=free_cost, choice_probability=below)
+    return dataclasses.replace(
+        decision, choice=choice, ties=tuple(free), free_cost=free_cost, choice_probability=below, warnings=said
+    )
 
 
 def probability_below(decision: Decision, box_id: str, bound: float) -> float:
