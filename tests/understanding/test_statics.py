@@ -302,3 +302,24 @@ def test_a_finding_about_a_box_not_among_the_objects_is_refused() -> None:
 
     with pytest.raises(InvalidArgument, match="found: 'zz' is not one of objects"):
         raise_tip_supports(np.zeros((2, 2)), ["a", "b"], [TipSupport("a", "zz", 0.05, True)])
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_an_upright_box_a_pose_error_above_the_floor_stands_on_it(seed: int) -> None:
+    """Poses 1-2 cm off: a wall's bottom box seen 1.7 cm above the floor (the floor's points under
+    it, seen at a slant and 3 mm noisy, make a base of a few points), its neighbour beside it."""
+    low = Box("low", [0.4, 0.5, 0.3], [1.3, 0.0, 0.167])
+    beside = Box("beside", [0.4, 0.5, 0.3], [1.3, 0.502, 0.15])
+    on = Box("on", [0.4, 0.5, 0.3], [1.3, 0.03, 0.47])
+    cloud = surface_cloud([low, beside, on], viewpoint=(-1.8, 0.0, 1.6), spacing=0.02, depth_noise=0.003, seed=seed)
+    assert tip_supports(Scene([low, beside, on], cloud, ["low", "beside", "on"])) == []
+
+
+def test_a_box_reaching_into_an_upright_box_at_its_top_holds_it_at_no_side() -> None:
+    """The carton 5 cm past the short box's edge, nothing beside it but a box whose pose puts its
+    bottom a centimetre below the carton's top, against the carton's side there."""
+    scene = _overhang_against_a_column(0.05, column=False)
+    carton = scene.box("carton")
+    top = float(carton.position[2]) + 0.125
+    on = Box("on", [0.4, 0.3, 0.3], [1.3, float(carton.position[1]) + 0.25 + 0.15 + 0.002, top - 0.01 + 0.15])
+    assert tip_supports(Scene([*scene.boxes, on], np.zeros((0, 3)), [*scene.detected, "on"])) == []

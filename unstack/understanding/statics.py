@@ -19,7 +19,9 @@ without a model. For each detected box ``Y``:
   bottom and the tops of the upright boxes under it overlap (a carton on a short box whose
   centre is past that box's edge, kept from tipping by a taller box beside it), by no more
   than a push from the side can hold, and the cloud shows nothing nobody detected under the
-  part of it beyond its base (what stands there may hold it);
+  part of it beyond its base (what stands there may hold it); it is held at its side below its
+  top (not by a box on it whose pose reaches into it), and one whose bottom is within
+  :data:`UPRIGHT_FLOOR_GAP` of the floor stands on the floor;
 * a box that stands, tilted or not, is held up by a detected box of its base without whose
   contacts it would tip (the centre more than :data:`MIN_OVERHANG` outside the rest of the
   base, that box's contacts beyond its edge): a box across a gap between two, a box on its
@@ -71,6 +73,7 @@ __all__ = [
     "MIN_OVERHANG",
     "MIN_TILT_DEG",
     "TIP_SUPPORT_PROBABILITY",
+    "UPRIGHT_FLOOR_GAP",
     "UPRIGHT_OVERHANG",
     "TipSupport",
     "raise_tip_supports",
@@ -114,6 +117,9 @@ MIN_OVERHANG = 0.01
 #: under it, a centimetre off each, do not make a box on a box look as if it overhangs (its base
 #: on an upright box is measured to the edges of the two faces' overlap, not to the grid).
 UPRIGHT_OVERHANG = 0.02
+#: An upright box whose bottom is at most this far above the floor stands on it (metres): its
+#: pose is off in z by a detector's error, and the floor is under all of it.
+UPRIGHT_FLOOR_GAP = 0.03
 #: Points of the cloud, near no detected box, under the part of an upright box beyond its base
 #: that show something nobody detected standing there: the rule for upright boxes then finds nothing.
 SEEN_UNDER_POINTS = 3
@@ -344,6 +350,8 @@ def tip_supports(
             tipping = _tipping(box, _to_overlap_edges(base, box, boxes), exclude=None)
         if tipping is not None and not tilted and _seen_under(cloud, box, tipping[1], tipping[2], boxes):
             tipping = None  # upright over something nobody detected: what stands there may hold it
+        if tipping is not None and not tilted and lowest <= UPRIGHT_FLOOR_GAP:
+            tipping = None  # upright with its bottom a pose error off the floor: it stands on the floor
         if tipping is not None and (tilted or tipping[0] > UPRIGHT_OVERHANG):  # it cannot stand on its base
             if not tilted:  # upright, its centre well beyond its base: its sides were not sampled
                 _, beside, lowest = _contacts(box, boxes, neighbours, downward_only=False)
@@ -355,6 +363,8 @@ def tip_supports(
                     & (pushes[:, 2] >= -0.1)
                     & (contacts[:, 2] >= lowest + MIN_RISE)
                     & ((contacts[:, :2] - edge) @ direction > 0.0)
+                    # an upright box is held at its side, not at its top (where a box on it reaches, poses off)
+                    & (tilted | (contacts[:, 2] <= bounds[row, 5] - CONTACT_GAP))
                 )
                 if np.any(holds) and (tilted or overhang <= _held_overhang(contacts[holds], edge, direction, lowest)):
                     leant_on.append(supporter)
