@@ -212,7 +212,8 @@ def _without_specks(mask: np.ndarray, name: str) -> np.ndarray:
     pixels = ", ".join(str(int(sizes[k])) for k in specks[:5]) + (" ..." if len(specks) > 5 else "")
     warnings.warn(
         f"mask {name}: {len(specks)} piece(s) of {pixels} pixels apart from its main region of "
-        f"{int(sizes.max())} left out (a detector's specks on something else)",
+        f"{int(sizes.max())} left out (a detector's speck on something else, or a part of the box seen through a "
+        "gap: too little to fit)",
         stacklevel=3,
     )
     return kept
