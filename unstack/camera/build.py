@@ -174,14 +174,21 @@ PIECES_GAP = 3
 PIECE_INSIDE_SHARE = 0.5
 
 
+def _window(mask: np.ndarray) -> tuple[slice, slice] | None:
+    """The rows and columns of the rectangle around ``mask``'s pixels (None when it has none)."""
+    rows, columns = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    if len(rows) == 0:
+        return None
+    return slice(rows[0], rows[-1] + 1), slice(columns[0], columns[-1] + 1)
+
+
 def _pieces(mask: np.ndarray) -> list[np.ndarray]:
     """The pieces of ``mask`` that lie apart (:data:`PIECES_GAP`), each as a mask."""
     from scipy.ndimage import binary_dilation, label
 
-    rows, columns = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
-    if len(rows) == 0:
+    window = _window(mask)
+    if window is None:
         return []
-    window = (slice(rows[0], rows[-1] + 1), slice(columns[0], columns[-1] + 1))
     grown = binary_dilation(mask[window], structure=np.ones((3, 3), dtype=bool), iterations=PIECES_GAP, border_value=0)
     labels, count = label(grown, structure=np.ones((3, 3), dtype=bool))
     pieces = []
@@ -196,10 +203,9 @@ def _without_specks(mask: np.ndarray, name: str) -> np.ndarray:
     """``mask`` without its specks (:data:`SPECK_SHARE`), with a warning naming them."""
     from scipy.ndimage import label
 
-    rows, columns = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
-    if len(rows) == 0:
+    window = _window(mask)
+    if window is None:
         return mask
-    window = (slice(rows[0], rows[-1] + 1), slice(columns[0], columns[-1] + 1))
     pieces, count = label(mask[window], structure=np.ones((3, 3), dtype=bool))
     if count < 2:
         return mask
@@ -287,17 +293,11 @@ def scene_from_depth(
         if len(pieces) > 1 and names[k] in unfitted:
             unfitted[names[k]] += f" (its mask is {len(pieces)} pieces apart: two boxes under one label?)"
         elif len(pieces) > 1:  # one box seen on both sides of something in front: every piece on the fitted box
+            seen = [frame.apply(depth_points(depth_m, intrinsics, pose, piece)) for piece in pieces]
             inside = [
-                float(
-                    np.mean(
-                        points_in_box(
-                            frame.apply(depth_points(depth_m, intrinsics, pose, piece)), by_id[names[k]], margin=0.03
-                        )
-                    )
-                )
-                for piece in pieces
+                float(np.mean(points_in_box(points, by_id[names[k]], margin=0.03))) for points in seen if len(points)
             ]
-            if min(inside) < PIECE_INSIDE_SHARE:
+            if inside and min(inside) < PIECE_INSIDE_SHARE:
                 warnings.warn(
                     f"mask {names[k]} is {len(pieces)} pieces apart and the box fitted to it holds "
                     f"{100 * min(inside):.0f} % of one piece's points: two boxes under one label, or one box seen "
