@@ -8,6 +8,7 @@ import pytest
 from unstack.camera import Intrinsics
 
 CAMERA_HEIGHT = 2.5
+MAX_RANGE = 6.0
 INTRINSICS = Intrinsics(fx=300.0, fy=300.0, cx=159.5, cy=119.5, width=320, height=240)
 
 
@@ -47,3 +48,57 @@ def render_tops(boxes: list[tuple[float, float, float, float, float, float]], ti
 def three_cartons():
     """Three cartons of two sizes, turned 0, 20 and -35 degrees, one on another's level."""
     return [(0.0, 0.0, 0.0, 0.4, 0.3, 0.3), (0.65, 0.1, 20.0, 0.6, 0.4, 0.4), (-0.45, -0.3, -35.0, 0.4, 0.3, 0.3)]
+
+
+def looking_in(height: float = 1.2, pitch_deg: float = 20.0) -> np.ndarray:
+    """Camera-to-world pose of a camera at the door (x = 0) ``height`` up, looking along +x and
+    ``pitch_deg`` down."""
+    forward = np.array([np.cos(np.radians(pitch_deg)), 0.0, -np.sin(np.radians(pitch_deg))])
+    right = np.array([0.0, -1.0, 0.0])
+    down = np.cross(forward, right)
+    pose = np.eye(4)
+    pose[:3, :3] = np.column_stack([right, down, forward])
+    pose[:3, 3] = [0.0, 0.0, height]
+    return pose
+
+
+FLOOR = (np.array([0.0, 0.0, 1.0]), 0.0)
+
+
+def render_boxes(boxes, pose: np.ndarray, planes=(FLOOR,)):
+    """Depth (metres along the optical axis) and one mask per box for :class:`~unstack.scene.Box`
+    objects in any orientation, and planes ``(normal, offset)`` (default: the floor z = 0)
+    seen from the side their normal points to."""
+    from unstack.geometry import rotation_matrix
+
+    rows, columns = np.mgrid[0 : INTRINSICS.height, 0 : INTRINSICS.width]
+    rays = (
+        np.stack(
+            [(columns - INTRINSICS.cx) / INTRINSICS.fx, (rows - INTRINSICS.cy) / INTRINSICS.fy, np.ones(rows.shape)], -1
+        )
+        @ pose[:3, :3].T
+    )  # world directions whose optical-axis part is 1: the distance along them is the depth
+    origin = pose[:3, 3]
+    depth = np.full(rows.shape, np.inf)
+    owner = np.full(rows.shape, -1)
+    for normal, offset in planes:
+        facing = rays @ normal
+        with np.errstate(divide="ignore", invalid="ignore"):
+            distance = (offset - origin @ normal) / facing
+        hit = (facing < 0) & (distance > 0) & (distance < depth)
+        depth[hit] = distance[hit]
+    for index, box in enumerate(boxes):
+        rotation = rotation_matrix(box.orientation_xyzw)
+        local_origin = (origin - box.position) @ rotation
+        local_rays = rays @ rotation
+        half = np.asarray(box.size) / 2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            first = (-half - local_origin) / local_rays
+            second = (half - local_origin) / local_rays
+        near = np.nanmax(np.minimum(first, second), axis=-1)
+        far = np.nanmin(np.maximum(first, second), axis=-1)
+        hit = (near <= far) & (near > 0) & (near < depth)
+        depth[hit] = near[hit]
+        owner[hit] = index
+    depth[~np.isfinite(depth) | (depth > MAX_RANGE)] = 0.0  # nothing within the sensor's range
+    return depth, [owner == index for index in range(len(boxes))]

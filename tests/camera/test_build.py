@@ -206,3 +206,24 @@ def test_two_boxes_under_one_mask_are_warned_about(three_cartons) -> None:
     with pytest.warns(UserWarning, match=r"mask b00 is 2 pieces apart and the box fitted to it holds 0 % of one piece"):
         built = scene_from_depth(depth, INTRINSICS, pose, [masks[0] | masks[1], masks[2]], known_sizes=SIZES)
     assert len(built.fitted) == 2  # fitted as one box: the warning is what tells
+
+
+def test_a_camera_at_the_door_that_sees_more_ceiling_than_floor_is_upright() -> None:
+    from tests.camera.conftest import looking_in, render_boxes
+    from unstack.scene import Box
+
+    boxes = [Box("a", [0.4, 0.3, 0.3], [2.0, 0.0, 0.15]), Box("b", [0.6, 0.4, 0.4], [2.0, 0.5, 0.2])]
+    ceiling = (np.array([0.0, 0.0, -1.0]), -1.6)  # z = 1.6, seen from below
+    back = (np.array([-1.0, 0.0, 0.0]), -4.0)  # the container's front wall, 4 m in
+    pose = looking_in(height=1.2, pitch_deg=5.0)
+    depth, masks = render_boxes(boxes, pose, planes=[(np.array([0.0, 0.0, 1.0]), 0.0), ceiling, back])
+    cloud_z = (pose[:3, :3] @ np.array([0.0, 0.0, 1.0]))[2]
+    assert cloud_z < 0.1  # looking nearly level: most of what the camera sees above the boxes is ceiling
+    built = scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES)
+    assert [sorted(box.size) for box in built.scene.boxes] == [sorted(box.size) for box in boxes]
+    assert sum(count for height, count in built.frame.plane_heights if height > 1.2) > sum(
+        count for height, count in built.frame.plane_heights if height < 1.2
+    )  # the ceiling outweighs the floor and the tops: the planes alone would call the pose upside down
+    upside_down = np.diag([1.0, -1.0, -1.0, 1.0]) @ pose
+    with pytest.raises(UnstackError, match="the pose's z points down"):
+        scene_from_depth(depth, INTRINSICS, upside_down, masks, known_sizes=SIZES)

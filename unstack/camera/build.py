@@ -36,16 +36,28 @@ MAX_MASK_POINTS = 20_000
 MAX_SCENE_POINTS = 200_000
 
 
-def _check_upright(frame: GravityFrame, pose: np.ndarray) -> None:
-    """Raise when the pose's z points down: a camera sees horizontal surfaces (the floor, the tops
-    of boxes) from above, so most of their points lie below it -- unless the frame is upside down."""
+#: Points of the masks looked at for the pose's up (every n-th of a larger union).
+UPRIGHT_SAMPLE = 20_000
+
+
+def _check_upright(frame: GravityFrame, pose: np.ndarray, box_points: Sequence[np.ndarray]) -> None:
+    """Raise when the pose's z points down: a camera sees the tops of boxes from above, so the
+    boxes' horizontal surfaces lie below it -- unless the frame is upside down. (The cloud's
+    planes cannot tell: a camera at a container's door sees the ceiling from below, and a
+    ceiling larger than the floor and the tops it sees is no sign of a pose upside down.)
+    Boxes showing no horizontal surface (all seen from the front) say nothing either way."""
+    from unstack.camera.planes import HORIZONTAL_TOLERANCE_DEG, surface_normals
+
+    points = np.concatenate([*box_points, np.empty((0, 3))])
+    points = points[:: max(1, -(-len(points) // UPRIGHT_SAMPLE))]
+    flat = np.abs(surface_normals(points)[:, 2]) >= np.cos(np.radians(HORIZONTAL_TOLERANCE_DEG))
     camera_height = float(frame.apply(pose[None, :3, 3])[0, 2])
-    below = sum(count for height, count in frame.plane_heights if height < camera_height)
-    above = sum(count for height, count in frame.plane_heights if height > camera_height)
+    above = int(np.sum(points[flat, 2] > camera_height))
+    below = int(np.sum(points[flat, 2] < camera_height))
     if above > below:
         raise UnstackError(
-            f"the camera sees {above} of the {above + below} points of horizontal surfaces from below (a camera sees "
-            "the floor and the tops of boxes from above): the pose's z points down; expected a camera-to-world "
+            f"the camera sees {above} of the {above + below} points of the boxes' horizontal surfaces from below "
+            "(a camera sees the tops of boxes from above): the pose's z points down; expected a camera-to-world "
             "pose whose z is up"
         )
 
@@ -274,7 +286,6 @@ def scene_from_depth(
         horizontal = np.linalg.norm(toward_camera[:2])
         door = list(toward_camera if horizontal > 0.3 * np.linalg.norm(toward_camera) else [-1.0, 0.0, 0.0])
     frame = gravity_frame(cloud, door=np.asarray(door, dtype=np.float64), seed=seed)
-    _check_upright(frame, pose)
     masks = [_without_specks(mask, name) for mask, name in zip(masks, names, strict=True)]
     duplicates = duplicate_masks(masks)
     merged = merged_masks(masks)
@@ -286,6 +297,7 @@ def scene_from_depth(
             subset = content_rng(seed, np.flatnonzero(masks[k])).choice(len(points), MAX_MASK_POINTS, replace=False)
             points = points[subset]
         mask_points.append(points)
+    _check_upright(frame, pose, mask_points)
     fitted, unfitted = boxes_from_masks(mask_points, [names[k] for k in kept], known_sizes=known_sizes, seed=seed)
     by_id = {item.box.id: item.box for item in fitted}
     for k in kept:  # a mask of pieces apart: two boxes under one label, fitted as one or not at all

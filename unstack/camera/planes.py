@@ -25,7 +25,7 @@ import numpy as np
 from unstack.camera.files import Intrinsics
 from unstack.errors import UnstackError
 
-__all__ = ["GravityFrame", "depth_points", "fit_plane", "gravity_frame"]
+__all__ = ["GravityFrame", "depth_points", "fit_plane", "gravity_frame", "surface_normals"]
 
 #: Distance (metres) within which a point belongs to a plane.
 PLANE_THRESHOLD = 0.01
@@ -140,6 +140,28 @@ def fit_plane(
         normal, offset = refined, float(refined @ centre)
         inliers = np.abs(points @ normal - offset) < threshold
     return normal, offset, inliers
+
+
+def surface_normals(points: np.ndarray, neighbours: int = 12) -> np.ndarray:
+    """Each point's unit surface normal: the smallest principal axis of it and its nearest
+    ``neighbours`` (the sign is arbitrary).
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> flat = np.column_stack([rng.uniform(0, 1, 200), rng.uniform(0, 1, 200), np.zeros(200)])
+    >>> bool(np.all(np.abs(surface_normals(flat)[:, 2]) > 0.999))
+    True
+    """
+    from scipy.spatial import cKDTree
+
+    points = np.asarray(points, dtype=np.float64)
+    if len(points) < 3:
+        return np.zeros((len(points), 3))
+    _, near = cKDTree(points).query(points, k=min(neighbours + 1, len(points)))
+    patches = points[near] - points[near].mean(axis=1, keepdims=True)
+    normals: np.ndarray = np.linalg.eigh(np.einsum("nki,nkj->nij", patches, patches))[1][:, :, 0]
+    return normals
 
 
 @dataclass(frozen=True)
