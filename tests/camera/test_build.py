@@ -227,3 +227,67 @@ def test_a_camera_at_the_door_that_sees_more_ceiling_than_floor_is_upright() -> 
     upside_down = np.diag([1.0, -1.0, -1.0, 1.0]) @ pose
     with pytest.raises(UnstackError, match="the pose's z points down"):
         scene_from_depth(depth, INTRINSICS, upside_down, masks, known_sizes=SIZES)
+
+
+def _turned(axis: list[float], degrees: float, yaw_deg: float = 0.0) -> np.ndarray:
+    from scipy.spatial.transform import Rotation
+
+    tilt = Rotation.from_rotvec(np.radians(degrees) * np.asarray(axis) / np.linalg.norm(axis))
+    return (Rotation.from_euler("z", yaw_deg, degrees=True) * tilt).as_quat()
+
+
+def _axis_error_deg(first: np.ndarray, second: np.ndarray) -> float:
+    """The largest angle between an axis of one orientation and the nearest axis of the other."""
+    dots = np.abs(rotation_matrix(first).T @ rotation_matrix(second))
+    return float(np.degrees(np.arccos(min(1.0, dots.max(axis=0).min()))))
+
+
+@pytest.mark.parametrize("tilt_deg", [8.0, 20.0, 35.0])
+@pytest.mark.parametrize(
+    ("axis", "yaw_deg"), [([0.0, 1.0, 0.0], 0.0), ([1.0, 0.0, 0.0], 15.0), ([1.0, 1.0, 0.0], -30.0)]
+)
+def test_a_box_lying_tilted_is_fitted_in_full_3d(tilt_deg: float, axis: list[float], yaw_deg: float) -> None:
+    from tests.camera.conftest import looking_in, render_boxes
+    from unstack.scene import Box
+
+    rng = np.random.default_rng(int(tilt_deg * 10 + yaw_deg))
+    size = np.array(SIZES[rng.integers(0, 2)])
+    box = Box("a", size, [2.0 + rng.uniform(-0.2, 0.2), rng.uniform(-0.3, 0.3), 0.45], _turned(axis, tilt_deg, yaw_deg))
+    pose = looking_in(height=1.6, pitch_deg=30.0)
+    depth, masks = render_boxes([box], pose)
+    built = scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES, door=[-1.0, 0.0, 0.0])
+    [fitted] = built.fitted
+    assert fitted.face == "tilted"
+    assert _axis_error_deg(fitted.box.orientation_xyzw, box.orientation_xyzw) < 2.0
+    assert np.linalg.norm(fitted.box.position - box.position) < 0.015
+    assert sorted(fitted.box.size) == pytest.approx(sorted(size))
+
+    def reach(item: Box) -> np.ndarray:  # the box's extent along x, y and z: each edge along its own axis
+        return np.abs(rotation_matrix(item.orientation_xyzw)) @ item.size
+
+    assert reach(fitted.box) == pytest.approx(reach(box), abs=0.02)
+
+
+@pytest.mark.parametrize("tilt_deg", [0.0, 3.0])
+def test_a_box_within_a_few_degrees_of_upright_is_fitted_upright(tilt_deg: float) -> None:
+    from tests.camera.conftest import looking_in, render_boxes
+    from unstack.scene import Box
+
+    box = Box("a", SIZES[0], [2.0, 0.1, 0.2], _turned([0.0, 1.0, 0.0], tilt_deg, 10.0))
+    pose = looking_in(height=1.6, pitch_deg=30.0)
+    depth, masks = render_boxes([box], pose)
+    [fitted] = scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES, door=[-1.0, 0.0, 0.0]).fitted
+    assert fitted.face == "top"
+    assert rotation_matrix(fitted.box.orientation_xyzw)[2, 2] == pytest.approx(1.0)
+
+
+def test_a_tilted_box_without_known_sizes_takes_its_seen_edges() -> None:
+    from tests.camera.conftest import looking_in, render_boxes
+    from unstack.scene import Box
+
+    box = Box("a", [0.6, 0.4, 0.4], [2.0, 0.0, 0.4], _turned([0.0, 1.0, 0.0], -25.0))  # the top turned to the camera
+    pose = looking_in(height=1.6, pitch_deg=30.0)
+    depth, masks = render_boxes([box], pose)
+    [fitted] = scene_from_depth(depth, INTRINSICS, pose, masks, door=[-1.0, 0.0, 0.0]).fitted
+    assert fitted.face == "tilted"
+    assert sorted(fitted.box.size) == pytest.approx([0.4, 0.4, 0.6], abs=0.02)

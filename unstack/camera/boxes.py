@@ -21,6 +21,13 @@ A mask that shows no top face (a box above the camera, seen from the front) is f
 its front face instead: the vertical plane's normal gives the yaw, the face its width and
 height, the known size its depth.
 
+A box lying **tilted** (its faces :data:`TILT_MIN_DEG` or more from level and plumb, as boxes
+dropped on others rest) is fitted in full 3-D: up to three planes of the mask's points are its
+visible faces, the largest face's normal and a second face square to it (or the smallest
+rectangle around the largest face) give its axes, the known size nearest the faces' edges its
+size, and each seen face fixes where the box ends on that axis (the box lies behind it, away
+from the camera).
+
 Examples
 --------
 >>> rng = np.random.default_rng(0)
@@ -71,6 +78,15 @@ OVERSIZE_WEIGHT = 4.0
 #: Known sizes whose top edges differ from the rectangle's by less than this (metres, summed)
 #: are ties, decided by where the bottom lands.
 SIZE_TIE = 0.02
+#: A box whose axes are tilted at least this far from upright (degrees) is fitted in full 3-D
+#: from its faces (:func:`fit_box`); below it, upright from its top or front face.
+TILT_MIN_DEG = 5.0
+#: Faces of a tilted box: planes holding at least this share of the mask's points ...
+TILTED_FACE_SHARE = 0.1
+#: ... whose normal is within this many degrees of square to the first face's (a second face).
+SQUARE_TOLERANCE_DEG = 20.0
+#: Where no viewpoint is given, faces are taken to look this way (out through the door and up).
+DEFAULT_VIEW = (-1.0, 0.0, 1.0)
 
 
 @dataclass(frozen=True)
@@ -83,8 +99,8 @@ class FittedBox:
     Attributes
     ----------
     box : Box
-    face : {"top", "front"}
-        The face it was fitted from.
+    face : {"top", "front", "tilted"}
+        The face it was fitted from ("tilted": in full 3-D from the faces of a box lying tilted).
     residual_m : float
         RMS distance of the face's points to the fitted face plane.
     fill : float
@@ -213,8 +229,13 @@ def fit_box(
     known_sizes: Sequence[Sequence[float]] | None,
     surfaces: Sequence[float],
     rng: np.random.Generator,
+    viewpoint: Sequence[float] | None = None,
 ) -> FittedBox:
-    """Fit one box to a mask's points (gravity frame); see the module docstring."""
+    """Fit one box to a mask's points (gravity frame); see the module docstring.
+
+    ``viewpoint``: where the camera stands (gravity frame), the side a tilted box's seen faces
+    look to; default: out through the door and up (:data:`DEFAULT_VIEW`).
+    """
     points = np.asarray(points, dtype=np.float64)
     if len(points) < MIN_FACE_POINTS:
         raise UnstackError(
@@ -222,9 +243,138 @@ def fit_box(
         )
     up = np.array([0.0, 0.0, 1.0])
     normal, offset, inliers = fit_plane(points, rng=rng, near_normal=up)
-    if inliers.sum() >= max(MIN_FACE_POINTS, TOP_SHARE * len(points)):
+    top_seen = bool(inliers.sum() >= max(MIN_FACE_POINTS, TOP_SHARE * len(points)))
+    if top_seen and normal @ up >= np.cos(np.radians(TILT_MIN_DEG)):
+        return _fit_from_top(box_id, points, normal, offset, inliers, known_sizes, surfaces, rng)
+    # the tilted fit draws from a child generator: the upright fits below draw as they would without it
+    tilted = _fit_tilted(box_id, points, known_sizes, rng.spawn(1)[0], viewpoint)
+    if tilted is not None:
+        return tilted
+    if top_seen:
         return _fit_from_top(box_id, points, normal, offset, inliers, known_sizes, surfaces, rng)
     return _fit_from_front(box_id, points, known_sizes, rng)
+
+
+def _tilted_axes(
+    points: np.ndarray, rng: np.random.Generator, toward: np.ndarray
+) -> tuple[np.ndarray, list[tuple[int, float, float, np.ndarray]]] | None:
+    """A tilted box's axes (rows, right-handed) from the planes of its points, and its seen faces
+    as ``(axis, side, place, inliers)``: the box lies from ``place`` along the axis towards
+    ``side`` (+1 or -1), away from ``toward`` (a point: the camera); None when no face holds
+    :data:`TILTED_FACE_SHARE` of the points."""
+    remaining = np.ones(len(points), dtype=bool)
+    planes: list[tuple[np.ndarray, float, np.ndarray]] = []
+    while len(planes) < 3 and remaining.sum() >= MIN_FACE_POINTS:
+        normal, offset, inliers = fit_plane(points[remaining], rng=rng)
+        if inliers.sum() < max(MIN_FACE_POINTS, TILTED_FACE_SHARE * len(points)):
+            break
+        where = np.flatnonzero(remaining)[inliers]
+        face = np.zeros(len(points), dtype=bool)
+        face[where] = True
+        if normal @ (toward - points[face].mean(axis=0)) < 0:
+            normal, offset = -normal, -offset
+        planes.append((normal, offset, face))
+        remaining &= ~face
+    if not planes:
+        return None
+    first = planes[0][0]
+    square = [plane for plane in planes[1:] if abs(plane[0] @ first) < np.sin(np.radians(SQUARE_TOLERANCE_DEG))]
+    if square:
+        second = square[0][0] - (square[0][0] @ first) * first
+    else:  # one face: its smallest rectangle gives the other two axes
+        helper = np.array([0.0, 0.0, 1.0]) if abs(first[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+        u = np.cross(first, helper)
+        u /= np.linalg.norm(u)
+        v = np.cross(first, u)
+        face_points = points[planes[0][2]]
+        _, angle, _ = min_area_rectangle(np.column_stack([face_points @ u, face_points @ v]))
+        second = np.cos(angle) * u + np.sin(angle) * v
+    second /= np.linalg.norm(second)
+    axes = np.vstack([first, second, np.cross(first, second)])
+    seen: list[tuple[int, np.ndarray, np.ndarray]] = [(0, first, planes[0][2])]
+    for normal, _, face in planes[1:]:
+        axis = int(np.argmax(np.abs(axes @ normal)))
+        if axis != 0 and abs(axes[axis] @ normal) >= np.cos(np.radians(SQUARE_TOLERANCE_DEG)):
+            seen.append((axis, normal, face))
+    # each seen face: its axis, which way the box lies from it along that axis (against the face's
+    # normal, which looks at the camera), and where the face is along it
+    faces = [
+        (axis, -float(np.sign(axes[axis] @ normal)), float(np.median(points[face] @ axes[axis])), face)
+        for axis, normal, face in seen
+    ]
+    return axes, faces
+
+
+def _match_tilted_size(
+    extents: np.ndarray, observed: np.ndarray, known_sizes: Sequence[Sequence[float]] | None
+) -> tuple[np.ndarray, float]:
+    """The box's size along its three axes and the error: the known size (in any of its six
+    turns) nearest the extents measured along the ``observed`` axes (a longer measure costs
+    :data:`OVERSIZE_WEIGHT` times a shorter); without known sizes, the measured extents, and
+    an axis no face shows as deep as the shorter seen one."""
+    if not known_sizes:
+        seen = extents[observed]
+        depth = float(seen.min()) if len(seen) else float(extents.max())
+        return np.where(observed, extents, depth), 0.0
+    best: tuple[float, np.ndarray] | None = None
+    for size in known_sizes:
+        for turn in ((0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)):
+            placed = np.asarray(size, dtype=np.float64)[list(turn)]
+            difference = (extents - placed)[observed]
+            error = float(np.sum(np.where(difference > 0, OVERSIZE_WEIGHT * difference, -difference)))
+            if best is None or error < best[0] - 1e-12:
+                best = (error, placed)
+    assert best is not None
+    return best[1], best[0]
+
+
+def _fit_tilted(
+    box_id: str,
+    points: np.ndarray,
+    known_sizes: Sequence[Sequence[float]] | None,
+    rng: np.random.Generator,
+    viewpoint: Sequence[float] | None,
+) -> FittedBox | None:
+    """A box fitted in full 3-D from its seen faces; None when it stands within
+    :data:`TILT_MIN_DEG` of upright (the upright fits are better there) or shows no face."""
+    from scipy.spatial.transform import Rotation
+
+    centroid = points.mean(axis=0)
+    toward = np.asarray(viewpoint, dtype=np.float64) if viewpoint is not None else centroid + np.asarray(DEFAULT_VIEW)
+    found = _tilted_axes(points, rng, toward)
+    if found is None:
+        return None
+    axes, faces = found
+    if np.max(np.abs(axes[:, 2])) >= np.cos(np.radians(TILT_MIN_DEG)):
+        return None
+    local = points @ axes.T
+    low, high = np.percentile(local, 1, axis=0), np.percentile(local, 99, axis=0)
+    first = local[faces[0][3]]
+    spacing = _spacing(first[:, 1:])
+    extents = high - low + spacing
+    observed = np.ones(3, dtype=bool)
+    observed[0] = len(faces) > 1  # the depth behind the first face shows only on another face
+    size, size_error = _match_tilted_size(extents, observed, known_sizes)
+    seen_faces = {axis: (side, place) for axis, side, place, _ in faces}
+    view = (toward - centroid) / max(float(np.linalg.norm(toward - centroid)), 1e-9)
+    centre = np.empty(3)
+    for axis in range(3):
+        if axis in seen_faces:  # the box lies behind its seen face
+            side, place = seen_faces[axis]
+            centre[axis] = place + side * size[axis] / 2
+        elif axes[axis] @ view > 0.2:  # the end nearer the camera is the one seen
+            centre[axis] = high[axis] + spacing / 2 - size[axis] / 2
+        elif axes[axis] @ view < -0.2:
+            centre[axis] = low[axis] - spacing / 2 + size[axis] / 2
+        else:
+            centre[axis] = (low[axis] + high[axis]) / 2
+    residual = float(np.sqrt(np.mean((first[:, 0] - faces[0][2]) ** 2)))
+    face_extents = np.array([extents[1], extents[2]])
+    fill = _fill(first[:, 1:], (low[1:] + high[1:]) / 2, 0.0, face_extents)
+    partial = fill < PARTIAL_FILL or bool(np.any((size - extents)[observed] > PARTIAL_EDGE))
+    quaternion = Rotation.from_matrix(axes.T).as_quat()
+    box = Box(box_id, size, centre @ axes, quaternion)
+    return FittedBox(box, "tilted", residual, fill, size_error, len(points), partial)
 
 
 def _fit_from_top(
@@ -440,13 +590,15 @@ def boxes_from_masks(
     *,
     known_sizes: Sequence[Sequence[float]] | None = None,
     seed: int = 0,
+    viewpoint: Sequence[float] | None = None,
 ) -> tuple[list[FittedBox], dict[str, str]]:
     """Fit a box to each mask's points (gravity frame); bottoms land on the floor or other tops.
 
     Returns the fitted boxes and, for each mask that could not be fitted, why. Each mask's
     RANSAC draws from its own generator, seeded by ``seed`` and the mask's points
     (:func:`content_rng`): a box's fit depends on its own points only, not on the masks given
-    before it or their order.
+    before it or their order. ``viewpoint``: the camera's place (gravity frame), see
+    :func:`fit_box`.
     """
     if len(mask_points) != len(ids):
         raise UnstackError(f"{len(mask_points)} masks but {len(ids)} ids")
@@ -457,7 +609,9 @@ def boxes_from_masks(
         surfaces = [0.0, *(top for j, top in enumerate(tops) if j != k)]
         try:
             rng = content_rng(seed, points)
-            fitted.append(fit_box(box_id, points, known_sizes=known_sizes, surfaces=surfaces, rng=rng))
+            fitted.append(
+                fit_box(box_id, points, known_sizes=known_sizes, surfaces=surfaces, rng=rng, viewpoint=viewpoint)
+            )
         except InvalidFile as error:  # a box no carton is: say so of the fit, not of an array
             unfitted[box_id] = f"the fitted box's {error.json_path[2:]}: {error.message}"
         except UnstackError as error:

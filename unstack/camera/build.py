@@ -298,7 +298,10 @@ def scene_from_depth(
             points = points[subset]
         mask_points.append(points)
     _check_upright(frame, pose, mask_points)
-    fitted, unfitted = boxes_from_masks(mask_points, [names[k] for k in kept], known_sizes=known_sizes, seed=seed)
+    viewpoint = frame.apply(pose[None, :3, 3])[0]
+    fitted, unfitted = boxes_from_masks(
+        mask_points, [names[k] for k in kept], known_sizes=known_sizes, seed=seed, viewpoint=viewpoint
+    )
     by_id = {item.box.id: item.box for item in fitted}
     for k in kept:  # a mask of pieces apart: two boxes under one label, fitted as one or not at all
         pieces = _pieces(masks[k])
