@@ -354,7 +354,9 @@ def _fit_tilted(
     extents = high - low + spacing
     observed = np.ones(3, dtype=bool)
     observed[0] = len(faces) > 1  # the depth behind the first face shows only on another face
-    size, size_error = _match_tilted_size(extents, observed, known_sizes)
+    size, _ = _match_tilted_size(extents, observed, known_sizes)
+    across = size[1:] - extents[1:]  # the largest face's two edges, as the upright fits report
+    size_error = float(np.sum(np.where(across < 0, -OVERSIZE_WEIGHT * across, across))) if known_sizes else 0.0
     seen_faces = {axis: (side, place) for axis, side, place, _ in faces}
     view = (toward - centroid) / max(float(np.linalg.norm(toward - centroid)), 1e-9)
     centre = np.empty(3)

@@ -63,12 +63,12 @@ def _check_upright(frame: GravityFrame, pose: np.ndarray, box_points: Sequence[n
 
 
 #: A median summed edge error of the fitted boxes above this (metres) says the depth's units or
-#: the known sizes are wrong: the camera example's 22 boxes, many seen in part, err by a median
-#: 0.09 m; depth in centimetres read as millimetres by 0.53 m, sizes of 1.5 m by 2.4 m.
+#: the known sizes are wrong: the camera example's 29 boxes, many seen in part, err by a median
+#: 0.08 m; depth in centimetres read as millimetres by 0.53 m, sizes of 1.5 and 2.4 m by 1.32 m.
 SIZE_DOUBT_M = 0.25
 #: Fitted boxes whose longest edges' median is above this (metres) are no cartons: the depth is
-#: in a finer unit than declared (the camera example's 22 boxes: 0.40 m; read at 4 times the
-#: depth, 1.29 m).
+#: in a finer unit than declared (the camera example's 29 boxes: 0.40 m; read at 4 times the
+#: depth, 1.59 m).
 LARGE_FIT_M = 1.0
 #: A camera further in than the boxes' median by more than this (metres) stands beyond the pile
 #: from the door: the door's direction was given the wrong way (a camera looking down from above
