@@ -222,8 +222,8 @@ def test_decide_on_a_scene_takes_the_highest_free_box_unless_free_cost_is_0(tmp_
     )
     words = " ".join(unstack("decide", str(path)).stdout.split())
     assert (
-        "Unload first: tall (tied with low: EC below 0.5, so more likely than not holding nothing up; the box whose centre is highest wins)"
-        in words
+        "Unload first: tall (tied with low: EC below 0.5, so more likely than not holding nothing up; the box whose centre is highest wins "
+        "(on equal heights, the larger id))" in words
     )
 
 

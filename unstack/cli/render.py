@@ -232,7 +232,8 @@ def _tie_rule(margin: float, free_cost: float) -> str:
     """How the choice was made among the tied boxes, in words."""
     if free_cost:
         return (
-            f"EC below {free_cost:g}, so more likely than not holding nothing up; the box whose centre is highest wins"
+            f"EC below {free_cost:g}, so more likely than not holding nothing up; the box whose centre is highest wins "
+            "(on equal heights, the larger id)"
         )
     if margin:
         return f"EC within {margin:g} of the lowest; the box resting highest wins, on one layer the lowest EC"
