@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import unstack
-from unstack.experiments.camera_roundtrip import yaw_error_deg
+from unstack.experiments.camera_roundtrip import axis_error_deg, yaw_error_deg
 
 pytestmark = pytest.mark.slow  # renders piles and decides
 
@@ -23,10 +23,22 @@ def test_yaw_errors_are_taken_modulo_the_top_face_symmetry(turn_deg: float, squa
     assert yaw_error_deg(np.array([0.0, 0.0, 0.0, 1.0]), turned, square) == pytest.approx(error, abs=1e-6)
 
 
+@pytest.mark.parametrize(
+    ("axis", "turn_deg", "error"), [([0, 0, 1], 90.0, 0.0), ([0, 1, 0], 180.0, 0.0), ([0, 1, 0], 30.0, 30.0)]
+)
+def test_axis_errors_pair_each_axis_with_the_nearest_true_one(axis: list[float], turn_deg: float, error: float) -> None:
+    half = np.radians(turn_deg) / 2
+    turned = np.array([*(np.sin(half) * np.asarray(axis, dtype=float)), np.cos(half)])
+    assert axis_error_deg(np.array([0.0, 0.0, 0.0, 1.0]), turned) == pytest.approx(error, abs=1e-6)
+
+
 def test_the_cli_reports_errors_and_decisions(small_dataset: Path, tmp_path: Path) -> None:
     run = unstack("experiment", "camera-roundtrip", str(small_dataset), "--out", str(tmp_path), "--piles", "2")
     assert run.returncode == 0, run.stderr
-    assert "position error (mm)" in run.stdout
-    summary = json.loads((tmp_path / "camera-roundtrip.json").read_text())["summary"]
+    assert "position error (mm)" in run.stdout and "axis error (degrees)" in run.stdout
+    result = json.loads((tmp_path / "camera-roundtrip.json").read_text())
+    summary, piles = result["summary"], result["piles"]
     assert summary["piles"] == 2 and summary["boxes"] <= summary["masks"]
     assert summary["position_error_m_median"] < 0.02
+    assert summary["axis_error_deg_median"] < 2.0
+    assert summary["tilted_boxes"] == sum(box["true_tilt_deg"] >= 5.0 for pile in piles for box in pile["boxes"])

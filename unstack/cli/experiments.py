@@ -18,7 +18,7 @@ from unstack.cli.progress import progress_bar
 from unstack.cli.text import number_table
 from unstack.errors import UnstackError
 from unstack.experiments.belief_calibration import belief_calibration
-from unstack.experiments.camera_roundtrip import camera_roundtrip
+from unstack.experiments.camera_roundtrip import TILTED_DEG, camera_roundtrip
 from unstack.experiments.container import (
     CONTAINER_SAMPLES,
     DEFAULT_CONTAINER_MAKERS,
@@ -610,6 +610,15 @@ def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, pi
     table.add_row(
         "yaw error (degrees)", f"{summary['yaw_error_deg_median']:.1f}", f"{summary['yaw_error_deg_p90']:.1f}"
     )
+    table.add_row(
+        "axis error (degrees)", f"{summary['axis_error_deg_median']:.1f}", f"{summary['axis_error_deg_p90']:.1f}"
+    )
+    if summary["tilted_boxes"]:
+        table.add_row(
+            f"position error of the {summary['tilted_boxes']} boxes lying tilted {TILTED_DEG:g} degrees or more (mm)",
+            f"{1000 * summary['tilted_position_error_m_median']:.1f}",
+            f"{1000 * summary['tilted_position_error_m_p90']:.1f}",
+        )
     if summary["whole_boxes"]:
         table.add_row(
             f"position error of the {summary['whole_boxes']} boxes whose face was seen whole (mm)",

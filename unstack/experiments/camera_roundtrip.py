@@ -4,7 +4,8 @@ Each pile of a simulated data set is rendered as a robot's camera would hand it 
 (:func:`unstack.sim.camera_view.camera_view`: depth image, intrinsics, pose, one mask per
 seen box); :func:`unstack.camera.scene_from_depth` builds the scene back with the data set's
 carton sizes as the known sizes. Per fitted box: the position error (metres), the yaw error
-(degrees, modulo the top face's symmetry: 180 degrees, 90 for a square top), whether the
+(degrees, modulo the top face's symmetry: 180 degrees, 90 for a square top), the axis error
+(:func:`axis_error_deg`, which a box lying tilted has too), whether the
 size is the true one, and the fit's residual; the errors also for the boxes whose face was
 seen whole alone (:attr:`unstack.camera.FittedBox.partial`, what the fit itself says). Per
 pile: whether the default decision on the built scene picks the same box as on the true
@@ -28,7 +29,10 @@ import numpy as np
 from unstack.experiments.dispatch import run_unordered
 from unstack.parameters import COUNT, JOBS, validate_params
 
-__all__ = ["camera_roundtrip", "yaw_error_deg"]
+__all__ = ["TILTED_DEG", "axis_error_deg", "camera_roundtrip", "yaw_error_deg"]
+
+#: Boxes lying tilted at least this far from standing on a face (degrees) are reported apart.
+TILTED_DEG = 5.0
 
 
 def yaw_error_deg(truth_xyzw: np.ndarray, fitted_xyzw: np.ndarray, square_top: bool) -> float:
@@ -42,6 +46,22 @@ def yaw_error_deg(truth_xyzw: np.ndarray, fitted_xyzw: np.ndarray, square_top: b
     period = np.pi / 2 if square_top else np.pi
     difference = np.mod(heading(truth_xyzw) - heading(fitted_xyzw), period)
     return float(np.degrees(min(difference, period - difference)))
+
+
+def axis_error_deg(truth_xyzw: np.ndarray, fitted_xyzw: np.ndarray) -> float:
+    """The largest angle between an axis of the fitted box and the nearest axis of the true one
+    (degrees: 0 when the two boxes' axes are the same lines, whatever their order and signs).
+
+    Examples
+    --------
+    >>> quarter_turn = np.array([0.0, 0.0, np.sin(np.pi / 4), np.cos(np.pi / 4)])
+    >>> round(axis_error_deg(np.array([0.0, 0.0, 0.0, 1.0]), quarter_turn), 6)
+    0.0
+    """
+    from unstack.geometry import rotation_matrix
+
+    dots = np.abs(rotation_matrix(np.asarray(truth_xyzw)).T @ rotation_matrix(np.asarray(fitted_xyzw)))
+    return float(np.degrees(np.arccos(min(1.0, float(dots.max(axis=0).min())))))
 
 
 def _long_edge_quaternion(box: Any) -> np.ndarray:
@@ -58,6 +78,7 @@ def _long_edge_quaternion(box: Any) -> np.ndarray:
 
 def _roundtrip_pile(path: Path, number: int, model: Any, samples: int) -> tuple[int, dict[str, Any]]:
     from unstack.camera import scene_from_depth
+    from unstack.geometry import tilt_deg
     from unstack.pipeline import scene_support_probabilities
     from unstack.reasoner.decision import decide
     from unstack.scene import Scene, load_scene
@@ -81,6 +102,8 @@ def _roundtrip_pile(path: Path, number: int, model: Any, samples: int) -> tuple[
             **item.to_dict(),
             "position_error_m": float(np.linalg.norm(item.box.position - truth.position)),
             "yaw_error_deg": yaw_error_deg(_long_edge_quaternion(truth), _long_edge_quaternion(item.box), square),
+            "axis_error_deg": axis_error_deg(truth.orientation_xyzw, item.box.orientation_xyzw),
+            "true_tilt_deg": tilt_deg(truth),
             "size_right": bool(np.allclose(np.sort(item.box.size), true_size, atol=1e-6)),
         })  # fmt: skip
     detected = [item.box.id for item in built.fitted]
@@ -109,7 +132,8 @@ def camera_roundtrip(
     Returns
     -------
     dict
-        ``summary``: fitted boxes, median and 90th-percentile position and yaw errors, share
+        ``summary``: fitted boxes, median and 90th-percentile position, yaw and axis errors (the
+        last also for the boxes lying tilted :data:`TILTED_DEG` or more in the pile), share
         of sizes right, median residual, share of piles whose decision on the built scene is
         the one on the true poses; ``piles``: every box of every pile.
     """
@@ -129,6 +153,8 @@ def camera_roundtrip(
     position = np.array([box["position_error_m"] for box in boxes])
     yaw = np.array([box["yaw_error_deg"] for box in boxes])
     whole = np.array([not box["partial"] for box in boxes], dtype=bool)
+    tilted = np.array([box["true_tilt_deg"] >= TILTED_DEG for box in boxes], dtype=bool)
+    axes = np.array([box["axis_error_deg"] for box in boxes])
     summary = {
         "piles": len(done),
         "masks": int(sum(result["masks"] for result in done)),
@@ -137,6 +163,12 @@ def camera_roundtrip(
         "position_error_m_p90": float(np.percentile(position, 90)),
         "yaw_error_deg_median": float(np.median(yaw)),
         "yaw_error_deg_p90": float(np.percentile(yaw, 90)),
+        "axis_error_deg_median": float(np.median(axes)),
+        "axis_error_deg_p90": float(np.percentile(axes, 90)),
+        "tilted_boxes": int(tilted.sum()),
+        "tilted_position_error_m_median": float(np.median(position[tilted])) if tilted.any() else None,
+        "tilted_position_error_m_p90": float(np.percentile(position[tilted], 90)) if tilted.any() else None,
+        "tilted_axis_error_deg_median": float(np.median(axes[tilted])) if tilted.any() else None,
         "whole_boxes": int(whole.sum()),
         "whole_position_error_m_median": float(np.median(position[whole])) if whole.any() else None,
         "whole_position_error_m_p90": float(np.percentile(position[whole], 90)) if whole.any() else None,
