@@ -291,3 +291,26 @@ def test_a_tilted_box_without_known_sizes_takes_its_seen_edges() -> None:
     [fitted] = scene_from_depth(depth, INTRINSICS, pose, masks, door=[-1.0, 0.0, 0.0]).fitted
     assert fitted.face == "tilted"
     assert sorted(fitted.box.size) == pytest.approx([0.4, 0.4, 0.6], abs=0.02)
+
+
+@pytest.mark.parametrize("seed", range(12))
+@pytest.mark.parametrize(("tilt_deg", "tilted"), [(0.0, False), (2.0, False), (20.0, True)])
+def test_depth_noise_of_two_centimetres_keeps_upright_and_tilted_apart(
+    seed: int, tilt_deg: float, tilted: bool
+) -> None:
+    from scipy.spatial.transform import Rotation
+
+    from tests.camera.conftest import looking_in, render_boxes
+    from unstack.scene import Box
+
+    rng = np.random.default_rng(seed)
+    tilt = Rotation.from_rotvec(np.radians(tilt_deg) * np.array([1.0, 0.0, 0.0]))
+    turned = (Rotation.from_euler("z", rng.uniform(0.0, 90.0), degrees=True) * tilt).as_quat()
+    size = SIZES[seed % 2]
+    box = Box("a", size, [2.5 + rng.uniform(-0.3, 0.3), rng.uniform(-0.4, 0.4), size[2] / 2 + 0.01], turned)
+    pose = looking_in(height=1.6, pitch_deg=30.0)
+    depth, masks = render_boxes([box], pose)
+    noisy = np.where(depth > 0, depth + rng.normal(0.0, 0.02, depth.shape), 0.0)
+    [fitted] = scene_from_depth(noisy, INTRINSICS, pose, masks, known_sizes=SIZES, door=[-1.0, 0.0, 0.0]).fitted
+    assert (fitted.face == "tilted") is tilted  # upright: from its top or its front
+    assert _axis_error_deg(fitted.box.orientation_xyzw, box.orientation_xyzw) < 5.0
