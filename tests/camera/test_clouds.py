@@ -37,6 +37,35 @@ def test_a_tilted_frame_is_levelled_and_the_box_stands_on_the_floor(tilt_deg: fl
     assert box.size.tolist() == [0.4, 0.3, 0.3]
 
 
+def _quaternion(rotation: np.ndarray) -> list[float]:
+    from scipy.spatial.transform import Rotation
+
+    return [float(value) for value in Rotation.from_matrix(rotation).as_quat()]
+
+
+@pytest.mark.parametrize(
+    ("frame_tilt_deg", "box_tilt_deg", "kept"),
+    [(0.0, 30.0, True), (9.0, 30.0, True), (9.0, 0.0, False), (0.0, 3.0, False), (9.0, -9.0, False)],
+)  # the last: given upright in the detector's tilted frame
+def test_a_detection_lying_tilted_in_both_frames_keeps_its_tilt(
+    frame_tilt_deg: float, box_tilt_deg: float, kept: bool
+) -> None:
+    turn = _tilt(frame_tilt_deg)  # the detector's frame against gravity
+    cloud = _floor_and_top(np.random.default_rng(3)) @ turn.T + [0.0, 0.0, 0.5]
+    lying = _tilt(box_tilt_deg)  # the box against gravity
+    given = turn @ lying  # as the detector sees it in its frame
+    centre = (turn @ [0.0, 0.0, 0.3]) + [0.0, 0.0, 0.5]
+    detection = {"id": "a", "center": centre.tolist(), "size": [0.4, 0.3, 0.3], "orientation_xyzw": _quaternion(given)}
+    box = scene_from_cloud(cloud, [detection]).scene.box("a")
+    rotation = rotation_matrix(box.orientation_xyzw)
+    if kept:
+        assert rotation == pytest.approx(lying, abs=0.01)  # the tilt against gravity, not the frame's
+        assert box.size.tolist() == [0.4, 0.3, 0.3]
+    else:
+        assert abs(rotation[2, 2]) == pytest.approx(1.0)  # levelled
+    assert box.position[2] == pytest.approx(0.3, abs=0.005)
+
+
 def _write_pcd(path: Path, points: np.ndarray, data: str) -> None:
     header = (
         "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"

@@ -7,8 +7,11 @@
   ``"orientation_xyzw"`` instead of the yaw) in the cloud's frame, a list or ``{"boxes": [...]}``;
 * :func:`scene_from_cloud` finds gravity and the floor from the cloud's horizontal planes
   (:func:`unstack.camera.planes.gravity_frame`), moves cloud and boxes into that frame and
-  levels each box: a detector's frame tilted against gravity tilts its boxes with it, while a
-  carton stands level, so only each box's heading about the gravity frame's z is kept.
+  levels each box that stands within :data:`~unstack.camera.boxes.TILT_MIN_DEG` of upright in
+  the detector's frame or in the gravity frame: a detector's frame tilted against gravity tilts
+  its boxes with it (or a detector reports boxes upright in its own frame), so only each box's
+  heading about the gravity frame's z is kept. A box given tilted further than that in both
+  frames (as a box dropped on others lies) keeps its whole orientation, in the gravity frame.
 
 Examples
 --------
@@ -270,10 +273,18 @@ def _heading(rotation: np.ndarray, size: np.ndarray) -> tuple[float, np.ndarray]
     return float(np.arctan2(direction[1], direction[0])), np.array([size[longest], size[other], size[vertical]])
 
 
+def _tilt_deg(rotation: np.ndarray) -> float:
+    """The angle between z and the box axis standing most upright (degrees)."""
+    return float(np.degrees(np.arccos(min(1.0, float(np.max(np.abs(rotation[2])))))))
+
+
 def scene_from_cloud(
     points: np.ndarray, detections: Sequence[dict[str, Any]], *, door: Sequence[float] | None = None, seed: int = 0
 ) -> CameraScene:
     """Build a scene from a cloud and box detections in the same frame (z roughly up)."""
+    from scipy.spatial.transform import Rotation
+
+    from unstack.camera.boxes import TILT_MIN_DEG
     from unstack.checks import check_points
     from unstack.geometry import rotation_matrix
     from unstack.scene import finite_points
@@ -291,10 +302,16 @@ def scene_from_cloud(
         else:
             yaw = np.radians(float(item.get("yaw_deg", 0.0)))
             rotation = np.array([[np.cos(yaw), -np.sin(yaw), 0.0], [np.sin(yaw), np.cos(yaw), 0.0], [0.0, 0.0, 1.0]])
-        heading, size = _heading(frame.rotation @ rotation, np.asarray(item["size"], dtype=np.float64))
+        size = np.asarray(item["size"], dtype=np.float64)
+        turned = frame.rotation @ rotation
+        if min(_tilt_deg(rotation), _tilt_deg(turned)) >= TILT_MIN_DEG:  # lying tilted, in either frame
+            orientation = Rotation.from_matrix(turned).as_quat()
+        else:
+            heading, size = _heading(turned, size)
+            orientation = np.array([0.0, 0.0, np.sin(heading / 2), np.cos(heading / 2)])
         centre = frame.apply(np.asarray(item["center"], dtype=np.float64)[None])[0]
         try:
-            boxes.append(Box(item["id"], size, centre, [0.0, 0.0, np.sin(heading / 2), np.cos(heading / 2)]))
+            boxes.append(Box(item["id"], size, centre, orientation))
         except InvalidFile as error:  # the detection was checked: the cloud's frame put it there
             raise UnstackError(
                 f"detection {item['id']!r}, moved into the gravity frame the cloud gives: {error.json_path[2:]}: "
