@@ -42,3 +42,9 @@ def test_the_cli_reports_errors_and_decisions(small_dataset: Path, tmp_path: Pat
     assert summary["position_error_m_median"] < 0.02
     assert summary["axis_error_deg_median"] < 2.0
     assert summary["tilted_boxes"] == sum(box["true_tilt_deg"] >= 5.0 for pile in piles for box in pile["boxes"])
+    for name in ("camera", "truth"):  # each pick was taken out of the true pile in the physics engine
+        assert all(pile["choices"][name] not in pile["moved"][name] for pile in piles)
+        moved = [len(pile["moved"][name]) for pile in piles]
+        assert summary[f"{name}_pick_boxes_moved_mean"] == pytest.approx(np.mean(moved))
+        assert summary[f"{name}_pick_moved_nothing_share"] == pytest.approx(np.mean([count == 0 for count in moved]))
+    assert "the pick moves nothing in the true pile" in run.stdout

@@ -630,7 +630,10 @@ def camera_roundtrip_command(data_dir: str, out: str, model_path: str | None, pi
         written,
         f"sizes right {100 * summary['size_right_share']:.0f} %; fitted from the top face "
         f"{100 * summary['top_faces_share']:.0f} %; the same decision as on the true poses in "
-        f"{100 * summary['same_decision_share']:.0f} % of piles",
+        f"{100 * summary['same_decision_share']:.0f} % of piles; the pick moves nothing in the true pile in "
+        f"{100 * summary['camera_pick_moved_nothing_share']:.0f} % of piles from the camera, "
+        f"{100 * summary['truth_pick_moved_nothing_share']:.0f} % from the true poses (boxes moved per pile "
+        f"{summary['camera_pick_boxes_moved_mean']:.2f} and {summary['truth_pick_boxes_moved_mean']:.2f})",
     )
 
 
