@@ -46,7 +46,7 @@ from typing import Any
 
 import numpy as np
 
-from unstack.camera.planes import PLANE_THRESHOLD, fit_plane
+from unstack.camera.planes import PLANE_THRESHOLD, fit_plane, plane_within_noise
 from unstack.errors import InvalidFile, UnstackError
 from unstack.scene import Box
 
@@ -87,9 +87,6 @@ TILTED_FACE_SHARE = 0.1
 SQUARE_TOLERANCE_DEG = 20.0
 #: Where no viewpoint is given, faces are taken to look this way (out through the door and up).
 DEFAULT_VIEW = (-1.0, 0.0, 1.0)
-#: A tilted box's face is refitted to its points within 2.5 noise widths, the width measured on
-#: the points within this distance of the first fit (metres).
-NOISE_BAND = 0.05
 
 
 @dataclass(frozen=True)
@@ -269,9 +266,10 @@ def _tilted_axes(
     planes: list[tuple[np.ndarray, float, np.ndarray]] = []
     while len(planes) < 3 and remaining.sum() >= MIN_FACE_POINTS:
         normal, offset, inliers = fit_plane(points[remaining], rng=rng)
+        if inliers.sum() >= 3:
+            normal, offset, inliers = plane_within_noise(points[remaining], normal, offset, inliers)
         if inliers.sum() < max(MIN_FACE_POINTS, TILTED_FACE_SHARE * len(points)):
             break
-        normal, offset, inliers = _widened(points[remaining], normal, offset)
         where = np.flatnonzero(remaining)[inliers]
         face = np.zeros(len(points), dtype=bool)
         face[where] = True
@@ -307,25 +305,6 @@ def _tilted_axes(
         for axis, normal, face in seen
     ]
     return axes, faces
-
-
-def _widened(points: np.ndarray, normal: np.ndarray, offset: float) -> tuple[np.ndarray, float, np.ndarray]:
-    """The plane refitted to the points within 2.5 noise widths of it (the width from the median
-    distance of the points within :data:`NOISE_BAND` m): a band as thin as
-    :data:`~unstack.camera.planes.PLANE_THRESHOLD` through a noisy face tilts the fit towards
-    the three points that proposed it."""
-    for _ in range(3):
-        distances = np.abs(points @ normal - offset)
-        near = distances[distances < NOISE_BAND]
-        width = 1.4826 * float(np.median(near)) if len(near) else 0.0
-        band = distances < max(PLANE_THRESHOLD, 2.5 * width)
-        if band.sum() < 3:
-            break
-        centre = points[band].mean(axis=0)
-        refined = np.linalg.svd(points[band] - centre, full_matrices=False)[2][-1]
-        normal = refined * (np.sign(refined @ normal) or 1.0)
-        offset = float(normal @ centre)
-    return normal, offset, np.abs(points @ normal - offset) < max(PLANE_THRESHOLD, 2.5 * width)
 
 
 def _match_tilted_size(
