@@ -25,7 +25,15 @@ import numpy as np
 from unstack.camera.files import Intrinsics
 from unstack.errors import UnstackError
 
-__all__ = ["GravityFrame", "depth_points", "fit_plane", "gravity_frame", "plane_within_noise", "surface_normals"]
+__all__ = [
+    "GravityFrame",
+    "depth_points",
+    "fit_plane",
+    "gravity_frame",
+    "plane_by_heights",
+    "plane_within_noise",
+    "surface_normals",
+]
 
 #: Distance (metres) within which a point belongs to a plane.
 PLANE_THRESHOLD = 0.01
@@ -185,6 +193,67 @@ def plane_within_noise(
         inliers = np.abs(points @ normal - offset) < band
 
 
+def _fills_band(points: np.ndarray, normal: np.ndarray, offset: float, band: float = PLANE_THRESHOLD) -> bool:
+    """Whether the points within ``band`` of the plane lie a mean :data:`NOISE_FILL` of it or more
+    from it: depth noise as wide as the band, or wider."""
+    distances = np.abs(points @ normal - offset)
+    inside = distances[distances < band]
+    return bool(len(inside) >= 3 and np.mean(inside) >= NOISE_FILL * band)
+
+
+def _directions_around(centre: np.ndarray, radius_deg: float, step_deg: float) -> np.ndarray:
+    """Unit vectors within ``radius_deg`` of ``centre``, about ``step_deg`` apart."""
+    helper = np.array([1.0, 0.0, 0.0]) if abs(centre[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    first = np.cross(centre, helper)
+    first /= np.linalg.norm(first)
+    second = np.cross(centre, first)
+    steps = np.arange(-radius_deg, radius_deg + step_deg / 2, step_deg)
+    a, b = (np.radians(grid).ravel() for grid in np.meshgrid(steps, steps))
+    keep = np.hypot(a, b) <= np.radians(radius_deg) + 1e-12
+    directions = centre + np.tan(a[keep, None]) * first + np.tan(b[keep, None]) * second
+    unit: np.ndarray = directions / np.linalg.norm(directions, axis=1, keepdims=True)
+    return unit
+
+
+def plane_by_heights(
+    points: np.ndarray, near_normal: np.ndarray, *, tolerance_deg: float = HORIZONTAL_TOLERANCE_DEG,
+    bin_m: float = 4 * PLANE_THRESHOLD, rng: np.random.Generator,
+) -> tuple[np.ndarray, float]:  # fmt: skip
+    """The plane within ``tolerance_deg`` of ``near_normal`` that the most points lie in a slab of
+    ``bin_m`` of: for each direction tried, the points' heights along it in bins of ``bin_m``
+    (two grids, half a bin apart), the fullest bin counted; directions 2.5 degrees apart over
+    the whole cone, then 0.5 and 0.1 degrees apart around the best.
+
+    What a noisy cloud needs: three neighbouring points a centimetre apart with depth noise of
+    centimetres propose planes in every direction, while a floor 3 m across, its heights binned
+    along a direction 1 degree off, spreads over five 4 cm bins.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> floor = np.column_stack([rng.uniform(-2, 2, 4000), rng.uniform(-2, 2, 4000), rng.normal(0, 0.03, 4000)])
+    >>> normal, offset = plane_by_heights(floor, np.array([0.0, 0.0, 1.0]), rng=rng)
+    >>> bool(normal[2] > np.cos(np.radians(0.5))), abs(offset) < 0.03
+    (True, True)
+    """
+    points = np.asarray(points, dtype=np.float64)
+    if len(points) > PLANE_SAMPLE // 2:
+        points = points[rng.choice(len(points), PLANE_SAMPLE // 2, replace=False)]
+    reference = np.asarray(near_normal, dtype=np.float64) / np.linalg.norm(near_normal)
+    best = (reference, 0.0, -1)
+    for centre, radius, step in ((reference, tolerance_deg, 2.5), (None, 2.5, 0.5), (None, 0.5, 0.1)):
+        for direction in _directions_around(best[0] if centre is None else centre, radius, step):
+            heights = points @ direction
+            for phase in (0.0, 0.5):
+                bins = np.floor(heights / bin_m + phase).astype(np.int64)
+                lowest = int(bins.min())
+                counts = np.bincount(bins - lowest)
+                k = int(np.argmax(counts))
+                if counts[k] > best[2]:
+                    best = (direction, float((k + lowest + 0.5 - phase) * bin_m), int(counts[k]))
+    return best[0], best[1]
+
+
 def surface_normals(points: np.ndarray, neighbours: int = 12) -> np.ndarray:
     """Each point's unit surface normal: the smallest principal axis of it and its nearest
     ``neighbours`` (the sign is arbitrary).
@@ -279,10 +348,18 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
     up_guess = np.array([0.0, 0.0, 1.0])
     remaining = points
     found: list[tuple[np.ndarray, float, int]] = []
+    noisy_up: np.ndarray | None = None
     for _ in range(MAX_PLANES):
         if len(remaining) < max(3, MIN_PLANE_SHARE * len(points)):
             break
         normal, offset, inliers = fit_plane(remaining, rng=rng, near_normal=up_guess)
+        if inliers.sum() >= 3 and _fills_band(remaining, normal, offset):  # noisy: search by heights instead
+            if noisy_up is None:  # the first: over the whole cone; the next ones parallel to it
+                normal, offset = plane_by_heights(remaining, up_guess, rng=rng)
+                noisy_up = normal
+            else:
+                normal, offset = plane_by_heights(remaining, noisy_up, tolerance_deg=PARALLEL_DEG, rng=rng)
+            inliers = np.abs(remaining @ normal - offset) < PLANE_THRESHOLD
         if inliers.sum() >= 3:
             normal, offset, inliers = plane_within_noise(remaining, normal, offset, inliers)
         if inliers.sum() < MIN_PLANE_SHARE * len(points):
