@@ -314,3 +314,27 @@ def test_depth_noise_of_two_centimetres_keeps_upright_and_tilted_apart(
     [fitted] = scene_from_depth(noisy, INTRINSICS, pose, masks, known_sizes=SIZES, door=[-1.0, 0.0, 0.0]).fitted
     assert (fitted.face == "tilted") is tilted  # upright: from its top or its front
     assert _axis_error_deg(fitted.box.orientation_xyzw, box.orientation_xyzw) < 5.0
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("frame_tilt_deg", [0.0, 9.0])
+def test_gravity_comes_back_under_kinect_like_depth_noise(seed: int, frame_tilt_deg: float) -> None:
+    from scipy.spatial.transform import Rotation
+
+    from tests.camera.conftest import FLOOR, looking_in, render_boxes
+    from unstack.camera.planes import depth_points, gravity_frame
+    from unstack.scene import Box
+
+    rng = np.random.default_rng(seed)
+    boxes = [
+        Box(f"b{k}", SIZES[k % 2], [3.0 + 0.5 * (k // 3), -0.6 + 0.6 * (k % 3), SIZES[k % 2][2] / 2]) for k in range(6)
+    ]
+    planes = [FLOOR, (np.array([0.0, 0.0, -1.0]), -2.4), (np.array([-1.0, 0.0, 0.0]), -5.0)]  # ceiling, front wall
+    pose = looking_in(height=1.4, pitch_deg=15.0)
+    depth, _ = render_boxes(boxes, pose, planes=planes)
+    sigma = 0.0012 + 0.0019 * (depth - 0.4) ** 2  # 1.4 cm at 3 m, 2.6 cm at 4 m
+    noisy = np.where(depth > 0, depth + rng.normal(size=depth.shape) * sigma, 0.0)
+    tilt = np.eye(4)
+    tilt[:3, :3] = Rotation.from_rotvec(np.radians(frame_tilt_deg) * np.array([1.0, 0.0, 0.0])).as_matrix()
+    frame = gravity_frame(depth_points(noisy, INTRINSICS, tilt @ pose), door=np.array([-1.0, 0.0, 0.0]), seed=seed)
+    assert frame.tilt_deg == pytest.approx(frame_tilt_deg, abs=1.0)
