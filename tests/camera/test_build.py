@@ -236,6 +236,14 @@ def _turned(axis: list[float], degrees: float, yaw_deg: float = 0.0) -> np.ndarr
     return (Rotation.from_euler("z", yaw_deg, degrees=True) * tilt).as_quat()
 
 
+def _resting(box_id: str, size, x: float, y: float, orientation: np.ndarray):
+    """A box turned by ``orientation`` with its lowest corner on the floor."""
+    from unstack.scene import Box
+
+    half_height = float(np.abs(rotation_matrix(orientation))[2] @ np.asarray(size, dtype=float)) / 2
+    return Box(box_id, size, [x, y, half_height + 0.001], orientation)
+
+
 def _axis_error_deg(first: np.ndarray, second: np.ndarray) -> float:
     """The largest angle between an axis of one orientation and the nearest axis of the other."""
     dots = np.abs(rotation_matrix(first).T @ rotation_matrix(second))
@@ -252,7 +260,7 @@ def test_a_box_lying_tilted_is_fitted_in_full_3d(tilt_deg: float, axis: list[flo
 
     rng = np.random.default_rng(int(tilt_deg * 10 + yaw_deg))
     size = np.array(SIZES[rng.integers(0, 2)])
-    box = Box("a", size, [2.0 + rng.uniform(-0.2, 0.2), rng.uniform(-0.3, 0.3), 0.45], _turned(axis, tilt_deg, yaw_deg))
+    box = _resting("a", size, 2.0 + rng.uniform(-0.2, 0.2), rng.uniform(-0.3, 0.3), _turned(axis, tilt_deg, yaw_deg))
     pose = looking_in(height=1.6, pitch_deg=30.0)
     depth, masks = render_boxes([box], pose)
     built = scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES, door=[-1.0, 0.0, 0.0])
@@ -283,9 +291,8 @@ def test_a_box_within_a_few_degrees_of_upright_is_fitted_upright(tilt_deg: float
 
 def test_a_tilted_box_without_known_sizes_takes_its_seen_edges() -> None:
     from tests.camera.conftest import looking_in, render_boxes
-    from unstack.scene import Box
 
-    box = Box("a", [0.6, 0.4, 0.4], [2.0, 0.0, 0.4], _turned([0.0, 1.0, 0.0], -25.0))  # the top turned to the camera
+    box = _resting("a", [0.6, 0.4, 0.4], 2.0, 0.0, _turned([0.0, 1.0, 0.0], -25.0))  # the top turned to the camera
     pose = looking_in(height=1.6, pitch_deg=30.0)
     depth, masks = render_boxes([box], pose)
     [fitted] = scene_from_depth(depth, INTRINSICS, pose, masks, door=[-1.0, 0.0, 0.0]).fitted
@@ -301,13 +308,12 @@ def test_depth_noise_of_two_centimetres_keeps_upright_and_tilted_apart(
     from scipy.spatial.transform import Rotation
 
     from tests.camera.conftest import looking_in, render_boxes
-    from unstack.scene import Box
 
     rng = np.random.default_rng(seed)
     tilt = Rotation.from_rotvec(np.radians(tilt_deg) * np.array([1.0, 0.0, 0.0]))
     turned = (Rotation.from_euler("z", rng.uniform(0.0, 90.0), degrees=True) * tilt).as_quat()
     size = SIZES[seed % 2]
-    box = Box("a", size, [2.5 + rng.uniform(-0.3, 0.3), rng.uniform(-0.4, 0.4), size[2] / 2 + 0.01], turned)
+    box = _resting("a", size, 2.5 + rng.uniform(-0.3, 0.3), rng.uniform(-0.4, 0.4), turned)
     pose = looking_in(height=1.6, pitch_deg=30.0)
     depth, masks = render_boxes([box], pose)
     noisy = np.where(depth > 0, depth + rng.normal(0.0, 0.02, depth.shape), 0.0)
@@ -338,3 +344,39 @@ def test_gravity_comes_back_under_kinect_like_depth_noise(seed: int, frame_tilt_
     tilt[:3, :3] = Rotation.from_rotvec(np.radians(frame_tilt_deg) * np.array([1.0, 0.0, 0.0])).as_matrix()
     frame = gravity_frame(depth_points(noisy, INTRINSICS, tilt @ pose), door=np.array([-1.0, 0.0, 0.0]), seed=seed)
     assert frame.tilt_deg == pytest.approx(frame_tilt_deg, abs=1.0)
+
+
+def _wall(rows: int) -> list:
+    from unstack.scene import Box
+
+    return [
+        Box(f"w{j}{k}", [0.6, 0.4, 0.4], [2.8, (j - 1.5) * 0.4, 0.2 + 0.4 * k]) for j in range(4) for k in range(rows)
+    ]
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_a_noisy_wall_of_box_fronts_above_a_low_camera_is_not_taken_upside_down(seed: int) -> None:
+    from tests.camera.conftest import looking_in, render_boxes
+
+    wall = _wall(5)
+    pose = looking_in(height=0.6, pitch_deg=5.0)
+    depth, masks = render_boxes(wall, pose)
+    rng = np.random.default_rng(seed)
+    noisy = np.where(depth > 0, depth + rng.normal(0.0, 0.01, depth.shape), 0.0)
+    built = scene_from_depth(noisy, INTRINSICS, pose, masks, ids=[box.id for box in wall], known_sizes=SIZES)
+    assert built.frame.tilt_deg < 1.0
+
+
+@pytest.mark.parametrize(("height", "pitch_deg"), [(1.0, 10.0), (2.5, 30.0)])
+def test_a_pose_upside_down_is_refused_whether_or_not_the_boxes_show_their_tops(
+    height: float, pitch_deg: float
+) -> None:
+    from tests.camera.conftest import looking_in, render_boxes
+
+    wall = _wall(4)  # 1.6 m high: the camera 1.0 m up sees fronts only, 2.5 m up sees the tops
+    pose = looking_in(height=height, pitch_deg=pitch_deg)
+    depth, masks = render_boxes(wall, pose)
+    ids = [box.id for box in wall]
+    scene_from_depth(depth, INTRINSICS, pose, masks, ids=ids, known_sizes=SIZES)
+    with pytest.raises(UnstackError, match="the pose's z points down"):
+        scene_from_depth(depth, INTRINSICS, np.diag([1.0, -1.0, -1.0, 1.0]) @ pose, masks, ids=ids, known_sizes=SIZES)

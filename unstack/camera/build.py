@@ -36,29 +36,111 @@ MAX_MASK_POINTS = 20_000
 MAX_SCENE_POINTS = 200_000
 
 
-#: Points of the masks looked at for the pose's up (every n-th of a larger union).
-UPRIGHT_SAMPLE = 20_000
+#: Heights of a mask's points are binned this fine (metres) to find the slab of its top face.
+TOP_SLAB_M = 0.03
+#: A box shows its top when the fullest slab holds this share of its points or more, and this
+#: many times the points of a typical slab (a strip of a front cut by the image's edge fills its
+#: few slabs alike) ...
+TOP_SLAB_SHARE = 0.15
+SLAB_PROMINENCE = 3.0
+#: ... and its points spread this far (metres, standard deviation) across their narrower
+#: direction: a top, not the strip a slab cuts from a face lying tilted ...
+TOP_SPREAD_M = 0.03
+#: ... and says which way is up when this many times more of its other points lie on one side of
+#: the slab (below: seen from above, as a camera sees tops) than on the other.
+SIDE_MARGIN = 2.0
+
+
+def _side_of_tops(box_points: Sequence[np.ndarray]) -> tuple[int, int]:
+    """Boxes whose top slab has most of their other points below it (a top seen from above) and
+    boxes whose slab has most above it (a top seen from below: the pose upside down)."""
+    below_votes = above_votes = 0
+    for points in box_points:
+        if len(points) < 30:
+            continue
+        heights = points[:, 2]
+        bins = np.floor(heights / TOP_SLAB_M).astype(np.int64)
+        counts = np.bincount(bins - bins.min())
+        fullest = int(np.argmax(counts))
+        if counts[fullest] < max(TOP_SLAB_SHARE * len(points), SLAB_PROMINENCE * np.median(counts[counts > 0])):
+            continue  # no level face: a front (whole, or a strip of it), or a box lying tilted
+        slab = (fullest + bins.min() + 0.5) * TOP_SLAB_M
+        level = points[np.abs(heights - slab) <= TOP_SLAB_M / 2, :2]
+        if np.linalg.svd(level - level.mean(axis=0), compute_uv=False)[-1] / np.sqrt(len(level)) < TOP_SPREAD_M:
+            continue  # a strip, not a face: a slice through a face lying tilted
+        below = int(np.sum(heights < slab - TOP_SLAB_M))
+        above = int(np.sum(heights > slab + TOP_SLAB_M))
+        if below >= 10 and below >= SIDE_MARGIN * above:
+            below_votes += 1
+        elif above >= 10 and above >= SIDE_MARGIN * below:
+            above_votes += 1
+    return below_votes, above_votes
+
+
+#: The level planes lie all on one side of the camera when the other holds no more than this
+#: share of their points.
+ONE_SIDE_SHARE = 0.05
+#: Box points within this of a level plane (metres) rest on it or hang from it.
+RESTING_M = 0.05
+
+
+def _resting_planes(frame: GravityFrame, box_points: Sequence[np.ndarray]) -> list[float]:
+    """The heights of the level planes that box points rest on: at least 30 of them within
+    :data:`RESTING_M` above the plane and :data:`SIDE_MARGIN` times as many as within it below."""
+    heights = np.concatenate([points[:, 2] for points in box_points] + [np.empty(0)])
+    resting = []
+    for height, _ in frame.plane_heights:
+        above = int(np.sum((heights > height) & (heights < height + RESTING_M)))
+        below = int(np.sum((heights < height) & (heights > height - RESTING_M)))
+        if above >= 30 and above >= SIDE_MARGIN * below:
+            resting.append(height)
+    return resting
 
 
 def _check_upright(frame: GravityFrame, pose: np.ndarray, box_points: Sequence[np.ndarray]) -> None:
-    """Raise when the pose's z points down: a camera sees the tops of boxes from above, so the
-    boxes' horizontal surfaces lie below it -- unless the frame is upside down. (The cloud's
-    planes cannot tell: a camera at a container's door sees the ceiling from below, and a
-    ceiling larger than the floor and the tops it sees is no sign of a pose upside down.)
-    Boxes showing no horizontal surface (all seen from the front) say nothing either way."""
-    from unstack.camera.planes import HORIZONTAL_TOLERANCE_DEG, surface_normals
+    """Raise when the pose's z points down; warn when nothing tells.
 
-    points = np.concatenate([*box_points, np.empty((0, 3))])
-    points = points[:: max(1, -(-len(points) // UPRIGHT_SAMPLE))]
-    flat = np.abs(surface_normals(points)[:, 2]) >= np.cos(np.radians(HORIZONTAL_TOLERANCE_DEG))
-    camera_height = float(frame.apply(pose[None, :3, 3])[0, 2])
-    above = int(np.sum(points[flat, 2] > camera_height))
-    below = int(np.sum(points[flat, 2] < camera_height))
-    if above > below:
+    A box seen with its top shows it as the highest level slab of its points, its front below:
+    upside down, the slab is the lowest and the front above it. The boxes decide when they agree
+    (one side at least :data:`SIDE_MARGIN` times the other). Else the cloud's level planes do
+    when they all lie on one side of the camera (a camera looking down sees tops and floor alone;
+    one that sees nothing level but a ceiling is taken upside down: the mirror image of a floor);
+    else the floor, the level plane the boxes rest on, seen from above. (Level planes on both
+    sides cannot tell by their points: a camera at a container's door sees the ceiling from
+    below.) When none tells, a warning says so.
+    """
+    seen_from_above, seen_from_below = _side_of_tops(box_points)
+    if seen_from_below >= 1 and seen_from_below >= SIDE_MARGIN * seen_from_above:
         raise UnstackError(
-            f"the camera sees {above} of the {above + below} points of the boxes' horizontal surfaces from below "
-            "(a camera sees the tops of boxes from above): the pose's z points down; expected a camera-to-world "
-            "pose whose z is up"
+            f"{seen_from_below} of the {seen_from_above + seen_from_below} boxes that show a level top show it as "
+            "their lowest face with the rest of the box above (a camera sees tops from above): the pose's z points "
+            "down; expected a camera-to-world pose whose z is up"
+        )
+    if seen_from_above >= 1 and seen_from_above >= SIDE_MARGIN * seen_from_below:
+        return
+    camera_height = float(frame.apply(pose[None, :3, 3])[0, 2])
+    below = sum(count for height, count in frame.plane_heights if height < camera_height)
+    above = sum(count for height, count in frame.plane_heights if height > camera_height)
+    if above <= ONE_SIDE_SHARE * (above + below):  # every level plane below: a camera looking down
+        return
+    if below <= ONE_SIDE_SHARE * (above + below):
+        raise UnstackError(
+            f"the camera sees all {above} points of the cloud's level planes from below and no box shows its top (a "
+            "camera sees the floor and the tops of boxes from above): the pose's z points down; expected a "
+            "camera-to-world pose whose z is up"
+        )
+    resting = _resting_planes(frame, box_points)
+    if resting and all(height > camera_height for height in resting):
+        raise UnstackError(
+            f"the level plane the boxes rest on lies {min(resting) - camera_height:.2f} m above the camera and no box "
+            "shows its top (a camera sees the floor from above): the pose's z points down; expected a "
+            "camera-to-world pose whose z is up"
+        )
+    if not resting or any(height > camera_height for height in resting):
+        warnings.warn(
+            "cannot tell whether the pose's z is up: no box shows a level top and no floor the boxes rest on is seen "
+            "below the camera; check the boxes' heights in the scene",
+            stacklevel=3,
         )
 
 

@@ -304,7 +304,7 @@ def scene_from_cloud(
             rotation = np.array([[np.cos(yaw), -np.sin(yaw), 0.0], [np.sin(yaw), np.cos(yaw), 0.0], [0.0, 0.0, 1.0]])
         size = np.asarray(item["size"], dtype=np.float64)
         turned = frame.rotation @ rotation
-        if min(_tilt_deg(rotation), _tilt_deg(turned)) >= TILT_MIN_DEG:  # lying tilted, in either frame
+        if min(_tilt_deg(rotation), _tilt_deg(turned)) >= TILT_MIN_DEG:  # lying tilted, in both frames
             orientation = Rotation.from_matrix(turned).as_quat()
         else:
             heading, size = _heading(turned, size)

@@ -55,8 +55,10 @@ NEIGHBOURS = 24
 #: A plane's band is widened while its points lie a mean distance over this share of the band
 #: from the plane (the noise fills the band) ...
 NOISE_FILL = 0.35
-#: ... up to this width (metres).
+#: ... up to this width (metres), and while the refitted plane turns less than this (degrees):
+#: a wider band that takes in another surface turns the fit towards it.
 NOISE_BAND = 0.05
+NOISE_TURN_DEG = 15.0
 #: Points used for the plane search (a random subset of larger clouds; the fit is refined on all).
 PLANE_SAMPLE = 60_000
 
@@ -188,8 +190,10 @@ def plane_within_noise(
         wide = distances < band
         centre = points[wide].mean(axis=0)
         refined = np.linalg.svd(points[wide] - centre, full_matrices=False)[2][-1]
-        normal = refined * (np.sign(refined @ normal) or 1.0)
-        offset = float(normal @ centre)
+        refined *= np.sign(refined @ normal) or 1.0
+        if refined @ normal < np.cos(np.radians(NOISE_TURN_DEG)):  # the wider band holds another surface
+            return normal, offset, inliers
+        normal, offset = refined, float(refined @ centre)
         inliers = np.abs(points @ normal - offset) < band
 
 
