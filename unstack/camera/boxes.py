@@ -85,6 +85,9 @@ TILT_MIN_DEG = 5.0
 TILTED_FACE_SHARE = 0.1
 #: ... whose normal is within this many degrees of square to the first face's (a second face).
 SQUARE_TOLERANCE_DEG = 20.0
+#: A level plane under the rest of a mask's points, holding less than this share of them, is a
+#: surface the mask bled onto (left out).
+BLEED_SHARE = 0.35
 #: Where no viewpoint is given, faces are taken to look this way (out through the door and up).
 DEFAULT_VIEW = (-1.0, 0.0, 1.0)
 
@@ -242,6 +245,7 @@ def fit_box(
             f"{box_id}: the mask holds {len(points)} points with depth; at least {MIN_FACE_POINTS} needed"
         )
     up = np.array([0.0, 0.0, 1.0])
+    points = _without_surface_below(points, rng.spawn(1)[0])
     normal, offset, inliers = fit_plane(points, rng=rng, near_normal=up)
     top_seen = bool(inliers.sum() >= max(MIN_FACE_POINTS, TOP_SHARE * len(points)))
     if top_seen and normal @ up >= np.cos(np.radians(TILT_MIN_DEG)):
@@ -253,6 +257,21 @@ def fit_box(
     if top_seen:
         return _fit_from_top(box_id, points, normal, offset, inliers, known_sizes, surfaces, rng)
     return _fit_from_front(box_id, points, known_sizes, rng)
+
+
+def _without_surface_below(points: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """The mask's points without those on a level surface under the box (a mask that bleeds a
+    pixel or two onto the floor or the box below): a level plane holding under
+    :data:`BLEED_SHARE` of the points with half of them or more above it and almost none below."""
+    normal, offset, inliers = fit_plane(points, rng=rng, near_normal=np.array([0.0, 0.0, 1.0]))
+    if not inliers.any() or inliers.mean() > BLEED_SHARE or normal[2] < np.cos(np.radians(TILT_MIN_DEG)):
+        return points
+    heights = points @ normal - offset
+    under_the_rest = np.mean(heights > 0.03) >= 0.5 and np.mean(heights < -0.03) <= 0.02
+    if not under_the_rest or len(points) - inliers.sum() < MIN_FACE_POINTS:
+        return points
+    kept: np.ndarray = points[~inliers]
+    return kept
 
 
 def _tilted_axes(

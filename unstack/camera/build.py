@@ -97,6 +97,23 @@ def _resting_planes(frame: GravityFrame, box_points: Sequence[np.ndarray]) -> li
     return resting
 
 
+#: The up check reads each mask without this many pixels at its edge (a mask that bleeds onto the
+#: floor under a box shows a level ring below it, as a top would in a pose upside down).
+CORE_ERODE_PX = 3
+
+
+def _core_points(
+    depth_m: np.ndarray, intrinsics: Intrinsics, pose: np.ndarray, frame: GravityFrame, mask: np.ndarray
+) -> np.ndarray:
+    """The gravity-frame points of ``mask`` without its edge (:data:`CORE_ERODE_PX`), every n-th
+    of more than :data:`MAX_MASK_POINTS`."""
+    from scipy.ndimage import binary_erosion
+
+    core = binary_erosion(mask, iterations=CORE_ERODE_PX)
+    points = frame.apply(depth_points(depth_m, intrinsics, pose, core))
+    return points[:: max(1, -(-len(points) // MAX_MASK_POINTS))]
+
+
 def _check_upright(frame: GravityFrame, pose: np.ndarray, box_points: Sequence[np.ndarray]) -> None:
     """Raise when the pose's z points down; warn when nothing tells.
 
@@ -379,7 +396,7 @@ def scene_from_depth(
             subset = content_rng(seed, np.flatnonzero(masks[k])).choice(len(points), MAX_MASK_POINTS, replace=False)
             points = points[subset]
         mask_points.append(points)
-    _check_upright(frame, pose, mask_points)
+    _check_upright(frame, pose, [_core_points(depth_m, intrinsics, pose, frame, masks[k]) for k in kept])
     viewpoint = frame.apply(pose[None, :3, 3])[0]
     fitted, unfitted = boxes_from_masks(
         mask_points, [names[k] for k in kept], known_sizes=known_sizes, seed=seed, viewpoint=viewpoint
