@@ -32,7 +32,6 @@ __all__ = [
     "gravity_frame",
     "plane_by_heights",
     "plane_within_noise",
-    "surface_normals",
 ]
 
 #: Distance (metres) within which a point belongs to a plane.
@@ -256,28 +255,6 @@ def plane_by_heights(
                 if counts[k] > best[2]:
                     best = (direction, float((k + lowest + 0.5 - phase) * bin_m), int(counts[k]))
     return best[0], best[1]
-
-
-def surface_normals(points: np.ndarray, neighbours: int = 12) -> np.ndarray:
-    """Each point's unit surface normal: the smallest principal axis of it and its nearest
-    ``neighbours`` (the sign is arbitrary).
-
-    Examples
-    --------
-    >>> rng = np.random.default_rng(0)
-    >>> flat = np.column_stack([rng.uniform(0, 1, 200), rng.uniform(0, 1, 200), np.zeros(200)])
-    >>> bool(np.all(np.abs(surface_normals(flat)[:, 2]) > 0.999))
-    True
-    """
-    from scipy.spatial import cKDTree
-
-    points = np.asarray(points, dtype=np.float64)
-    if len(points) < 3:
-        return np.zeros((len(points), 3))
-    _, near = cKDTree(points).query(points, k=min(neighbours + 1, len(points)))
-    patches = points[near] - points[near].mean(axis=1, keepdims=True)
-    normals: np.ndarray = np.linalg.eigh(np.einsum("nki,nkj->nij", patches, patches))[1][:, :, 0]
-    return normals
 
 
 @dataclass(frozen=True)
