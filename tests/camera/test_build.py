@@ -224,7 +224,7 @@ def test_a_camera_at_the_door_that_sees_more_ceiling_than_floor_is_upright() -> 
     assert sum(count for height, count in built.frame.plane_heights if height > 1.2) > sum(
         count for height, count in built.frame.plane_heights if height < 1.2
     )  # the ceiling outweighs the floor and the tops: the planes alone would call the pose upside down
-    upside_down = np.diag([1.0, -1.0, -1.0, 1.0]) @ pose
+    upside_down = np.diag([1.0, -1.0, -1.0, 1.0]) @ pose  # the floor the boxes rest on: above the camera
     with pytest.raises(UnstackError, match="the pose's z points down"):
         scene_from_depth(depth, INTRINSICS, upside_down, masks, known_sizes=SIZES)
 

@@ -119,7 +119,8 @@ def _check_upright(frame: GravityFrame, pose: np.ndarray, box_points: Sequence[n
 
     A box seen with its top shows it as the highest level slab of its points, its front below:
     upside down, the slab is the lowest and the front above it. The boxes decide when they agree
-    (one side at least :data:`SIDE_MARGIN` times the other). Else the cloud's level planes do
+    (one side at least :data:`SIDE_MARGIN` times the other; two boxes at least to refuse: a front
+    cut by what stands before it can show a slab at its foot). Else the cloud's level planes do
     when they all lie on one side of the camera (a camera looking down sees tops and floor alone;
     one that sees nothing level but a ceiling is taken upside down: the mirror image of a floor);
     else the floor, the level plane the boxes rest on, seen from above. (Level planes on both
@@ -127,7 +128,7 @@ def _check_upright(frame: GravityFrame, pose: np.ndarray, box_points: Sequence[n
     below.) When none tells, a warning says so.
     """
     seen_from_above, seen_from_below = _side_of_tops(box_points)
-    if seen_from_below >= 1 and seen_from_below >= SIDE_MARGIN * seen_from_above:
+    if seen_from_below >= 2 and seen_from_below >= SIDE_MARGIN * seen_from_above:
         raise UnstackError(
             f"{seen_from_below} of the {seen_from_above + seen_from_below} boxes that show a level top show it as "
             "their lowest face with the rest of the box above (a camera sees tops from above): the pose's z points "
