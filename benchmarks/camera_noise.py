@@ -4,7 +4,7 @@ Each pile of each data set is rendered as :func:`unstack.sim.camera_view.camera_
 over (exact depth), noise is drawn onto every reading, and
 :func:`unstack.camera.scene_from_depth` builds the scene back with the data set's carton sizes.
 Per mask: the box's true tilt, whether a box was fitted and from which face, the position error
-and the axis error (:func:`unstack.experiments.camera_roundtrip.axis_error_deg`). Printed per
+and the axis error (:func:`unstack.geometry.axis_error_deg`). Printed per
 data set, for upright boxes (true tilt under 5 degrees) and tilted ones apart: boxes fitted,
 median position error, the share within 5 cm, median axis error, and how many upright boxes were
 fitted tilted (and the other way); and, as a comment line, how far the gravity found is from the
@@ -46,8 +46,7 @@ def pile_rows(path: Path, noise: str, rng: np.random.Generator) -> list[dict[str
     """One row per mask of the pile: the truth's tilt and how the fit did."""
     from unstack.camera import scene_from_depth
     from unstack.errors import UnstackError
-    from unstack.experiments.camera_roundtrip import axis_error_deg
-    from unstack.geometry import tilt_deg
+    from unstack.geometry import axis_error_deg, tilt_deg
     from unstack.scene import load_scene
     from unstack.sim.camera_view import camera_view
     from unstack.sim.settings import SimulationSettings, scene_settings

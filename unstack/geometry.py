@@ -26,6 +26,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "BOX_FACES",
+    "axis_error_deg",
     "bounding_box_overlap_xy",
     "bounding_boxes",
     "box_corners",
@@ -40,6 +41,7 @@ __all__ = [
     "polygon_distance",
     "rotation_angles_deg",
     "rotation_matrix",
+    "rotation_tilt_deg",
     "tilt_deg",
 ]
 
@@ -131,6 +133,19 @@ def rotation_angles_deg(before_xyzw: np.ndarray, after_xyzw: np.ndarray) -> np.n
     return angles
 
 
+def rotation_tilt_deg(rotation: np.ndarray) -> float:
+    """The angle between the world's z axis and the nearest axis of a rotation matrix's frame
+    (degrees, 0 for a frame standing upright, up to about 54.7).
+
+    Examples
+    --------
+    >>> round(rotation_tilt_deg(rotation_matrix(np.array([np.sin(0.1), 0.0, 0.0, np.cos(0.1)]))), 2)
+    11.46
+    """
+    cosine = float(np.max(np.abs(np.asarray(rotation)[2, :])))
+    return float(np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0))))
+
+
 def tilt_deg(box: Box) -> float:
     """How far the box is from standing on a face: the angle between the world's z axis and
     the nearest of the box's axes (degrees, 0 for an upright box, up to about 54.7).
@@ -141,9 +156,22 @@ def tilt_deg(box: Box) -> float:
     >>> tilt_deg(Box("a", [1, 1, 1], [0, 0, 0]))
     0.0
     """
-    rotation = rotation_matrix(box.orientation_xyzw)
-    cosine = float(np.max(np.abs(rotation[2, :])))
-    return float(np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0))))
+    return rotation_tilt_deg(rotation_matrix(box.orientation_xyzw))
+
+
+def axis_error_deg(truth_xyzw: np.ndarray, fitted_xyzw: np.ndarray) -> float:
+    """The largest angle between an axis of the fitted orientation and the nearest axis of the
+    true one (degrees: 0 when the two frames' axes are the same lines, whatever their order and
+    signs).
+
+    Examples
+    --------
+    >>> quarter_turn = np.array([0.0, 0.0, np.sin(np.pi / 4), np.cos(np.pi / 4)])
+    >>> round(axis_error_deg(np.array([0.0, 0.0, 0.0, 1.0]), quarter_turn), 6)
+    0.0
+    """
+    dots = np.abs(rotation_matrix(np.asarray(truth_xyzw)).T @ rotation_matrix(np.asarray(fitted_xyzw)))
+    return float(np.degrees(np.arccos(min(1.0, float(dots.max(axis=0).min())))))
 
 
 def convex_hull_2d(points: np.ndarray) -> np.ndarray:

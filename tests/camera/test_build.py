@@ -8,7 +8,7 @@ import pytest
 from tests.camera.conftest import INTRINSICS, render_tops
 from unstack.camera import scene_from_depth
 from unstack.errors import UnstackError
-from unstack.geometry import rotation_matrix
+from unstack.geometry import axis_error_deg, rotation_matrix
 
 SIZES = [(0.6, 0.4, 0.4), (0.4, 0.3, 0.3)]
 
@@ -244,12 +244,6 @@ def _resting(box_id: str, size, x: float, y: float, orientation: np.ndarray):
     return Box(box_id, size, [x, y, half_height + 0.001], orientation)
 
 
-def _axis_error_deg(first: np.ndarray, second: np.ndarray) -> float:
-    """The largest angle between an axis of one orientation and the nearest axis of the other."""
-    dots = np.abs(rotation_matrix(first).T @ rotation_matrix(second))
-    return float(np.degrees(np.arccos(min(1.0, dots.max(axis=0).min()))))
-
-
 @pytest.mark.parametrize("tilt_deg", [8.0, 20.0, 35.0])
 @pytest.mark.parametrize(
     ("axis", "yaw_deg"), [([0.0, 1.0, 0.0], 0.0), ([1.0, 0.0, 0.0], 15.0), ([1.0, 1.0, 0.0], -30.0)]
@@ -266,7 +260,7 @@ def test_a_box_lying_tilted_is_fitted_in_full_3d(tilt_deg: float, axis: list[flo
     built = scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES, door=[-1.0, 0.0, 0.0])
     [fitted] = built.fitted
     assert fitted.face == "tilted"
-    assert _axis_error_deg(fitted.box.orientation_xyzw, box.orientation_xyzw) < 2.0
+    assert axis_error_deg(fitted.box.orientation_xyzw, box.orientation_xyzw) < 2.0
     assert np.linalg.norm(fitted.box.position - box.position) < 0.015
     assert sorted(fitted.box.size) == pytest.approx(sorted(size))
 
@@ -319,7 +313,7 @@ def test_depth_noise_of_two_centimetres_keeps_upright_and_tilted_apart(
     noisy = np.where(depth > 0, depth + rng.normal(0.0, 0.02, depth.shape), 0.0)
     [fitted] = scene_from_depth(noisy, INTRINSICS, pose, masks, known_sizes=SIZES, door=[-1.0, 0.0, 0.0]).fitted
     assert (fitted.face == "tilted") is tilted  # upright: from its top or its front
-    assert _axis_error_deg(fitted.box.orientation_xyzw, box.orientation_xyzw) < 5.0
+    assert axis_error_deg(fitted.box.orientation_xyzw, box.orientation_xyzw) < 5.0
 
 
 @pytest.mark.parametrize("seed", range(6))

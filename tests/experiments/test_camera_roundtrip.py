@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from tests.conftest import unstack
-from unstack.experiments.camera_roundtrip import axis_error_deg, yaw_error_deg
+from unstack.experiments.camera_roundtrip import yaw_error_deg
+from unstack.geometry import axis_error_deg
 
 pytestmark = pytest.mark.slow  # renders piles and decides
 

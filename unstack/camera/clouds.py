@@ -273,11 +273,6 @@ def _heading(rotation: np.ndarray, size: np.ndarray) -> tuple[float, np.ndarray]
     return float(np.arctan2(direction[1], direction[0])), np.array([size[longest], size[other], size[vertical]])
 
 
-def _tilt_deg(rotation: np.ndarray) -> float:
-    """The angle between z and the box axis standing most upright (degrees)."""
-    return float(np.degrees(np.arccos(min(1.0, float(np.max(np.abs(rotation[2])))))))
-
-
 def scene_from_cloud(
     points: np.ndarray, detections: Sequence[dict[str, Any]], *, door: Sequence[float] | None = None, seed: int = 0
 ) -> CameraScene:
@@ -286,7 +281,7 @@ def scene_from_cloud(
 
     from unstack.camera.boxes import TILT_MIN_DEG
     from unstack.checks import check_points
-    from unstack.geometry import rotation_matrix
+    from unstack.geometry import rotation_matrix, rotation_tilt_deg
     from unstack.scene import finite_points
 
     check_detections(detections)
@@ -304,7 +299,7 @@ def scene_from_cloud(
             rotation = np.array([[np.cos(yaw), -np.sin(yaw), 0.0], [np.sin(yaw), np.cos(yaw), 0.0], [0.0, 0.0, 1.0]])
         size = np.asarray(item["size"], dtype=np.float64)
         turned = frame.rotation @ rotation
-        if min(_tilt_deg(rotation), _tilt_deg(turned)) >= TILT_MIN_DEG:  # lying tilted, in both frames
+        if min(rotation_tilt_deg(rotation), rotation_tilt_deg(turned)) >= TILT_MIN_DEG:  # lying tilted, in both frames
             orientation = Rotation.from_matrix(turned).as_quat()
         else:
             heading, size = _heading(turned, size)

@@ -180,20 +180,17 @@ def plane_within_noise(
     (True, True)
     """
     band = PLANE_THRESHOLD
-    while True:
-        distances = np.abs(points @ normal - offset)
-        inside = distances < band
-        if inside.sum() < 3 or np.mean(distances[inside]) < NOISE_FILL * band or 2.0 * band > NOISE_BAND:
-            return normal, offset, inliers
+    while _fills_band(points, normal, offset, band) and 2.0 * band <= NOISE_BAND:
         band *= 2.0
-        wide = distances < band
+        wide = np.abs(points @ normal - offset) < band
         centre = points[wide].mean(axis=0)
         refined = np.linalg.svd(points[wide] - centre, full_matrices=False)[2][-1]
         refined *= np.sign(refined @ normal) or 1.0
         if refined @ normal < np.cos(np.radians(NOISE_TURN_DEG)):  # the wider band holds another surface
-            return normal, offset, inliers
+            break
         normal, offset = refined, float(refined @ centre)
         inliers = np.abs(points @ normal - offset) < band
+    return normal, offset, inliers
 
 
 def _fills_band(points: np.ndarray, normal: np.ndarray, offset: float, band: float = PLANE_THRESHOLD) -> bool:

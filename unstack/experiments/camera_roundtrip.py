@@ -5,7 +5,7 @@ Each pile of a simulated data set is rendered as a robot's camera would hand it 
 seen box); :func:`unstack.camera.scene_from_depth` builds the scene back with the data set's
 carton sizes as the known sizes. Per fitted box: the position error (metres), the yaw error
 (degrees, modulo the top face's symmetry: 180 degrees, 90 for a square top), the axis error
-(:func:`axis_error_deg`, which a box lying tilted has too), whether the
+(:func:`unstack.geometry.axis_error_deg`, which a box lying tilted has too), whether the
 size is the true one, and the fit's residual; the errors also for the boxes whose face was
 seen whole alone (:attr:`unstack.camera.FittedBox.partial`, what the fit itself says). Per
 pile: the default decision (:func:`unstack.decide`) on the built scene and on the true poses
@@ -30,7 +30,7 @@ import numpy as np
 from unstack.experiments.dispatch import run_unordered
 from unstack.parameters import COUNT, JOBS, validate_params
 
-__all__ = ["TILTED_DEG", "axis_error_deg", "camera_roundtrip", "yaw_error_deg"]
+__all__ = ["TILTED_DEG", "camera_roundtrip", "yaw_error_deg"]
 
 #: Boxes lying tilted at least this far from standing on a face (degrees) are reported apart.
 TILTED_DEG = 5.0
@@ -47,22 +47,6 @@ def yaw_error_deg(truth_xyzw: np.ndarray, fitted_xyzw: np.ndarray, square_top: b
     period = np.pi / 2 if square_top else np.pi
     difference = np.mod(heading(truth_xyzw) - heading(fitted_xyzw), period)
     return float(np.degrees(min(difference, period - difference)))
-
-
-def axis_error_deg(truth_xyzw: np.ndarray, fitted_xyzw: np.ndarray) -> float:
-    """The largest angle between an axis of the fitted box and the nearest axis of the true one
-    (degrees: 0 when the two boxes' axes are the same lines, whatever their order and signs).
-
-    Examples
-    --------
-    >>> quarter_turn = np.array([0.0, 0.0, np.sin(np.pi / 4), np.cos(np.pi / 4)])
-    >>> round(axis_error_deg(np.array([0.0, 0.0, 0.0, 1.0]), quarter_turn), 6)
-    0.0
-    """
-    from unstack.geometry import rotation_matrix
-
-    dots = np.abs(rotation_matrix(np.asarray(truth_xyzw)).T @ rotation_matrix(np.asarray(fitted_xyzw)))
-    return float(np.degrees(np.arccos(min(1.0, float(dots.max(axis=0).min())))))
 
 
 def _long_edge_quaternion(box: Any) -> np.ndarray:
@@ -82,7 +66,7 @@ def _roundtrip_pile(path: Path, number: int, model: Any, samples: int) -> tuple[
 
     import unstack
     from unstack.camera import scene_from_depth
-    from unstack.geometry import tilt_deg
+    from unstack.geometry import axis_error_deg, tilt_deg
     from unstack.scene import Scene, load_scene
     from unstack.sim.camera_view import camera_view
     from unstack.sim.settings import SimulationSettings, scene_settings
