@@ -238,11 +238,13 @@ class CameraScene:
         return doubts
 
     def report(self) -> dict[str, Any]:
-        """JSON-ready: gravity (tilt, planes, floor), every fitted box with its residual, duplicates."""
+        """JSON-ready: gravity (tilt, planes, floor, whether the depth's noise filled the planes' band),
+        every fitted box with its residual, duplicates."""
         return {
             "tilt_deg": self.frame.tilt_deg,
             "horizontal_planes": self.frame.planes,
             "floor_points": self.frame.floor_inliers,
+            "noisy_depth": self.frame.noisy,
             "boxes": [item.to_dict() for item in self.fitted],
             "duplicates": dict(self.duplicates),
             "unfitted": dict(self.unfitted),
@@ -400,8 +402,9 @@ def scene_from_depth(
     _check_upright(frame, pose, [_core_points(depth_m, intrinsics, pose, frame, masks[k]) for k in kept])
     viewpoint = frame.apply(pose[None, :3, 3])[0]
     fitted, unfitted = boxes_from_masks(
-        mask_points, [names[k] for k in kept], known_sizes=known_sizes, seed=seed, viewpoint=viewpoint
-    )
+        mask_points, [names[k] for k in kept], known_sizes=known_sizes, seed=seed, viewpoint=viewpoint,
+        noisy=frame.noisy,
+    )  # fmt: skip
     by_id = {item.box.id: item.box for item in fitted}
     for k in kept:  # a mask of pieces apart: two boxes under one label, fitted as one or not at all
         pieces = _pieces(masks[k])

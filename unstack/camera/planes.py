@@ -271,6 +271,10 @@ class GravityFrame:
         Points on the floor plane (0 when the floor was taken as the lowest points).
     plane_heights : tuple of (float, int)
         Each of those horizontal planes' height in the gravity frame (metres) and its points.
+    noisy : bool
+        The depth's noise fills the planes' band (:data:`PLANE_THRESHOLD`): told by the first,
+        largest plane; planes are then searched by heights (:func:`plane_by_heights`) and
+        refitted in a band as wide as the noise (:func:`plane_within_noise`).
     """
 
     rotation: np.ndarray
@@ -279,6 +283,7 @@ class GravityFrame:
     planes: int
     floor_inliers: int
     plane_heights: tuple[tuple[float, int], ...] = ()
+    noisy: bool = False
 
     def apply(self, points: np.ndarray) -> np.ndarray:
         """The points in the gravity frame."""
@@ -326,19 +331,24 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
     up_guess = np.array([0.0, 0.0, 1.0])
     remaining = points
     found: list[tuple[np.ndarray, float, int]] = []
+    noisy: bool | None = None  # the depth's noise, told by the first (largest) plane: the sensor's, not a plane's
     noisy_up: np.ndarray | None = None
     for _ in range(MAX_PLANES):
         if len(remaining) < max(3, MIN_PLANE_SHARE * len(points)):
             break
         normal, offset, inliers = fit_plane(remaining, rng=rng, near_normal=up_guess)
-        if inliers.sum() >= 3 and _fills_band(remaining, normal, offset):  # noisy: search by heights instead
+        if noisy is None and inliers.sum() >= 3:
+            noisy = _fills_band(remaining, normal, offset)
+        # a later plane of exact depth can fill its band too -- a few points of a top among the sides
+        # crossing it -- and must not be searched by heights or widened: that turned gravity 25 degrees
+        if noisy and inliers.sum() >= 3 and _fills_band(remaining, normal, offset):  # search by heights instead
             if noisy_up is None:  # the first: over the whole cone; the next ones parallel to it
                 normal, offset = plane_by_heights(remaining, up_guess, rng=rng)
                 noisy_up = normal
             else:
                 normal, offset = plane_by_heights(remaining, noisy_up, tolerance_deg=PARALLEL_DEG, rng=rng)
             inliers = np.abs(remaining @ normal - offset) < PLANE_THRESHOLD
-        if inliers.sum() >= 3:
+        if noisy and inliers.sum() >= 3:
             normal, offset, inliers = plane_within_noise(remaining, normal, offset, inliers)
         if inliers.sum() < MIN_PLANE_SHARE * len(points):
             break
@@ -374,4 +384,6 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
     plane_heights = tuple(
         (float(height - floor_level), count) for height, (*_, count) in zip(floor_heights, found, strict=True)
     )
-    return GravityFrame(rotation, np.array([0.0, 0.0, -floor_level]), tilt, len(found), floor_inliers, plane_heights)
+    return GravityFrame(
+        rotation, np.array([0.0, 0.0, -floor_level]), tilt, len(found), floor_inliers, plane_heights, bool(noisy)
+    )
