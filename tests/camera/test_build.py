@@ -173,6 +173,14 @@ def test_the_masks_order_changes_no_box(example_frame) -> None:
         assert np.array_equal(boxes[box.id].size, box.size)
 
 
+@pytest.mark.parametrize("sizes", [SIZES, [(0.4, 0.4, 0.3), (0.3, 0.3, 0.4), (0.6, 0.4, 0.4), (0.4, 0.3, 0.3)]])
+def test_the_order_of_the_known_sizes_changes_no_box(example_frame, sizes: list[tuple[float, ...]]) -> None:
+    depth, intrinsics, pose, masks, ids = example_frame
+    forward = scene_from_depth(depth, intrinsics, pose, masks, ids=ids, known_sizes=sizes, seed=0)
+    reverse = scene_from_depth(depth, intrinsics, pose, masks, ids=ids, known_sizes=sizes[::-1], seed=0)
+    assert forward.report() == reverse.report()
+
+
 def test_a_few_pixels_of_a_mask_on_another_box_are_left_out_with_a_warning(three_cartons) -> None:
     depth, masks, pose = render_tops(three_cartons)
     clean = scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES)

@@ -184,7 +184,8 @@ def _match_size(
     known_sizes: Sequence[Sequence[float]],
     surfaces: Sequence[float],
 ) -> tuple[np.ndarray, float, bool]:
-    """The known size nearest the measured top edges; ties by where the bottom lands.
+    """The known size nearest the measured top edges; ties by where the bottom lands (then by
+    the edges, then by the size: not by the order of ``known_sizes``).
 
     A face seen in part is smaller than the box, never larger: an edge measured longer than a
     size's costs :data:`OVERSIZE_WEIGHT` times as much as one measured shorter, and a size lower
@@ -208,7 +209,8 @@ def _match_size(
                 options.append((error, landing, np.array([*placed, height]), turned))
     best_error = min(option[0] for option in options)
     tied = [option for option in options if option[0] <= best_error + SIZE_TIE]
-    chosen = min(tied, key=lambda option: option[1])
+    # where the bottom lands, then the nearer top edges, then the size itself: never the order given
+    chosen = min(tied, key=lambda option: (option[1], option[0], tuple(option[2]), option[3]))
     return np.asarray(chosen[2], dtype=np.float64), float(chosen[0]), chosen[3]
 
 
@@ -255,7 +257,7 @@ def fit_box(
     if top_seen and normal @ up >= np.cos(np.radians(TILT_MIN_DEG)):
         return _fit_from_top(box_id, points, normal, offset, inliers, known_sizes, surfaces, rng)
     # the tilted fit draws from a child generator: the upright fits below draw as they would without it
-    tilted = _fit_tilted(box_id, points, known_sizes, rng.spawn(1)[0], viewpoint, noisy)
+    tilted = _fit_tilted(box_id, points, known_sizes, rng.spawn(1)[0], viewpoint, noisy, surfaces)
     if tilted is not None:
         return tilted
     if top_seen:
@@ -330,27 +332,35 @@ def _tilted_axes(
     return axes, faces
 
 
-def _match_tilted_size(
+def _match_tilted_sizes(
     extents: np.ndarray, observed: np.ndarray, known_sizes: Sequence[Sequence[float]] | None
-) -> tuple[np.ndarray, float]:
-    """The box's size along its three axes and the error: the known size (in any of its six
-    turns) nearest the extents measured along the ``observed`` axes (a longer measure costs
-    :data:`OVERSIZE_WEIGHT` times a shorter); without known sizes, the measured extents, and
-    an axis no face shows as deep as the shorter seen one."""
+) -> list[np.ndarray]:
+    """The box's possible sizes along its three axes: the known sizes (in any of their six turns)
+    nearest the extents measured along the ``observed`` axes (a longer measure costs
+    :data:`OVERSIZE_WEIGHT` times a shorter), several when they differ only along an axis no face
+    shows (in the order of their edges, not of ``known_sizes``); without known sizes, the
+    measured extents, and an axis no face shows as deep as the shorter seen one."""
     if not known_sizes:
         seen = extents[observed]
         depth = float(seen.min()) if len(seen) else float(extents.max())
-        return np.where(observed, extents, depth), 0.0
-    best: tuple[float, np.ndarray] | None = None
+        return [np.where(observed, extents, depth)]
+    options: list[tuple[float, tuple[float, ...]]] = []
     for size in known_sizes:
         for turn in ((0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)):
             placed = np.asarray(size, dtype=np.float64)[list(turn)]
             difference = (extents - placed)[observed]
             error = float(np.sum(np.where(difference > 0, OVERSIZE_WEIGHT * difference, -difference)))
-            if best is None or error < best[0] - 1e-12:
-                best = (error, placed)
-    assert best is not None
-    return best[1], best[0]
+            options.append((error, tuple(float(edge) for edge in placed)))
+    best = min(error for error, _ in options)
+    return [np.array(placed) for placed in sorted({placed for error, placed in options if error <= best + 1e-12})]
+
+
+def _lowest_landing(size: np.ndarray, position: np.ndarray, axes: np.ndarray, surfaces: Sequence[float]) -> float:
+    """How far a tilted box's lowest corner lies from the nearest surface (the floor or another
+    box's top); under the floor costs 10 more, as for the upright fits (:func:`_match_size`)."""
+    lowest = float(position[2] - 0.5 * np.abs(axes[:, 2]) @ size)
+    landing = min((abs(lowest - surface) for surface in surfaces), default=0.0)
+    return landing + (10.0 if lowest < -PLANE_THRESHOLD * 3 else 0.0)
 
 
 def _fit_tilted(
@@ -360,9 +370,14 @@ def _fit_tilted(
     rng: np.random.Generator,
     viewpoint: Sequence[float] | None,
     noisy: bool | None = None,
+    surfaces: Sequence[float] = (0.0,),
 ) -> FittedBox | None:
     """A box fitted in full 3-D from its seen faces; None when it stands within
-    :data:`TILT_MIN_DEG` of upright (the upright fits are better there) or shows no face."""
+    :data:`TILT_MIN_DEG` of upright (the upright fits are better there) or shows no face.
+
+    Known sizes that fit the seen faces alike but differ in a depth no face shows are told
+    apart by where the box's lowest corner lands (the floor or another box's top), then by the
+    smaller; such a box is seen in part."""
     from scipy.spatial.transform import Rotation
 
     centroid = points.mean(axis=0)
@@ -380,26 +395,34 @@ def _fit_tilted(
     extents = high - low + spacing
     observed = np.ones(3, dtype=bool)
     observed[0] = len(faces) > 1  # the depth behind the first face shows only on another face
-    size, _ = _match_tilted_size(extents, observed, known_sizes)
-    across = size[1:] - extents[1:]  # the largest face's two edges, as the upright fits report
-    size_error = float(np.sum(np.where(across < 0, -OVERSIZE_WEIGHT * across, across))) if known_sizes else 0.0
     seen_faces = {axis: (side, place) for axis, side, place, _ in faces}
     view = (toward - centroid) / max(float(np.linalg.norm(toward - centroid)), 1e-9)
-    centre = np.empty(3)
-    for axis in range(3):
-        if axis in seen_faces:  # the box lies behind its seen face
-            side, place = seen_faces[axis]
-            centre[axis] = place + side * size[axis] / 2
-        elif axes[axis] @ view > 0.2:  # the end nearer the camera is the one seen
-            centre[axis] = high[axis] + spacing / 2 - size[axis] / 2
-        elif axes[axis] @ view < -0.2:
-            centre[axis] = low[axis] - spacing / 2 + size[axis] / 2
-        else:
-            centre[axis] = (low[axis] + high[axis]) / 2
+
+    def centre_of(size: np.ndarray) -> np.ndarray:
+        centre = np.empty(3)
+        for axis in range(3):
+            if axis in seen_faces:  # the box lies behind its seen face
+                side, place = seen_faces[axis]
+                centre[axis] = place + side * size[axis] / 2
+            elif axes[axis] @ view > 0.2:  # the end nearer the camera is the one seen
+                centre[axis] = high[axis] + spacing / 2 - size[axis] / 2
+            elif axes[axis] @ view < -0.2:
+                centre[axis] = low[axis] - spacing / 2 + size[axis] / 2
+            else:
+                centre[axis] = (low[axis] + high[axis]) / 2
+        return centre
+
+    sizes = _match_tilted_sizes(extents, observed, known_sizes)
+    size = min(
+        sizes, key=lambda size: (_lowest_landing(size, centre_of(size) @ axes, axes, surfaces), float(np.prod(size)))
+    )
+    centre = centre_of(size)
+    across = size[1:] - extents[1:]  # the largest face's two edges, as the upright fits report
+    size_error = float(np.sum(np.where(across < 0, -OVERSIZE_WEIGHT * across, across))) if known_sizes else 0.0
     residual = float(np.sqrt(np.mean((first[:, 0] - faces[0][2]) ** 2)))
     face_extents = np.array([extents[1], extents[2]])
     fill = _fill(first[:, 1:], (low[1:] + high[1:]) / 2, 0.0, face_extents)
-    partial = fill < PARTIAL_FILL or bool(np.any((size - extents)[observed] > PARTIAL_EDGE))
+    partial = fill < PARTIAL_FILL or bool(np.any((size - extents)[observed] > PARTIAL_EDGE)) or len(sizes) > 1
     quaternion = Rotation.from_matrix(axes.T).as_quat()
     box = Box(box_id, size, centre @ axes, quaternion)
     return FittedBox(box, "tilted", residual, fill, size_error, len(points), partial)
