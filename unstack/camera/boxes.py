@@ -235,15 +235,11 @@ def fit_box(
     surfaces: Sequence[float],
     rng: np.random.Generator,
     viewpoint: Sequence[float] | None = None,
-    noisy: bool | None = None,
 ) -> FittedBox:
     """Fit one box to a mask's points (gravity frame); see the module docstring.
 
     ``viewpoint``: where the camera stands (gravity frame), the side a tilted box's seen faces
-    look to; default: out through the door and up (:data:`DEFAULT_VIEW`). ``noisy``: whether
-    the depth's noise fills the planes' band (:attr:`~unstack.camera.planes.GravityFrame.noisy`),
-    so that a tilted box's faces are refitted in a band as wide as the noise
-    (:func:`~unstack.camera.planes.plane_within_noise`); ``None``: each face tells by itself.
+    look to; default: out through the door and up (:data:`DEFAULT_VIEW`).
     """
     points = np.asarray(points, dtype=np.float64)
     if len(points) < MIN_FACE_POINTS:
@@ -257,7 +253,7 @@ def fit_box(
     if top_seen and normal @ up >= np.cos(np.radians(TILT_MIN_DEG)):
         return _fit_from_top(box_id, points, normal, offset, inliers, known_sizes, surfaces, rng)
     # the tilted fit draws from a child generator: the upright fits below draw as they would without it
-    tilted = _fit_tilted(box_id, points, known_sizes, rng.spawn(1)[0], viewpoint, noisy, surfaces)
+    tilted = _fit_tilted(box_id, points, known_sizes, rng.spawn(1)[0], viewpoint, surfaces)
     if tilted is not None:
         return tilted
     if top_seen:
@@ -281,7 +277,7 @@ def _without_surface_below(points: np.ndarray, rng: np.random.Generator) -> np.n
 
 
 def _tilted_axes(
-    points: np.ndarray, rng: np.random.Generator, toward: np.ndarray, noisy: bool | None = None
+    points: np.ndarray, rng: np.random.Generator, toward: np.ndarray
 ) -> tuple[np.ndarray, list[tuple[int, float, float, np.ndarray]]] | None:
     """A tilted box's axes (rows, right-handed) from the planes of its points, and its seen faces
     as ``(axis, side, place, inliers)``: the box lies from ``place`` along the axis towards
@@ -291,7 +287,7 @@ def _tilted_axes(
     planes: list[tuple[np.ndarray, float, np.ndarray]] = []
     while len(planes) < 3 and remaining.sum() >= MIN_FACE_POINTS:
         normal, offset, inliers = fit_plane(points[remaining], rng=rng)
-        if inliers.sum() >= 3 and noisy is not False:  # exact depth: a face's band is filled only by other faces
+        if inliers.sum() >= 3:
             normal, offset, inliers = plane_within_noise(points[remaining], normal, offset, inliers)
         if inliers.sum() < max(MIN_FACE_POINTS, TILTED_FACE_SHARE * len(points)):
             break
@@ -369,7 +365,6 @@ def _fit_tilted(
     known_sizes: Sequence[Sequence[float]] | None,
     rng: np.random.Generator,
     viewpoint: Sequence[float] | None,
-    noisy: bool | None = None,
     surfaces: Sequence[float] = (0.0,),
 ) -> FittedBox | None:
     """A box fitted in full 3-D from its seen faces; None when it stands within
@@ -382,7 +377,7 @@ def _fit_tilted(
 
     centroid = points.mean(axis=0)
     toward = np.asarray(viewpoint, dtype=np.float64) if viewpoint is not None else centroid + np.asarray(DEFAULT_VIEW)
-    found = _tilted_axes(points, rng, toward, noisy)
+    found = _tilted_axes(points, rng, toward)
     if found is None:
         return None
     axes, faces = found
@@ -642,15 +637,14 @@ def boxes_from_masks(
     known_sizes: Sequence[Sequence[float]] | None = None,
     seed: int = 0,
     viewpoint: Sequence[float] | None = None,
-    noisy: bool | None = None,
 ) -> tuple[list[FittedBox], dict[str, str]]:
     """Fit a box to each mask's points (gravity frame); bottoms land on the floor or other tops.
 
     Returns the fitted boxes and, for each mask that could not be fitted, why. Each mask's
     RANSAC draws from its own generator, seeded by ``seed`` and the mask's points
     (:func:`content_rng`): a box's fit depends on its own points only, not on the masks given
-    before it or their order. ``viewpoint`` (the camera's place, gravity frame) and ``noisy``:
-    see :func:`fit_box`.
+    before it or their order. ``viewpoint``: the camera's place (gravity frame), see
+    :func:`fit_box`.
     """
     if len(mask_points) != len(ids):
         raise UnstackError(f"{len(mask_points)} masks but {len(ids)} ids")
@@ -661,10 +655,9 @@ def boxes_from_masks(
         surfaces = [0.0, *(top for j, top in enumerate(tops) if j != k)]
         try:
             rng = content_rng(seed, points)
-            box = fit_box(
-                box_id, points, known_sizes=known_sizes, surfaces=surfaces, rng=rng, viewpoint=viewpoint, noisy=noisy
+            fitted.append(
+                fit_box(box_id, points, known_sizes=known_sizes, surfaces=surfaces, rng=rng, viewpoint=viewpoint)
             )
-            fitted.append(box)
         except InvalidFile as error:  # a box no carton is: say so of the fit, not of an array
             unfitted[box_id] = f"the fitted box's {error.json_path[2:]}: {error.message}"
         except UnstackError as error:
