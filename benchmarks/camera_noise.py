@@ -12,12 +12,15 @@ simulator's z at most.
 
 Noise: ``kinect`` draws sigma = 0.0012 + 0.0019 (z - 0.4)^2 metres at depth z (a Kinect-like
 sensor: 1.4 cm at 3 m, 2.6 cm at 4 m); a number draws that sigma (metres) everywhere; ``0``
-leaves the depth exact.
+leaves the depth exact. ``--flying SHARE``: that share of the pixels beside a jump of more than
+5 cm to a farther neighbour read a random mix of their depth and the neighbour's, as a
+time-of-flight sensor's mixed ("flying") pixels do where its own filter is off.
 
 Usage::
 
     unstack simulate --family stacked --configs 10 --seed 7707 --viewpoint-jitter 0.3 --out piles-stacked
     python benchmarks/camera_noise.py piles-stacked --piles 10 --noise kinect --seed 1
+    python benchmarks/camera_noise.py piles-stacked --piles 10 --noise 0 --flying 1 --seed 1
 """
 
 from __future__ import annotations
@@ -42,7 +45,25 @@ def noisy_depth(depth: np.ndarray, noise: str, rng: np.random.Generator) -> np.n
     return np.where(depth > 0, depth + rng.normal(size=depth.shape) * sigma, 0.0)
 
 
-def pile_rows(path: Path, noise: str, rng: np.random.Generator) -> list[dict[str, Any]]:
+#: A neighbour this much farther (metres) makes a depth jump, beside which pixels may fly.
+JUMP_M = 0.05
+
+
+def flying_pixels(noisy: np.ndarray, exact: np.ndarray, share: float, rng: np.random.Generator) -> np.ndarray:
+    """``noisy`` with ``share`` of the pixels beside a depth jump (in ``exact``: a 4-neighbour
+    :data:`JUMP_M` or more farther) reading a uniform random mix of their depth and the farthest
+    such neighbour's; no draw at all when ``share`` is 0 (the tables without flying pixels stay
+    as they were)."""
+    if share <= 0:
+        return noisy
+    padded = np.pad(exact, 1, mode="edge")
+    farthest = np.max([padded[1:-1, :-2], padded[1:-1, 2:], padded[:-2, 1:-1], padded[2:, 1:-1]], axis=0)
+    flying = (farthest - exact > JUMP_M) & (exact > 0) & (rng.random(exact.shape) < share)
+    mix = rng.random(exact.shape)
+    return np.where(flying, mix * noisy + (1.0 - mix) * farthest, noisy)
+
+
+def pile_rows(path: Path, noise: str, rng: np.random.Generator, flying: float = 0.0) -> list[dict[str, Any]]:
     """One row per mask of the pile: the truth's tilt and how the fit did."""
     from unstack.camera import scene_from_depth
     from unstack.errors import UnstackError
@@ -54,7 +75,8 @@ def pile_rows(path: Path, noise: str, rng: np.random.Generator) -> list[dict[str
     scene = load_scene(path)
     settings = scene_settings(scene) or SimulationSettings()
     view = camera_view(scene)
-    view = dataclasses.replace(view, depth_m=noisy_depth(view.depth_m, noise, rng))
+    depth = flying_pixels(noisy_depth(view.depth_m, noise, rng), view.depth_m, flying, rng)
+    view = dataclasses.replace(view, depth_m=depth)
     ids = sorted(view.masks)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -100,7 +122,12 @@ def main(argv: list[str]) -> int:
     parser = data_sets_parser(__doc__.splitlines()[0], piles=10)
     parser.add_argument("--noise", default="kinect", help="kinect, or a sigma in metres (default: %(default)s)")
     parser.add_argument("--seed", type=int, default=1, help="seeds the noise (default: %(default)s)")
+    parser.add_argument(
+        "--flying", type=float, default=0.0, help="share of the pixels beside depth jumps that fly (default: 0)"
+    )
     args = parser.parse_args(argv)
+    if not 0.0 <= args.flying <= 1.0:
+        parser.error(f"--flying: expected a share from 0 to 1, got {args.flying}")
     if args.noise != "kinect":
         try:
             float(args.noise)
@@ -114,7 +141,8 @@ def main(argv: list[str]) -> int:
         "fitted as the other kind", numbers_from=2,
     )  # fmt: skip
     for folder in args.data:
-        rows = [row for path in first_configurations(folder, args.piles) for row in pile_rows(path, args.noise, rng)]
+        piles = first_configurations(folder, args.piles)
+        rows = [row for path in piles for row in pile_rows(path, args.noise, rng, args.flying)]
         for kind, tilted in (("upright", False), ("tilted", True)):
             chosen = [row for row in rows if row.get("tilted") is tilted]
             print(f"| {Path(folder).name} | {kind} | " + " | ".join(summary_cells(chosen)) + " |", flush=True)

@@ -53,3 +53,14 @@ def test_an_upright_box_takes_the_nearer_of_two_sizes_of_one_height_in_either_or
     fitted = fit_box("a", top, known_sizes=sizes, surfaces=[0.0], rng=np.random.default_rng(1))
     assert fitted.face == "top"
     assert sorted(fitted.box.size) == pytest.approx([0.3, 0.3, 0.42])
+
+
+def test_a_size_that_would_sink_the_box_into_the_floor_is_passed_over() -> None:
+    # a 0.6 x 0.4 top 0.4 m up measured 3 cm long on each edge (flying pixels, noise): the edges
+    # are nearer 0.6 x 0.5 of the 0.8 x 0.6 x 0.5 carton, which stood 0.8 m tall would sink 0.4 m
+    x, y = np.meshgrid(np.arange(0.7, 1.3201, 0.01), np.arange(-0.2, 0.2201, 0.01))
+    top = np.column_stack([x.ravel(), y.ravel(), np.full(x.size, 0.4)])
+    sizes = [(0.8, 0.6, 0.5), (0.6, 0.4, 0.4)]
+    fitted = fit_box("a", top, known_sizes=sizes, surfaces=[0.0], rng=np.random.default_rng(1))
+    assert sorted(fitted.box.size) == pytest.approx([0.4, 0.4, 0.6])
+    assert fitted.box.position[2] == pytest.approx(0.2)

@@ -399,3 +399,43 @@ def test_a_pose_upside_down_is_refused_whether_or_not_the_boxes_show_their_tops(
     scene_from_depth(depth, INTRINSICS, pose, masks, ids=ids, known_sizes=SIZES)
     with pytest.raises(UnstackError, match="the pose's z points down"):
         scene_from_depth(depth, INTRINSICS, np.diag([1.0, -1.0, -1.0, 1.0]) @ pose, masks, ids=ids, known_sizes=SIZES)
+
+
+def _with_flying_pixels(depth: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Every pixel beside a jump of more than 5 cm to a farther 4-neighbour reads a uniform random
+    mix of its depth and that neighbour's: a time-of-flight sensor's flying pixels."""
+    padded = np.pad(depth, 1, mode="edge")
+    farthest = np.max([padded[1:-1, :-2], padded[1:-1, 2:], padded[:-2, 1:-1], padded[2:, 1:-1]], axis=0)
+    flying = (farthest - depth > 0.05) & (depth > 0)
+    mix = rng.random(depth.shape)
+    return np.where(flying, mix * depth + (1.0 - mix) * farthest, depth)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_flying_pixels_at_every_edge_leave_upright_and_tilted_boxes_in_place(seed: int) -> None:
+    from tests.camera.conftest import FLOOR, looking_in, render_boxes
+    from unstack.scene import Box
+
+    rng = np.random.default_rng(seed)
+    upright = [
+        Box(
+            f"u{k}",
+            SIZES[k % 2],
+            [2.6 + 0.7 * (k // 2), -0.5 + 1.0 * (k % 2), SIZES[k % 2][2] / 2],
+            _turned([0, 0, 1], 0.0, 25.0 * k),
+        )
+        for k in range(4)
+    ]
+    tilted = _resting("t", SIZES[1], 2.3, -1.1, _turned([1.0, 0.5, 0.0], 25.0, rng.uniform(-30, 30)))
+    boxes = [*upright, tilted]
+    wall = (np.array([-1.0, 0.0, 0.0]), -5.0)  # the container's far end, behind the boxes
+    pose = looking_in(height=1.4, pitch_deg=15.0)
+    depth, masks = render_boxes(boxes, pose, planes=[FLOOR, wall])
+    flying = _with_flying_pixels(depth, rng)
+    built = scene_from_depth(
+        flying, INTRINSICS, pose, masks, ids=[box.id for box in boxes], known_sizes=SIZES, door=[-1.0, 0.0, 0.0]
+    )
+    fitted = {item.box.id: item.box for item in built.fitted}
+    for box in boxes:
+        assert np.linalg.norm(fitted[box.id].position - box.position) < 0.02, box.id
+        assert sorted(fitted[box.id].size) == pytest.approx(sorted(box.size)), box.id

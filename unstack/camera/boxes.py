@@ -7,11 +7,13 @@ For each mask (points already in the gravity frame, z up, floor at 0):
   the box's top;
 * the **yaw** and the top's extents come from the minimum-area rectangle around the top
   face's points (the convex hull's edges, rotating calipers), the long edge on the long
-  extent;
+  extent, leaving out points that stand apart (:data:`STRAY_SPREAD`: a time-of-flight sensor's
+  flying pixels along the edges);
 * the **size** is matched to the known carton sizes (any edge may stand vertical): the known
   size whose top edges are closest to the rectangle, ties to the one whose bottom lands nearest
-  a surface (the floor or another box's top); without known sizes, the rectangle and the
-  height down to the surface below;
+  a surface (the floor or another box's top), never one whose bottom would sink under the floor
+  while another does not; without known sizes, the rectangle and the height down to the
+  surface below;
 * the **residual** is the RMS distance of the top points to the fitted top plane, and the
   **fill** the share of the rectangle the top points cover;
 * a mask whose pixels are mostly (:data:`DUPLICATE_SHARE`) inside another, larger mask is a
@@ -88,6 +90,9 @@ SQUARE_TOLERANCE_DEG = 20.0
 #: A level plane under the rest of a mask's points, holding less than this share of them, is a
 #: surface the mask bled onto (left out).
 BLEED_SHARE = 0.35
+#: A point whose third nearest neighbour is this many times further than the median is a stray
+#: (a flying pixel), left out of a top's rectangle and of a tilted box's extents.
+STRAY_SPREAD = 3.0
 #: Where no viewpoint is given, faces are taken to look this way (out through the door and up).
 DEFAULT_VIEW = (-1.0, 0.0, 1.0)
 
@@ -207,6 +212,9 @@ def _match_size(
                 difference = top_edges - placed
                 error = float(np.sum(np.where(difference > 0, OVERSIZE_WEIGHT * difference, -difference)))
                 options.append((error, landing, np.array([*placed, height]), turned))
+    # a size that puts the bottom under the floor is taken only when every size does: edges
+    # measured long (flying pixels, depth noise) otherwise pick a taller box sunk into the floor
+    options = [option for option in options if option[1] < 10.0] or options
     best_error = min(option[0] for option in options)
     tied = [option for option in options if option[0] <= best_error + SIZE_TIE]
     # where the bottom lands, then the nearer top edges, then the size itself: never the order given
@@ -384,7 +392,10 @@ def _fit_tilted(
     if np.max(np.abs(axes[:, 2])) >= np.cos(np.radians(TILT_MIN_DEG)):
         return None
     local = points @ axes.T
-    low, high = np.percentile(local, 1, axis=0), np.percentile(local, 99, axis=0)
+    # the extents from the points on the seen faces or among others: not from flying pixels, which
+    # stand apart behind the box's edges
+    kept = np.any([face for *_, face in faces], axis=0) | ~_strays(points)
+    low, high = np.percentile(local[kept], 1, axis=0), np.percentile(local[kept], 99, axis=0)
     first = local[faces[0][3]]
     spacing = _spacing(first[:, 1:])
     extents = high - low + spacing
@@ -434,6 +445,7 @@ def _fit_from_top(
     rng: np.random.Generator,
 ) -> FittedBox:
     face = points[inliers]
+    face = face[~_strays(face[:, :2])]
     top = float(np.median(face[:, 2]))
     residual = float(np.sqrt(np.mean((face @ normal - offset) ** 2)))
     centre, yaw, extents = min_area_rectangle(face[:, :2])
@@ -469,6 +481,21 @@ def _fit_from_top(
     partial = fill < PARTIAL_FILL or bool(np.any(np.sort(size[:2])[::-1] - extents > PARTIAL_EDGE))
     box = Box(box_id, size, [centre[0], centre[1], top - size[2] / 2], _yaw_quaternion(yaw))
     return FittedBox(box, "top", residual, fill, size_error, len(points), partial)
+
+
+def _strays(flat: np.ndarray) -> np.ndarray:
+    """Which points stand apart from the rest (a face's in its plane, or a mask's in 3-D): their
+    third nearest neighbour lies more than :data:`STRAY_SPREAD` times the median third-neighbour
+    distance away. Flying pixels -- a time-of-flight sensor's readings that mix a box's edge with
+    what lies behind it -- stand apart along their rays, one pixel wide."""
+    from scipy.spatial import cKDTree
+
+    if len(flat) < 8:
+        return np.zeros(len(flat), dtype=bool)
+    distances, _ = cKDTree(flat).query(flat, k=4)
+    third = distances[:, 3]
+    strays: np.ndarray = third > STRAY_SPREAD * max(float(np.median(third)), 1e-9)
+    return strays
 
 
 def _spacing(xy: np.ndarray) -> float:
