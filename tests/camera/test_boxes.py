@@ -64,3 +64,18 @@ def test_a_size_that_would_sink_the_box_into_the_floor_is_passed_over() -> None:
     fitted = fit_box("a", top, known_sizes=sizes, surfaces=[0.0], rng=np.random.default_rng(1))
     assert sorted(fitted.box.size) == pytest.approx([0.4, 0.4, 0.6])
     assert fitted.box.position[2] == pytest.approx(0.2)
+
+
+@pytest.mark.parametrize("sizes", [[(0.4, 0.3, 0.3), (0.3, 0.3, 0.2)], [(0.3, 0.3, 0.2), (0.4, 0.3, 0.3)]])
+def test_a_box_seen_from_the_front_only_takes_the_deeper_of_two_sizes_sharing_its_face(
+    sizes: list[tuple[float, ...]],
+) -> None:
+    # a 0.3 x 0.3 front (x = 2.0, looking out through the door) with nothing of the top seen: the depth
+    # behind it is 0.4 or 0.2 by the sizes, whatever order they come in; the fit says it saw it in part
+    y, z = np.meshgrid(np.arange(-0.15, 0.1501, 0.01), np.arange(0.3, 0.6001, 0.01))
+    front = np.column_stack([np.full(y.size, 2.0), y.ravel(), z.ravel()])
+    fitted = fit_box("a", front, known_sizes=sizes, surfaces=[0.0, 0.3], rng=np.random.default_rng(1))
+    assert fitted.face == "front"
+    assert sorted(fitted.box.size) == pytest.approx([0.3, 0.3, 0.4])
+    assert fitted.box.position[0] == pytest.approx(2.2, abs=0.01)  # the box lies behind its front
+    assert fitted.partial

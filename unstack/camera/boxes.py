@@ -540,13 +540,19 @@ def _fit_from_front(
     width = float(np.ptp(face @ across))
     low, high = float(face[:, 2].min()), float(face[:, 2].max())
     residual = float(np.sqrt(np.mean((face @ normal - offset) ** 2)))
+    depths: set[float] = set()
     if known_sizes:
-        best = min(
-            ((abs(np.sort([a, b])[::-1] - np.sort([width, high - low])[::-1]).sum(), a, b, c)
-             for size in known_sizes for a, b, c in _faces(size)),
-            key=lambda option: option[0],
-        )  # fmt: skip
-        size_error, face_width, face_height, depth = best
+        options = [
+            (float(abs(np.sort([a, b])[::-1] - np.sort([width, high - low])[::-1]).sum()), a, b, c)
+            for size in known_sizes
+            for a, b, c in _faces(size)
+        ]
+        best_error = min(option[0] for option in options)
+        tied = [option for option in options if option[0] <= best_error + 1e-12]
+        # sizes that share the seen face differ in the depth behind it, which nothing shows: the
+        # deeper (it may hold up more behind), never the order of ``known_sizes``; seen in part
+        size_error, face_width, face_height, depth = max(tied, key=lambda option: (option[3], option[1], option[2]))
+        depths = {option[3] for option in tied}
     else:
         size_error, face_width, face_height, depth = 0.0, width, high - low, width
     face_centre = centre_face - (centre_face @ across - (face @ across).min() - width / 2) * across
@@ -554,7 +560,7 @@ def _fit_from_front(
     yaw = float(np.arctan2(horizontal[1], horizontal[0]))
     size = np.array([depth, face_width, face_height])
     box = Box(box_id, size, [centre[0], centre[1], low + face_height / 2], _yaw_quaternion(yaw))
-    partial = bool(face_width - width > PARTIAL_EDGE or face_height - (high - low) > PARTIAL_EDGE)
+    partial = bool(face_width - width > PARTIAL_EDGE or face_height - (high - low) > PARTIAL_EDGE or len(depths) > 1)
     return FittedBox(box, "front", residual, 1.0, float(size_error), len(points), partial)
 
 

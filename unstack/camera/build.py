@@ -65,7 +65,7 @@ def _side_of_tops(box_points: Sequence[np.ndarray]) -> tuple[int, int]:
         if counts[fullest] < max(TOP_SLAB_SHARE * len(points), SLAB_PROMINENCE * np.median(counts[counts > 0])):
             continue  # no level face: a front (whole, or a strip of it), or a box lying tilted
         slab = (fullest + bins.min() + 0.5) * TOP_SLAB_M
-        level = points[np.abs(heights - slab) <= TOP_SLAB_M / 2, :2]
+        level = points[bins - bins.min() == fullest, :2]  # the slab's own bin (a top on a bin edge)
         if np.linalg.svd(level - level.mean(axis=0), compute_uv=False)[-1] / np.sqrt(len(level)) < TOP_SPREAD_M:
             continue  # a strip, not a face: a slice through a face lying tilted
         below = int(np.sum(heights < slab - TOP_SLAB_M))

@@ -157,7 +157,12 @@ def fit_plane(
 
 
 def plane_within_noise(
-    points: np.ndarray, normal: np.ndarray, offset: float, inliers: np.ndarray
+    points: np.ndarray,
+    normal: np.ndarray,
+    offset: float,
+    inliers: np.ndarray,
+    *,
+    max_turn_deg: float = NOISE_TURN_DEG,
 ) -> tuple[np.ndarray, float, np.ndarray]:
     """The plane refitted in a wider band when the depth noise fills the band it was fitted in
     (else the plane as given).
@@ -168,7 +173,8 @@ def plane_within_noise(
     band is doubled (up to :data:`NOISE_BAND`) and the plane refitted to the points in it. Depth
     noise of a centimetre or more puts most of a face outside a 1 cm band, and the band's points
     lean the fit towards the three that proposed it: a floor 4 m away, its depth 2.5 cm off,
-    tilts gravity by degrees.
+    tilts gravity by degrees. A doubling that turns the plane ``max_turn_deg`` or more stops the
+    widening (the wider band holds another surface).
 
     Examples
     --------
@@ -186,7 +192,7 @@ def plane_within_noise(
         centre = points[wide].mean(axis=0)
         refined = np.linalg.svd(points[wide] - centre, full_matrices=False)[2][-1]
         refined *= np.sign(refined @ normal) or 1.0
-        if refined @ normal < np.cos(np.radians(NOISE_TURN_DEG)):  # the wider band holds another surface
+        if refined @ normal < np.cos(np.radians(max_turn_deg)):  # the wider band holds another surface
             break
         normal, offset = refined, float(refined @ centre)
         inliers = np.abs(points @ normal - offset) < band
@@ -272,9 +278,9 @@ class GravityFrame:
     plane_heights : tuple of (float, int)
         Each of those horizontal planes' height in the gravity frame (metres) and its points.
     noisy : bool
-        The depth's noise fills the planes' band (:data:`PLANE_THRESHOLD`): told by the first,
-        largest plane; planes are then searched by heights (:func:`plane_by_heights`) and
-        refitted in a band as wide as the noise (:func:`plane_within_noise`).
+        The depth's noise fills the lead plane's band (:data:`PLANE_THRESHOLD`; the plane with
+        the most points): it was searched by heights (:func:`plane_by_heights`) and refitted in a
+        band as wide as the noise (:func:`plane_within_noise`).
     """
 
     rotation: np.ndarray
@@ -331,28 +337,32 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
     up_guess = np.array([0.0, 0.0, 1.0])
     remaining = points
     found: list[tuple[np.ndarray, float, int]] = []
-    noisy: bool | None = None  # the depth's noise, told by the first (largest) plane: the sensor's, not a plane's
-    noisy_up: np.ndarray | None = None
+    noisy_planes: list[bool] = []
+    first_up: np.ndarray | None = None  # the first plane's normal: a later plane searched by heights keeps to it
     for _ in range(MAX_PLANES):
         if len(remaining) < max(3, MIN_PLANE_SHARE * len(points)):
             break
         normal, offset, inliers = fit_plane(remaining, rng=rng, near_normal=up_guess)
-        if noisy is None and inliers.sum() >= 3:
-            noisy = _fills_band(remaining, normal, offset)
-        # a later plane of exact depth can fill its band too -- a few points of a top among the sides
-        # crossing it -- and must not be searched by heights or widened: that turned gravity 25 degrees
-        if noisy and inliers.sum() >= 3 and _fills_band(remaining, normal, offset):  # search by heights instead
-            if noisy_up is None:  # the first: over the whole cone; the next ones parallel to it
+        # depth noise grows with distance: each plane tells whether noise fills its band. Only the
+        # first searches the whole cone by heights; a later one -- in exact depth a few tops among
+        # the sides crossing them fill a band too -- keeps within PARALLEL_DEG of the first, and is
+        # widened no further from it (a later plane searched over the cone turned gravity 25 degrees)
+        noisy = bool(inliers.sum() >= 3 and _fills_band(remaining, normal, offset))
+        if noisy:
+            if first_up is None:
                 normal, offset = plane_by_heights(remaining, up_guess, rng=rng)
-                noisy_up = normal
             else:
-                normal, offset = plane_by_heights(remaining, noisy_up, tolerance_deg=PARALLEL_DEG, rng=rng)
+                normal, offset = plane_by_heights(remaining, first_up, tolerance_deg=PARALLEL_DEG, rng=rng)
             inliers = np.abs(remaining @ normal - offset) < PLANE_THRESHOLD
-        if noisy and inliers.sum() >= 3:
-            normal, offset, inliers = plane_within_noise(remaining, normal, offset, inliers)
+        if inliers.sum() >= 3:
+            turn = NOISE_TURN_DEG if first_up is None else PARALLEL_DEG
+            normal, offset, inliers = plane_within_noise(remaining, normal, offset, inliers, max_turn_deg=turn)
         if inliers.sum() < MIN_PLANE_SHARE * len(points):
             break
         found.append((normal, offset, int(inliers.sum())))
+        noisy_planes.append(noisy)
+        if first_up is None:
+            first_up = normal
         remaining = remaining[~inliers]
     if not found:
         raise UnstackError(
@@ -362,6 +372,7 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
     # the largest plane (a floor, a deck, a layer of tops) leads; planes parallel to it within
     # PARALLEL_DEG join it, weighted by their points; a box resting tilted does not
     lead = max(found, key=lambda plane: plane[2])[0]
+    noisy = noisy_planes[max(range(len(found)), key=lambda k: found[k][2])]  # the lead plane's
     parallel = [plane for plane in found if plane[0] @ lead >= np.cos(np.radians(PARALLEL_DEG))]
     up = np.sum([normal * count for normal, _, count in parallel], axis=0)
     up /= np.linalg.norm(up)
