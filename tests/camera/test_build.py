@@ -488,3 +488,33 @@ def test_a_top_whose_height_lies_on_a_slab_edge_is_read_as_a_top() -> None:
     fitted = {item.box.id: item.box for item in built.fitted}
     assert fitted["T1"].position[2] == pytest.approx(0.6, abs=0.005)
     assert sorted(fitted["T1"].size) == pytest.approx([0.3, 0.3, 0.4])
+
+
+def test_masks_of_whole_numbers_fit_as_boolean_ones(three_cartons) -> None:
+    depth, masks, pose = render_tops(three_cartons)
+    as_bool = scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES).report()
+    as_bytes = scene_from_depth(
+        depth, INTRINSICS, pose, [mask.astype(np.uint8) * 255 for mask in masks], known_sizes=SIZES
+    )
+    assert as_bytes.report() == as_bool
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ("inf", r"the depth image holds 1 infinite readings; expected metres, with 0 or NaN"),
+        ("mask-shape", r"mask b00 is \(10, 10\) pixels, the depth image \(320, 240\)"),
+        ("mask-text", r"mask b00: expected numbers or booleans, got <U1"),
+    ],
+)
+def test_a_library_caller_s_bad_depth_or_mask_is_named(three_cartons, change: str, message: str) -> None:
+    depth, masks, pose = render_tops(three_cartons)
+    if change == "inf":
+        depth = depth.copy()
+        depth[0, 0] = np.inf
+    elif change == "mask-shape":
+        masks = [np.ones((10, 10), dtype=bool), *masks[1:]]
+    else:
+        masks = [np.full(depth.shape, "x"), *masks[1:]]
+    with pytest.raises(UnstackError, match=message):
+        scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES)

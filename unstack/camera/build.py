@@ -339,6 +339,17 @@ def _without_specks(mask: np.ndarray, name: str) -> np.ndarray:
     return kept
 
 
+def _mask_array(mask: np.ndarray, name: str, shape: tuple[int, ...]) -> np.ndarray:
+    """A mask as booleans (non-zero where the box is: 0/1, 0/255 or bool), of the depth image's shape."""
+    array = np.asarray(mask)
+    if array.shape != shape:
+        raise UnstackError(f"mask {name} is {array.shape[::-1]} pixels, the depth image {shape[::-1]}")
+    if not (np.issubdtype(array.dtype, np.number) or array.dtype == bool):
+        raise UnstackError(f"mask {name}: expected numbers or booleans, got {array.dtype}")
+    selected: np.ndarray = np.nan_to_num(array) != 0
+    return selected
+
+
 def scene_from_depth(
     depth_m: np.ndarray,
     intrinsics: Intrinsics,
@@ -377,6 +388,13 @@ def scene_from_depth(
         raise UnstackError(f"expected {len(masks)} distinct box ids, got {names}")
     if not masks:
         raise UnstackError("at least one box mask is needed")
+    depth_m = np.asarray(depth_m, dtype=np.float64)
+    if np.isinf(depth_m).any():
+        raise UnstackError(
+            f"the depth image holds {int(np.isinf(depth_m).sum()):,} infinite readings; expected metres, "
+            "with 0 or NaN where there is no reading"
+        )
+    masks = [_mask_array(mask, name, depth_m.shape) for mask, name in zip(masks, names, strict=True)]
     pose = np.asarray(camera_to_world, dtype=np.float64)
     cloud = depth_points(depth_m, intrinsics, pose)
     if len(cloud) < 100:
