@@ -518,3 +518,43 @@ def test_a_library_caller_s_bad_depth_or_mask_is_named(three_cartons, change: st
         masks = [np.full(depth.shape, "x"), *masks[1:]]
     with pytest.raises(UnstackError, match=message):
         scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES)
+
+
+@pytest.mark.parametrize("sizes", [[(0.4, 0.3, 0.3), (0.4, 0.3, 0.6)], [(0.4, 0.3, 0.6), (0.4, 0.3, 0.3)]])
+def test_a_tall_box_beside_a_short_one_is_as_tall_as_its_front_shows(sizes: list[tuple[float, ...]]) -> None:
+    # the tall box's 0.3 m size would land on the short box's top 0.3 m away as well as its 0.6 m
+    # size on the floor; its front, seen 0.6 m down from its top, tells (fuzz round 16: 15 cm off)
+    from tests.camera.conftest import looking_in, render_boxes
+    from unstack.scene import Box
+
+    boxes = [Box("tall", [0.4, 0.3, 0.6], [2.0, 0.3, 0.3]), Box("short", [0.4, 0.3, 0.3], [2.0, -0.4, 0.15])]
+    pose = looking_in(height=2.0, pitch_deg=40.0)
+    depth, masks = render_boxes(boxes, pose)
+    built = scene_from_depth(depth, INTRINSICS, pose, masks, ids=["tall", "short"], known_sizes=sizes, door=[-1, 0, 0])
+    fitted = {item.box.id: item.box for item in built.fitted}
+    for box in boxes:
+        assert np.linalg.norm(fitted[box.id].position - box.position) < 0.01, box.id
+
+
+def test_boxes_on_a_pallet_deck_land_on_the_deck() -> None:
+    # the deck (no mask) is a level plane of the gravity frame: a 0.3 m carton on it and a 0.45 m one
+    # on the floor behind it would both land (fuzz round 16: the 0.45 m one, 7.5 cm off)
+    from tests.camera.conftest import looking_in, render_boxes
+    from unstack.scene import Box
+
+    deck = Box("deck", [1.2, 1.0, 0.15], [2.0, 0.0, 0.075])
+    boxes = [Box("a", [0.4, 0.3, 0.3], [1.8, 0.25, 0.3]), Box("b", [0.3, 0.4, 0.3], [2.2, -0.2, 0.3])]
+    pose = looking_in(height=2.0, pitch_deg=40.0)
+    depth, masks = render_boxes([deck, *boxes], pose)
+    built = scene_from_depth(
+        depth,
+        INTRINSICS,
+        pose,
+        masks[1:],
+        ids=["a", "b"],
+        known_sizes=[(0.4, 0.3, 0.3), (0.4, 0.3, 0.45)],
+        door=[-1, 0, 0],
+    )
+    fitted = {item.box.id: item.box for item in built.fitted}
+    for box in boxes:
+        assert fitted[box.id].position[2] == pytest.approx(0.3, abs=0.005), box.id

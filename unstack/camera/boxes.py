@@ -188,13 +188,14 @@ def _match_size(
     top: float,
     known_sizes: Sequence[Sequence[float]],
     surfaces: Sequence[float],
+    seen_height: float = 0.0,
 ) -> tuple[np.ndarray, float, bool]:
-    """The known size nearest the measured top edges; ties by where the bottom lands (then by
-    the edges, then by the size: not by the order of ``known_sizes``).
+    """The known size nearest the measured top edges; ties to a size at least as tall as the
+    front face shows (``seen_height``, less :data:`PARTIAL_EDGE`), then by where the bottom lands
+    (to the centimetre), then by the edges, then by the size: not by the order of ``known_sizes``.
 
     A face seen in part is smaller than the box, never larger: an edge measured longer than a
-    size's costs :data:`OVERSIZE_WEIGHT` times as much as one measured shorter, and a size lower
-    than the height the front face shows is passed over. Returns the size as (along the measured
+    size's costs :data:`OVERSIZE_WEIGHT` times as much as one measured shorter. Returns the size as (along the measured
     long edge, across it, height), the error, and whether the size's long edge lies across the
     measured long edge (a face seen in part can show a box's short edge as its longer extent).
     """
@@ -217,8 +218,14 @@ def _match_size(
     options = [option for option in options if option[1] < 10.0] or options
     best_error = min(option[0] for option in options)
     tied = [option for option in options if option[0] <= best_error + SIZE_TIE]
-    # where the bottom lands, then the nearer top edges, then the size itself: never the order given
-    chosen = min(tied, key=lambda option: (option[1], option[0], tuple(option[2]), option[3]))
+    # as tall as the front shows, where the bottom lands, the nearer top edges, the size itself:
+    # never the order given
+    chosen = min(
+        tied,
+        key=lambda option: (
+            bool(option[2][2] < seen_height - PARTIAL_EDGE), round(option[1], 2), option[0], tuple(option[2]), option[3]
+        ),
+    )
     return np.asarray(chosen[2], dtype=np.float64), float(chosen[0]), chosen[3]
 
 
@@ -454,16 +461,16 @@ def _fit_from_top(
     seen_height = 0.0
     if front is not None:
         front_heights = points[~inliers][front[2], 2]
+        if np.max(front_heights) >= top - 0.03:  # a face up to the top: the box is at least this tall
+            seen_height = top - float(np.percentile(front_heights, 5))
         if np.percentile(front_heights, 95) < top - 0.03:
             front = None  # points below the top that do not reach it: another surface seen past the edge
-        else:
-            seen_height = top - float(np.percentile(front_heights, 5))
     below = [surface for surface in surfaces if surface < top - 0.02]
     turned = False
     if known_sizes:
         # the front face's height is not a bound: below a box's side the sides of the boxes under it
         # continue in the same plane; where the bottom lands decides among near sizes instead
-        size, size_error, turned = _match_size(extents, top, known_sizes, below or [0.0])
+        size, size_error, turned = _match_size(extents, top, known_sizes, below or [0.0], seen_height)
     else:
         support = max(below, default=0.0)
         size, size_error = np.array([*extents, max(top - support, seen_height, 0.02)]), 0.0
@@ -670,6 +677,7 @@ def boxes_from_masks(
     known_sizes: Sequence[Sequence[float]] | None = None,
     seed: int = 0,
     viewpoint: Sequence[float] | None = None,
+    levels: Sequence[float] = (),
 ) -> tuple[list[FittedBox], dict[str, str]]:
     """Fit a box to each mask's points (gravity frame); bottoms land on the floor or other tops.
 
@@ -677,7 +685,9 @@ def boxes_from_masks(
     RANSAC draws from its own generator, seeded by ``seed`` and the mask's points
     (:func:`content_rng`): a box's fit depends on its own points only, not on the masks given
     before it or their order. ``viewpoint``: the camera's place (gravity frame), see
-    :func:`fit_box`.
+    :func:`fit_box`. A bottom lands on the floor (z = 0), on another mask's top, or on one of
+    ``levels``: the heights of level surfaces no mask holds (a pallet's deck, a shelf), as
+    :attr:`~unstack.camera.planes.GravityFrame.plane_heights` gives them.
     """
     if len(mask_points) != len(ids):
         raise UnstackError(f"{len(mask_points)} masks but {len(ids)} ids")
@@ -685,7 +695,7 @@ def boxes_from_masks(
     fitted: list[FittedBox] = []
     unfitted: dict[str, str] = {}
     for k, (box_id, points) in enumerate(zip(ids, mask_points, strict=True)):
-        surfaces = [0.0, *(top for j, top in enumerate(tops) if j != k)]
+        surfaces = [0.0, *(top for j, top in enumerate(tops) if j != k), *levels]
         try:
             rng = content_rng(seed, points)
             fitted.append(

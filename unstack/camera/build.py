@@ -420,8 +420,9 @@ def scene_from_depth(
     _check_upright(frame, pose, [_core_points(depth_m, intrinsics, pose, frame, masks[k]) for k in kept])
     viewpoint = frame.apply(pose[None, :3, 3])[0]
     fitted, unfitted = boxes_from_masks(
-        mask_points, [names[k] for k in kept], known_sizes=known_sizes, seed=seed, viewpoint=viewpoint
-    )
+        mask_points, [names[k] for k in kept], known_sizes=known_sizes, seed=seed, viewpoint=viewpoint,
+        levels=[height for height, _ in frame.plane_heights],
+    )  # fmt: skip
     by_id = {item.box.id: item.box for item in fitted}
     for k in kept:  # a mask of pieces apart: two boxes under one label, fitted as one or not at all
         pieces = _pieces(masks[k])
