@@ -223,7 +223,11 @@ def _match_size(
     chosen = min(
         tied,
         key=lambda option: (
-            bool(option[2][2] < seen_height - PARTIAL_EDGE), round(option[1], 2), option[0], tuple(option[2]), option[3]
+            bool(option[2][2] < seen_height - PARTIAL_EDGE),
+            round(option[1], 2),
+            option[0],
+            tuple(option[2]),
+            option[3],
         ),
     )
     return np.asarray(chosen[2], dtype=np.float64), float(chosen[0]), chosen[3]

@@ -157,12 +157,7 @@ def fit_plane(
 
 
 def plane_within_noise(
-    points: np.ndarray,
-    normal: np.ndarray,
-    offset: float,
-    inliers: np.ndarray,
-    *,
-    max_turn_deg: float = NOISE_TURN_DEG,
+    points: np.ndarray, normal: np.ndarray, offset: float, inliers: np.ndarray
 ) -> tuple[np.ndarray, float, np.ndarray]:
     """The plane refitted in a wider band when the depth noise fills the band it was fitted in
     (else the plane as given).
@@ -173,8 +168,7 @@ def plane_within_noise(
     band is doubled (up to :data:`NOISE_BAND`) and the plane refitted to the points in it. Depth
     noise of a centimetre or more puts most of a face outside a 1 cm band, and the band's points
     lean the fit towards the three that proposed it: a floor 4 m away, its depth 2.5 cm off,
-    tilts gravity by degrees. A doubling that turns the plane ``max_turn_deg`` or more stops the
-    widening (the wider band holds another surface).
+    tilts gravity by degrees.
 
     Examples
     --------
@@ -192,11 +186,35 @@ def plane_within_noise(
         centre = points[wide].mean(axis=0)
         refined = np.linalg.svd(points[wide] - centre, full_matrices=False)[2][-1]
         refined *= np.sign(refined @ normal) or 1.0
-        if refined @ normal < np.cos(np.radians(max_turn_deg)):  # the wider band holds another surface
+        if refined @ normal < np.cos(np.radians(NOISE_TURN_DEG)):  # the wider band holds another surface
             break
         normal, offset = refined, float(refined @ centre)
         inliers = np.abs(points @ normal - offset) < band
     return normal, offset, inliers
+
+
+def _level_within_noise(points: np.ndarray, normal: np.ndarray) -> tuple[float, np.ndarray]:
+    """The height along ``normal`` of the fullest slab of the points (:func:`plane_by_heights`'s
+    bins, in that one direction), refitted in a band doubled while the noise fills it (up to
+    :data:`NOISE_BAND`), and the points within that band."""
+    heights = points @ normal
+    bin_m = 4 * PLANE_THRESHOLD
+    best = (0.0, -1)
+    for phase in (0.0, 0.5):
+        bins = np.floor(heights / bin_m + phase).astype(np.int64)
+        counts = np.bincount(bins - bins.min())
+        k = int(np.argmax(counts))
+        if counts[k] > best[1]:
+            best = (float((k + bins.min() + 0.5 - phase) * bin_m), int(counts[k]))
+    offset, band = best[0], PLANE_THRESHOLD
+    inside = np.abs(heights - offset) < band
+    if inside.any():
+        offset = float(np.mean(heights[inside]))
+    while _fills_band(points, normal, offset, band) and 2.0 * band <= NOISE_BAND:
+        band *= 2.0
+        inside = np.abs(heights - offset) < band
+        offset = float(np.mean(heights[inside]))
+    return offset, np.abs(heights - offset) < band
 
 
 def _fills_band(points: np.ndarray, normal: np.ndarray, offset: float, band: float = PLANE_THRESHOLD) -> bool:
@@ -338,25 +356,29 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
     remaining = points
     found: list[tuple[np.ndarray, float, int]] = []
     noisy_planes: list[bool] = []
-    first_up: np.ndarray | None = None  # the first plane's normal: a later plane searched by heights keeps to it
+    first_up: np.ndarray | None = None  # the first plane's normal
     for _ in range(MAX_PLANES):
         if len(remaining) < max(3, MIN_PLANE_SHARE * len(points)):
             break
         normal, offset, inliers = fit_plane(remaining, rng=rng, near_normal=up_guess)
-        # depth noise grows with distance: each plane tells whether noise fills its band. Only the
-        # first searches the whole cone by heights; a later one -- in exact depth a few tops among
-        # the sides crossing them fill a band too -- keeps within PARALLEL_DEG of the first, and is
-        # widened no further from it (a later plane searched over the cone turned gravity 25 degrees)
+        # depth noise grows with distance: each plane tells whether noise fills its band
         noisy = bool(inliers.sum() >= 3 and _fills_band(remaining, normal, offset))
-        if noisy:
-            if first_up is None:
-                normal, offset = plane_by_heights(remaining, up_guess, rng=rng)
-            else:
-                normal, offset = plane_by_heights(remaining, first_up, tolerance_deg=PARALLEL_DEG, rng=rng)
-            inliers = np.abs(remaining @ normal - offset) < PLANE_THRESHOLD
-        if inliers.sum() >= 3:
-            turn = NOISE_TURN_DEG if first_up is None else PARALLEL_DEG
-            normal, offset, inliers = plane_within_noise(remaining, normal, offset, inliers, max_turn_deg=turn)
+        if noisy and first_up is not None and not noisy_planes[0]:
+            # the first plane exact: this one -- a far floor, noisier with distance, or in exact depth
+            # a few tops among the sides crossing them -- keeps the first's direction and gives only
+            # its height, in a band as wide as its noise (searched over the cone, such a plane turned
+            # gravity 25 degrees; cut in 1 cm slabs, a far floor lifted every box 1-6 cm)
+            normal = first_up
+            offset, inliers = _level_within_noise(remaining, first_up)
+        else:
+            if noisy:  # the first plane over the whole cone, the next ones parallel to it
+                if first_up is None:
+                    normal, offset = plane_by_heights(remaining, up_guess, rng=rng)
+                else:
+                    normal, offset = plane_by_heights(remaining, first_up, tolerance_deg=PARALLEL_DEG, rng=rng)
+                inliers = np.abs(remaining @ normal - offset) < PLANE_THRESHOLD
+            if inliers.sum() >= 3:
+                normal, offset, inliers = plane_within_noise(remaining, normal, offset, inliers)
         if inliers.sum() < MIN_PLANE_SHARE * len(points):
             break
         found.append((normal, offset, int(inliers.sum())))
@@ -386,7 +408,19 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
     rotation = _rotation_onto_z(up, heading)
     heights = points @ up
     floor_heights = [offset / (normal @ up) for normal, offset, _ in found]
-    lowest = int(np.argmin(floor_heights))
+    # the lowest plane, passing over the tail of a noisy one: a plane with a quarter of its points or
+    # fewer, less than NOISE_BAND under it (a far floor's noise reaches past its widest band)
+    lowest = min(
+        (
+            k
+            for k in range(len(found))
+            if not any(
+                0.0 < floor_heights[j] - floor_heights[k] < NOISE_BAND and found[j][2] >= 4 * found[k][2]
+                for j in range(len(found))
+            )
+        ),
+        key=lambda k: floor_heights[k],
+    )
     floor_level = float(floor_heights[lowest])
     floor_inliers = found[lowest][2]
     if floor_level > np.percentile(heights, 5) + 0.05:  # the lowest plane is not under the cloud: no floor seen
