@@ -195,9 +195,10 @@ def _match_size(
     (to the centimetre), then by the edges, then by the size: not by the order of ``known_sizes``.
 
     A face seen in part is smaller than the box, never larger: an edge measured longer than a
-    size's costs :data:`OVERSIZE_WEIGHT` times as much as one measured shorter. Returns the size as (along the measured
-    long edge, across it, height), the error, and whether the size's long edge lies across the
-    measured long edge (a face seen in part can show a box's short edge as its longer extent).
+    size's costs :data:`OVERSIZE_WEIGHT` times as much as one measured shorter. Returns the size
+    as (along the measured long edge, across it, height), the error, and whether the size's long
+    edge lies across the measured long edge (a face seen in part can show a box's short edge as
+    its longer extent).
     """
     options: list[tuple[float, float, np.ndarray, bool]] = []
     for size in known_sizes:
@@ -472,8 +473,8 @@ def _fit_from_top(
     below = [surface for surface in surfaces if surface < top - 0.02]
     turned = False
     if known_sizes:
-        # the front face's height is not a bound: below a box's side the sides of the boxes under it
-        # continue in the same plane; where the bottom lands decides among near sizes instead
+        # the front face's height only breaks ties among near sizes: a mask that bleeds onto the box
+        # below continues its side in the same plane, so it is no hard bound
         size, size_error, turned = _match_size(extents, top, known_sizes, below or [0.0], seen_height)
     else:
         support = max(below, default=0.0)

@@ -296,9 +296,9 @@ class GravityFrame:
     plane_heights : tuple of (float, int)
         Each of those horizontal planes' height in the gravity frame (metres) and its points.
     noisy : bool
-        The depth's noise fills the lead plane's band (:data:`PLANE_THRESHOLD`; the plane with
-        the most points): it was searched by heights (:func:`plane_by_heights`) and refitted in a
-        band as wide as the noise (:func:`plane_within_noise`).
+        The depth's noise filled the lead plane's band (:data:`PLANE_THRESHOLD`; the plane with
+        the most points): it was found by binning the points' heights and refitted in a band as
+        wide as the noise (:func:`plane_by_heights`, :func:`plane_within_noise`).
     """
 
     rotation: np.ndarray
