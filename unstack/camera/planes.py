@@ -198,15 +198,8 @@ def _level_within_noise(points: np.ndarray, normal: np.ndarray) -> tuple[float, 
     bins, in that one direction), refitted in a band doubled while the noise fills it (up to
     :data:`NOISE_BAND`), and the points within that band."""
     heights = points @ normal
-    bin_m = 4 * PLANE_THRESHOLD
-    best = (0.0, -1)
-    for phase in (0.0, 0.5):
-        bins = np.floor(heights / bin_m + phase).astype(np.int64)
-        counts = np.bincount(bins - bins.min())
-        k = int(np.argmax(counts))
-        if counts[k] > best[1]:
-            best = (float((k + bins.min() + 0.5 - phase) * bin_m), int(counts[k]))
-    offset, band = best[0], PLANE_THRESHOLD
+    offset, _ = _fullest_slab(heights, 4 * PLANE_THRESHOLD)
+    band = PLANE_THRESHOLD
     inside = np.abs(heights - offset) < band
     if inside.any():
         offset = float(np.mean(heights[inside]))
@@ -267,15 +260,24 @@ def plane_by_heights(
     best = (reference, 0.0, -1)
     for centre, radius, step in ((reference, tolerance_deg, 2.5), (None, 2.5, 0.5), (None, 0.5, 0.1)):
         for direction in _directions_around(best[0] if centre is None else centre, radius, step):
-            heights = points @ direction
-            for phase in (0.0, 0.5):
-                bins = np.floor(heights / bin_m + phase).astype(np.int64)
-                lowest = int(bins.min())
-                counts = np.bincount(bins - lowest)
-                k = int(np.argmax(counts))
-                if counts[k] > best[2]:
-                    best = (direction, float((k + lowest + 0.5 - phase) * bin_m), int(counts[k]))
+            offset, count = _fullest_slab(points @ direction, bin_m)
+            if count > best[2]:
+                best = (direction, offset, count)
     return best[0], best[1]
+
+
+def _fullest_slab(heights: np.ndarray, bin_m: float) -> tuple[float, int]:
+    """The centre of the bin of ``bin_m`` holding the most ``heights`` (two grids, half a bin
+    apart; the first on a tie), and how many it holds."""
+    best = (0.0, -1)
+    for phase in (0.0, 0.5):
+        bins = np.floor(heights / bin_m + phase).astype(np.int64)
+        lowest = int(bins.min())
+        counts = np.bincount(bins - lowest)
+        k = int(np.argmax(counts))
+        if counts[k] > best[1]:
+            best = (float((k + lowest + 0.5 - phase) * bin_m), int(counts[k]))
+    return best
 
 
 @dataclass(frozen=True)
