@@ -58,6 +58,9 @@ NOISE_FILL = 0.35
 #: a wider band that takes in another surface turns the fit towards it.
 NOISE_BAND = 0.05
 NOISE_TURN_DEG = 15.0
+#: The lowest plane is the floor unless more than this share of the points lies more than
+#: :data:`NOISE_BAND` under it (then the floor is the lowest readings: :func:`_lowest_level`).
+FLOOR_BELOW_SHARE = 0.01
 #: Points used for the plane search (a random subset of larger clouds; the fit is refined on all).
 PLANE_SAMPLE = 60_000
 
@@ -210,6 +213,14 @@ def _level_within_noise(points: np.ndarray, normal: np.ndarray) -> tuple[float, 
     return offset, np.abs(heights - offset) < band
 
 
+def _lowest_level(heights: np.ndarray) -> float:
+    """The floor's height where no plane holds it: the median of the heights within
+    2 :data:`PLANE_THRESHOLD` of their 0.5th percentile (a floor seen as a sliver, under 1 % of
+    the points, or the lowest edges seen)."""
+    lowest = float(np.percentile(heights, 0.5))
+    return float(np.median(heights[np.abs(heights - lowest) <= 2 * PLANE_THRESHOLD]))
+
+
 def _fills_band(points: np.ndarray, normal: np.ndarray, offset: float, band: float = PLANE_THRESHOLD) -> bool:
     """Whether the points within ``band`` of the plane lie a mean :data:`NOISE_FILL` of it or more
     from it: depth noise as wide as the band, or wider."""
@@ -258,8 +269,10 @@ def plane_by_heights(
         points = points[rng.choice(len(points), PLANE_SAMPLE // 2, replace=False)]
     reference = np.asarray(near_normal, dtype=np.float64) / np.linalg.norm(near_normal)
     best = (reference, 0.0, -1)
+    inside_cone = np.cos(np.radians(tolerance_deg)) - 1e-12
     for centre, radius, step in ((reference, tolerance_deg, 2.5), (None, 2.5, 0.5), (None, 0.5, 0.1)):
-        for direction in _directions_around(best[0] if centre is None else centre, radius, step):
+        directions = _directions_around(best[0] if centre is None else centre, radius, step)
+        for direction in directions[directions @ reference >= inside_cone]:  # the finer grids stay in the cone
             offset, count = _fullest_slab(points @ direction, bin_m)
             if count > best[2]:
                 best = (direction, offset, count)
@@ -365,19 +378,17 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
         normal, offset, inliers = fit_plane(remaining, rng=rng, near_normal=up_guess)
         # depth noise grows with distance: each plane tells whether noise fills its band
         noisy = bool(inliers.sum() >= 3 and _fills_band(remaining, normal, offset))
-        if noisy and first_up is not None and not noisy_planes[0]:
-            # the first plane exact: this one -- a far floor, noisier with distance, or in exact depth
-            # a few tops among the sides crossing them -- keeps the first's direction and gives only
-            # its height, in a band as wide as its noise (searched over the cone, such a plane turned
-            # gravity 25 degrees; cut in 1 cm slabs, a far floor lifted every box 1-6 cm)
+        if noisy and first_up is not None:
+            # a noisy plane after the first -- a far floor, noisier with distance, tops among noisy
+            # sides, or in exact depth a few tops among the sides crossing them -- keeps the first's
+            # direction and gives only its height, in a band as wide as its noise (searched over the
+            # cone, such a plane turned gravity 25 degrees; searched within 2 degrees of a noisy
+            # ceiling, slabs cutting through a dropped pile's faces turned it 2-3 degrees)
             normal = first_up
             offset, inliers = _level_within_noise(remaining, first_up)
         else:
-            if noisy:  # the first plane over the whole cone, the next ones parallel to it
-                if first_up is None:
-                    normal, offset = plane_by_heights(remaining, up_guess, rng=rng)
-                else:
-                    normal, offset = plane_by_heights(remaining, first_up, tolerance_deg=PARALLEL_DEG, rng=rng)
+            if noisy:  # the first plane, over the whole cone, by its heights
+                normal, offset = plane_by_heights(remaining, up_guess, rng=rng)
                 inliers = np.abs(remaining @ normal - offset) < PLANE_THRESHOLD
             if inliers.sum() >= 3:
                 normal, offset, inliers = plane_within_noise(remaining, normal, offset, inliers)
@@ -425,8 +436,8 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
     )
     floor_level = float(floor_heights[lowest])
     floor_inliers = found[lowest][2]
-    if floor_level > np.percentile(heights, 5) + 0.05:  # the lowest plane is not under the cloud: no floor seen
-        floor_level, floor_inliers = float(np.percentile(heights, 1)), 0
+    if np.mean(heights < floor_level - NOISE_BAND) > FLOOR_BELOW_SHARE:  # not under the cloud: no floor plane
+        floor_level, floor_inliers = _lowest_level(heights), 0
     tilt = float(np.degrees(np.arccos(np.clip(up @ up_guess, -1.0, 1.0))))
     plane_heights = tuple(
         (float(height - floor_level), count) for height, (*_, count) in zip(floor_heights, found, strict=True)
