@@ -63,6 +63,32 @@ def test_a_mask_holding_several_boxes_is_left_out_and_theirs_are_kept(three_cart
     }
 
 
+@pytest.mark.parametrize("wrong", ["floor", "whole image", "floor and a carton"])
+@pytest.mark.parametrize("view", ["above", "door"])
+def test_a_mask_no_box_fits_is_left_out_saying_so(three_cartons, wrong: str, view: str) -> None:
+    # alone, a mask of the floor or of the whole image was fitted as a 0.6 m carton holding 0-1 % of its points
+    from tests.camera.conftest import looking_in, render_boxes
+    from unstack.scene import Box
+
+    if view == "above":
+        depth, masks, pose = render_tops(three_cartons)
+    else:
+        pose = looking_in(height=1.6, pitch_deg=35.0)
+        depth, masks = render_boxes(
+            [
+                Box("a", [0.4, 0.3, 0.3], [2.0, 0.3, 0.15], [0, 0, 0, 1]),
+                Box("b", [0.6, 0.4, 0.4], [2.3, -0.4, 0.2], [0, 0, 0, 1]),
+            ],
+            pose,
+        )
+    floor = ~np.any(masks, axis=0)
+    bad = {"floor": floor, "whole image": np.ones_like(floor), "floor and a carton": floor | masks[0]}[wrong]
+    built = scene_from_depth(depth, INTRINSICS, pose, [bad, masks[-1]], known_sizes=SIZES)
+    assert built.scene.detected == ("b01",)
+    assert built.unfitted["b00"].startswith("the box fitted to its mask holds")
+    assert built.unfitted["b00"].endswith("a detection of the floor, of several boxes or of the whole image?")
+
+
 @pytest.mark.parametrize("scale, doubted", [(1.0, False), (2.5, True), (0.4, True)])
 def test_known_sizes_far_from_every_measured_face_are_doubted(three_cartons, scale: float, doubted: bool) -> None:
     depth, masks, pose = render_tops(three_cartons)  # sizes off by a factor: depth units, or sizes not in metres

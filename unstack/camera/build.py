@@ -288,6 +288,46 @@ PIECES_GAP = 3
 PIECE_INSIDE_SHARE = 0.5
 
 
+#: A box fitted to a mask that holds (within 3 cm) less than this share of the mask's points is
+#: left out: the mask is not one box's (the floor, the whole image, several boxes). On simulated
+#: piles a fit holds 20 % of its mask's points at the least (exact depth), 30 % with flying pixels.
+MIN_HELD_SHARE = 0.1
+
+
+def _mask_cloud(
+    depth_m: np.ndarray, intrinsics: Intrinsics, pose: np.ndarray, frame: GravityFrame, mask: np.ndarray, seed: int
+) -> np.ndarray:
+    """A mask's points in the gravity frame: at most :data:`MAX_MASK_POINTS`, a subset drawn
+    from the mask's own pixels (the same wherever the mask stands among others)."""
+    points = frame.apply(depth_points(depth_m, intrinsics, pose, mask))
+    if len(points) > MAX_MASK_POINTS:
+        points = points[content_rng(seed, np.flatnonzero(mask)).choice(len(points), MAX_MASK_POINTS, replace=False)]
+    return points
+
+
+def _boxes_holding_their_points(
+    mask_points: dict[str, np.ndarray], **fitting: Any
+) -> tuple[list[FittedBox], dict[str, str]]:
+    """The boxes fitted to the masks' points (:func:`~unstack.camera.boxes.boxes_from_masks`
+    with ``fitting``) that hold :data:`MIN_HELD_SHARE` of their masks' points or more, and why
+    each other mask has none."""
+    fitted, unfitted = boxes_from_masks(list(mask_points.values()), list(mask_points), **fitting)
+    kept = []
+    for item in fitted:
+        points = mask_points[item.box.id]
+        held = float(np.mean(points_in_box(points, item.box, margin=0.03)))
+        if held < MIN_HELD_SHARE:
+            low, high = (round(float(height), 2) + 0.0 for height in np.percentile(points[:, 2], [5, 95]))
+            unfitted[item.box.id] = (
+                f"the box fitted to its mask holds {100 * held:.0f} % of the mask's points, which lie {low:.2f} "
+                f"to {high:.2f} m high over {np.ptp(points[:, 0]):.1f} x {np.ptp(points[:, 1]):.1f} m: a detection "
+                "of the floor, of several boxes or of the whole image?"
+            )
+        else:
+            kept.append(item)
+    return kept, unfitted
+
+
 def _window(mask: np.ndarray) -> tuple[slice, slice] | None:
     """The rows and columns of the rectangle around ``mask``'s pixels (None when it has none)."""
     rows, columns = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
@@ -410,19 +450,26 @@ def scene_from_depth(
     duplicates = duplicate_masks(masks)
     merged = merged_masks(masks)
     kept = [k for k in range(len(masks)) if k not in duplicates and k not in merged]
-    mask_points = []
-    for k in kept:
-        points = frame.apply(depth_points(depth_m, intrinsics, pose, masks[k]))
-        if len(points) > MAX_MASK_POINTS:  # a subset drawn from the mask's own pixels, whatever its place
-            subset = content_rng(seed, np.flatnonzero(masks[k])).choice(len(points), MAX_MASK_POINTS, replace=False)
-            points = points[subset]
-        mask_points.append(points)
+    mask_points = {names[k]: _mask_cloud(depth_m, intrinsics, pose, frame, masks[k], seed) for k in kept}
     _check_upright(frame, pose, [_core_points(depth_m, intrinsics, pose, frame, masks[k]) for k in kept])
-    viewpoint = frame.apply(pose[None, :3, 3])[0]
-    fitted, unfitted = boxes_from_masks(
-        mask_points, [names[k] for k in kept], known_sizes=known_sizes, seed=seed, viewpoint=viewpoint,
-        levels=[height for height, _ in frame.plane_heights],
-    )  # fmt: skip
+    fitting = {
+        "known_sizes": known_sizes,
+        "seed": seed,
+        "viewpoint": frame.apply(pose[None, :3, 3])[0],
+        "levels": [height for height, _ in frame.plane_heights],
+    }
+    fitted, unfitted = _boxes_holding_their_points(mask_points, **fitting)
+    originals = {k: j for k, j in duplicates.items() if names[j] in unfitted}
+    if originals:  # a larger mask no box holds: its duplicates are boxes of their own, fitted among the rest
+        for k in originals:
+            del duplicates[k]
+            kept.append(k)
+            mask_points[names[k]] = _mask_cloud(depth_m, intrinsics, pose, frame, masks[k], seed)
+        refused = dict(unfitted)
+        fitted, unfitted = _boxes_holding_their_points(
+            {name: points for name, points in mask_points.items() if name not in refused}, **fitting
+        )
+        unfitted.update(refused)
     by_id = {item.box.id: item.box for item in fitted}
     for k in kept:  # a mask of pieces apart: two boxes under one label, fitted as one or not at all
         pieces = _pieces(masks[k])
