@@ -66,6 +66,22 @@ def test_a_size_that_would_sink_the_box_into_the_floor_is_passed_over() -> None:
     assert fitted.box.position[2] == pytest.approx(0.2)
 
 
+@pytest.mark.parametrize("face", [(0.4, 0.3), (0.3, 0.4), (0.3, 0.5), (0.5, 0.3)])
+@pytest.mark.parametrize("sizes", [[(0.5, 0.4, 0.3)], [(0.3, 0.4, 0.5), (0.2, 0.2, 0.2)]])
+def test_a_box_seen_from_the_front_only_stands_the_way_up_its_front_shows(
+    face: tuple[float, float], sizes: list[tuple[float, ...]]
+) -> None:
+    # a front 0.3 wide and 0.4 tall was matched to a size's 0.4 x 0.3 face (sorted edges compared):
+    # fitted lying, 0.1 m lower than it stands
+    width, height = face
+    y, z = np.meshgrid(np.arange(-width / 2, width / 2 + 1e-4, 0.01), np.arange(1.2, 1.2 + height + 1e-4, 0.01))
+    front = np.column_stack([np.full(y.size, 2.0), y.ravel(), z.ravel()])
+    fitted = fit_box("a", front, known_sizes=sizes, surfaces=[0.0, 1.2], rng=np.random.default_rng(1))
+    assert fitted.face == "front"
+    assert fitted.box.size[1:] == pytest.approx([width, height])
+    assert fitted.box.position[2] == pytest.approx(1.2 + height / 2, abs=0.01)
+
+
 @pytest.mark.parametrize("sizes", [[(0.4, 0.3, 0.3), (0.3, 0.3, 0.2)], [(0.3, 0.3, 0.2), (0.4, 0.3, 0.3)]])
 def test_a_box_seen_from_the_front_only_takes_the_deeper_of_two_sizes_sharing_its_face(
     sizes: list[tuple[float, ...]],

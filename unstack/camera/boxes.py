@@ -554,11 +554,13 @@ def _fit_from_front(
     residual = float(np.sqrt(np.mean((face @ normal - offset) ** 2)))
     depths: set[float] = set()
     if known_sizes:
-        options = [
-            (float(abs(np.sort([a, b])[::-1] - np.sort([width, high - low])[::-1]).sum()), a, b, c)
-            for size in known_sizes
-            for a, b, c in _faces(size)
-        ]
+        seen = np.array([width, high - low])  # across and up: a face standing the other way up is another face
+        options = []
+        for size in known_sizes:
+            for a, b, c in _faces(size):
+                difference = seen - (a, b)
+                error = float(np.sum(np.where(difference > 0, OVERSIZE_WEIGHT * difference, -difference)))
+                options.append((error, a, b, c))
         best_error = min(option[0] for option in options)
         tied = [option for option in options if option[0] <= best_error + 1e-12]
         # sizes that share the seen face differ in the depth behind it, which nothing shows: the
