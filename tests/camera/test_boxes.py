@@ -66,6 +66,26 @@ def test_a_size_that_would_sink_the_box_into_the_floor_is_passed_over() -> None:
     assert fitted.box.position[2] == pytest.approx(0.2)
 
 
+@pytest.mark.parametrize("x", [-1.0, 0.0, 2.0])
+@pytest.mark.parametrize("yaw_deg", [0.0, 50.0, -50.0])
+def test_a_box_seen_from_the_front_only_lies_behind_its_front_as_the_camera_sees_it(x: float, yaw_deg: float) -> None:
+    # the side of the face the box lay on was told by the face's place against the frame's origin,
+    # not the camera: a front at x < 0, or turned from the door, had its box put in front of it
+    along = np.radians(yaw_deg)
+    outward = np.array([-np.cos(along), -np.sin(along), 0.0])  # the face looks this way, towards the camera
+    across = np.array([-outward[1], outward[0], 0.0])
+    u, z = np.meshgrid(np.arange(-0.2, 0.2001, 0.01), np.arange(0.0, 0.3001, 0.01))
+    face_centre = np.array([x, 0.5, 0.0])
+    front = face_centre + u.reshape(-1, 1) * across + z.reshape(-1, 1) * np.array([0.0, 0.0, 1.0])
+    viewpoint = face_centre + 3.0 * outward + np.array([0.0, 0.0, 1.2])
+    fitted = fit_box(
+        "a", front, known_sizes=[(0.4, 0.3, 0.3)], surfaces=[0.0], rng=np.random.default_rng(1), viewpoint=viewpoint
+    )
+    assert fitted.face == "front"
+    behind = (fitted.box.position - face_centre)[:2] @ outward[:2]
+    assert behind == pytest.approx(-0.15, abs=0.01)
+
+
 @pytest.mark.parametrize("face", [(0.4, 0.3), (0.3, 0.4), (0.3, 0.5), (0.5, 0.3)])
 @pytest.mark.parametrize("sizes", [[(0.5, 0.4, 0.3)], [(0.3, 0.4, 0.5), (0.2, 0.2, 0.2)]])
 def test_a_box_seen_from_the_front_only_stands_the_way_up_its_front_shows(

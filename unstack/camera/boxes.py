@@ -278,7 +278,7 @@ def fit_box(
         return tilted
     if top_seen:
         return _fit_from_top(box_id, points, normal, offset, inliers, known_sizes, surfaces, rng)
-    return _fit_from_front(box_id, points, known_sizes, rng)
+    return _fit_from_front(box_id, points, known_sizes, rng, viewpoint)
 
 
 def _without_surface_below(points: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -536,8 +536,11 @@ def _fit_from_front(
     points: np.ndarray,
     known_sizes: Sequence[Sequence[float]] | None,
     rng: np.random.Generator,
+    viewpoint: Sequence[float] | None = None,
 ) -> FittedBox:
-    """A box seen from the front only: its vertical face gives yaw, width and height."""
+    """A box seen from the front only: its vertical face gives yaw, width and height; the box
+    lies behind the face as seen from ``viewpoint`` (default: out through the door and up,
+    :data:`DEFAULT_VIEW`)."""
     front = _front_face(points, rng)
     if front is None:
         raise UnstackError(f"{box_id}: neither a top face nor a front face could be fitted to the mask's points")
@@ -546,7 +549,8 @@ def _fit_from_front(
     horizontal = np.array([normal[0], normal[1], 0.0])
     horizontal /= np.linalg.norm(horizontal)
     centre_face = face.mean(axis=0)
-    if horizontal @ centre_face > 0:  # the normal points away from the box's inside... towards the camera side
+    toward = np.asarray(viewpoint, dtype=np.float64) if viewpoint is not None else centre_face + DEFAULT_VIEW
+    if horizontal @ (toward - centre_face) < 0:  # the face looks towards the camera; the box lies behind it
         horizontal = -horizontal
     across = np.array([-horizontal[1], horizontal[0], 0.0])
     width = float(np.ptp(face @ across))
