@@ -560,8 +560,8 @@ def _fit_from_front(
     if known_sizes:
         seen = np.array([width, high - low])  # across and up: a face standing the other way up is another face
         options = []
-        for size in known_sizes:
-            for a, b, c in _faces(size):
+        for known in known_sizes:
+            for a, b, c in _faces(known):
                 difference = seen - (a, b)
                 error = float(np.sum(np.where(difference > 0, OVERSIZE_WEIGHT * difference, -difference)))
                 options.append((error, a, b, c))
