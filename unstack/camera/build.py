@@ -209,7 +209,8 @@ class CameraScene:
     def doubts(self) -> list[str]:
         """What the fits say of the inputs, as warnings: measured faces far from every known
         size (depth in other units than declared, or sizes not in metres), boxes larger than
-        cartons, a camera beyond the pile from the door (``door`` the wrong way)."""
+        cartons, no floor seen (z = 0 at the lowest readings), a camera beyond the pile from the
+        door (``door`` the wrong way)."""
         doubts = []
         errors = [item.size_error_m for item in self.fitted]
         if errors and float(np.median(errors)) > SIZE_DOUBT_M:
@@ -223,6 +224,11 @@ class CameraScene:
             doubts.append(
                 f"the fitted boxes are larger than cartons (their longest edges' median is {longest:.2f} m): are the "
                 "depth image's units right (--depth-units)?"
+            )
+        if self.frame.floor_inliers == 0:
+            doubts.append(
+                "no floor plane was seen (hidden by the boxes, or out of the view): z = 0 is put at the lowest "
+                "readings; if the floor lies lower, every box stands that much too low"
             )
         pile_x = float(np.median([box.position[0] for box in self.scene.boxes]))
         if self.camera is None and self.door_given and pile_x < 0:

@@ -58,9 +58,24 @@ NOISE_FILL = 0.35
 #: a wider band that takes in another surface turns the fit towards it.
 NOISE_BAND = 0.05
 NOISE_TURN_DEG = 15.0
+#: ... or, for gravity's level planes, this: a wall's foot in the wider band turned the floor of a
+#: wall of box fronts seen from the door by 12-26 degrees.
+LEVEL_TURN_DEG = 2.0
 #: The lowest plane is the floor unless more than this share of the points lies more than
-#: :data:`NOISE_BAND` under it (then the floor is the lowest readings: :func:`_lowest_level`).
+#: :data:`NOISE_BAND` under it, on surfaces (:func:`_surfaces`: a floor seen as a sliver, the
+#: sides of boxes standing on a floor not seen; not a sensor's stray readings scattered under
+#: the floor); the floor is then the lowest readings' level (:func:`_lowest_level`).
 FLOOR_BELOW_SHARE = 0.01
+#: Points lie on surfaces when their distance to their this-many-th nearest point is under
+#: :data:`SURFACE_SPREAD` times the cloud's (medians over at most :data:`SURFACE_SAMPLE` points).
+SURFACE_NEIGHBOURS = 8
+SURFACE_SPREAD = 3.0
+SURFACE_SAMPLE = 5_000
+#: :func:`plane_by_heights` leans from the direction it is given only when the leaning slab
+#: holds this many times the points of the level one (weighed by the lean's cosine).
+LEAN_EVIDENCE = 1.2
+#: A level plane's band holds at least this many times the points of the bands beside it.
+LEVEL_PEAK = 2.0
 #: Points used for the plane search (a random subset of larger clouds; the fit is refined on all).
 PLANE_SAMPLE = 60_000
 
@@ -154,13 +169,16 @@ def fit_plane(
         centre = points[inliers].mean(axis=0)
         refined = np.linalg.svd(points[inliers] - centre, full_matrices=False)[2][-1]
         refined *= np.sign(refined @ normal) or 1.0
-        normal, offset = refined, float(refined @ centre)
-        inliers = np.abs(points @ normal - offset) < threshold
+        # refined out of the cone, the inliers were mostly another surface the proposal crossed (a
+        # wall of box fronts): the proposal stands
+        if near_normal is None or refined @ reference >= np.cos(np.radians(tolerance_deg)):
+            normal, offset = refined, float(refined @ centre)
+            inliers = np.abs(points @ normal - offset) < threshold
     return normal, offset, inliers
 
 
 def plane_within_noise(
-    points: np.ndarray, normal: np.ndarray, offset: float, inliers: np.ndarray
+    points: np.ndarray, normal: np.ndarray, offset: float, inliers: np.ndarray, *, max_turn_deg: float = NOISE_TURN_DEG
 ) -> tuple[np.ndarray, float, np.ndarray]:
     """The plane refitted in a wider band when the depth noise fills the band it was fitted in
     (else the plane as given).
@@ -171,7 +189,8 @@ def plane_within_noise(
     band is doubled (up to :data:`NOISE_BAND`) and the plane refitted to the points in it. Depth
     noise of a centimetre or more puts most of a face outside a 1 cm band, and the band's points
     lean the fit towards the three that proposed it: a floor 4 m away, its depth 2.5 cm off,
-    tilts gravity by degrees.
+    tilts gravity by degrees. A refit turning more than ``max_turn_deg`` took in another surface:
+    the plane then keeps its direction, and only its height is refitted in the widening band.
 
     Examples
     --------
@@ -189,8 +208,9 @@ def plane_within_noise(
         centre = points[wide].mean(axis=0)
         refined = np.linalg.svd(points[wide] - centre, full_matrices=False)[2][-1]
         refined *= np.sign(refined @ normal) or 1.0
-        if refined @ normal < np.cos(np.radians(NOISE_TURN_DEG)):  # the wider band holds another surface
-            break
+        if refined @ normal < np.cos(np.radians(max_turn_deg)):
+            # the wider band holds another surface (a wall's foot): the plane keeps its direction
+            return (normal, *_widened(points @ normal, offset, band / 2.0))
         normal, offset = refined, float(refined @ centre)
         inliers = np.abs(points @ normal - offset) < band
     return normal, offset, inliers
@@ -201,16 +221,94 @@ def _level_within_noise(points: np.ndarray, normal: np.ndarray) -> tuple[float, 
     bins, in that one direction), refitted in a band doubled while the noise fills it (up to
     :data:`NOISE_BAND`), and the points within that band."""
     heights = points @ normal
-    offset, _ = _fullest_slab(heights, 4 * PLANE_THRESHOLD)
-    band = PLANE_THRESHOLD
+    return _widened(heights, _fullest_slab(heights, 4 * PLANE_THRESHOLD)[0], PLANE_THRESHOLD)
+
+
+def _widened(heights: np.ndarray, offset: float, band: float) -> tuple[float, np.ndarray]:
+    """A level at ``offset`` among ``heights``, refitted (the mean within ``band``) in a band
+    doubled while the noise fills it (up to :data:`NOISE_BAND`), and the heights within it."""
     inside = np.abs(heights - offset) < band
     if inside.any():
         offset = float(np.mean(heights[inside]))
-    while _fills_band(points, normal, offset, band) and 2.0 * band <= NOISE_BAND:
+    while _fills_level(heights, offset, band) and 2.0 * band <= NOISE_BAND:
         band *= 2.0
         inside = np.abs(heights - offset) < band
         offset = float(np.mean(heights[inside]))
     return offset, np.abs(heights - offset) < band
+
+
+def _level_unless_leaning(
+    points: np.ndarray, normal: np.ndarray, offset: float, inliers: np.ndarray, reference: np.ndarray
+) -> tuple[np.ndarray, float, np.ndarray]:
+    """The plane (``normal``, ``offset``) with its ``inliers``, or the plane level along ``reference`` through
+    the same points when that holds as many within :data:`PLANE_THRESHOLD` but for
+    :data:`LEAN_EVIDENCE`: a strip of floor before a wall of box fronts fits any lean about its
+    length, and the wall's foot in its band leans the least-squares fit by degrees.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> strip = np.column_stack([rng.uniform(1.6, 1.7, 3000), rng.uniform(-1, 1, 3000), np.zeros(3000)])
+    >>> foot = np.column_stack([np.full(300, 1.7), rng.uniform(-1, 1, 300), rng.uniform(0.0, 0.01, 300)])
+    >>> points = np.r_[strip, foot]
+    >>> leaning = np.array([-np.sin(0.05), 0.0, np.cos(0.05)])
+    >>> inliers = np.abs(points @ leaning - (points @ leaning).mean()) < 0.01
+    >>> normal, offset, _ = _level_unless_leaning(points, leaning, 0.0, inliers, np.array([0.0, 0.0, 1.0]))
+    >>> normal.tolist(), round(offset, 3)
+    ([0.0, 0.0, 1.0], 0.0)
+    """
+    heights = points @ reference
+    level_offset = float(np.mean(heights[inliers]))
+    level = np.abs(heights - level_offset) < PLANE_THRESHOLD
+    if inliers.sum() < LEAN_EVIDENCE * level.sum():
+        return reference, level_offset, level
+    return normal, offset, inliers
+
+
+def _stands_out(heights: np.ndarray, offset: float, band: float) -> bool:
+    """Whether a level plane's points stand out of the cloud's heights around it: the band
+    (``offset`` +- ``band``) holds :data:`LEVEL_PEAK` times the points of the two bands as wide
+    beside it. A plane does; a slab of the heights of a wall (box fronts seen from the door, with
+    no floor or top in it) holds as many as the slabs above and below it.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> wall = rng.uniform(0.0, 1.5, 20000)
+    >>> floor = np.r_[wall, rng.normal(0.0, 0.005, 3000)]
+    >>> _stands_out(floor, 0.0, 0.02), _stands_out(wall, 0.7, 0.02)
+    (True, False)
+    """
+    distances = np.abs(heights - offset)
+    inside = int(np.sum(distances < band))
+    return inside >= LEVEL_PEAK * int(np.sum((distances >= band) & (distances < 2.0 * band)))
+
+
+def _surfaces(points: np.ndarray, under: np.ndarray, rng: np.random.Generator) -> bool:
+    """Whether the points ``under`` selects lie on surfaces as the rest do: the median distance
+    to their :data:`SURFACE_NEIGHBOURS`-th nearest point is under :data:`SURFACE_SPREAD` times
+    the cloud's, as a depth image samples a surface, and they are not readings scattered apart
+    (multipath, a few pixels read far too long).
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> floor = np.column_stack([rng.uniform(0, 2, 8000), rng.uniform(0, 2, 8000), np.zeros(8000)])
+    >>> sliver = np.column_stack([rng.uniform(0, 2, 400), rng.uniform(2, 2.1, 400), np.full(400, -0.3)])
+    >>> stray = np.column_stack([rng.uniform(0, 2, 400), rng.uniform(0, 2, 400), rng.uniform(-1, -0.1, 400)])
+    >>> below = np.r_[np.zeros(8000, bool), np.ones(400, bool)]
+    >>> _surfaces(np.r_[floor, sliver], below, rng), _surfaces(np.r_[floor, stray], below, rng)
+    (True, False)
+    """
+    from scipy.spatial import cKDTree
+
+    def spacing(chosen: np.ndarray) -> float:
+        if len(chosen) > SURFACE_SAMPLE:
+            chosen = chosen[rng.choice(len(chosen), SURFACE_SAMPLE, replace=False)]
+        return float(np.median(tree.query(chosen, k=SURFACE_NEIGHBOURS + 1)[0][:, -1]))
+
+    tree = cKDTree(points)
+    return spacing(points[under]) < SURFACE_SPREAD * spacing(points)
 
 
 def _lowest_level(heights: np.ndarray) -> float:
@@ -224,7 +322,12 @@ def _lowest_level(heights: np.ndarray) -> float:
 def _fills_band(points: np.ndarray, normal: np.ndarray, offset: float, band: float = PLANE_THRESHOLD) -> bool:
     """Whether the points within ``band`` of the plane lie a mean :data:`NOISE_FILL` of it or more
     from it: depth noise as wide as the band, or wider."""
-    distances = np.abs(points @ normal - offset)
+    return _fills_level(points @ normal, offset, band)
+
+
+def _fills_level(heights: np.ndarray, offset: float, band: float) -> bool:
+    """:func:`_fills_band` for heights along the plane's normal."""
+    distances = np.abs(heights - offset)
     inside = distances[distances < band]
     return bool(len(inside) >= 3 and np.mean(inside) >= NOISE_FILL * band)
 
@@ -248,13 +351,15 @@ def plane_by_heights(
     bin_m: float = 4 * PLANE_THRESHOLD, rng: np.random.Generator,
 ) -> tuple[np.ndarray, float]:  # fmt: skip
     """The plane within ``tolerance_deg`` of ``near_normal`` that the most points lie in a slab of
-    ``bin_m`` of: for each direction tried, the points' heights along it in bins of ``bin_m``
-    (two grids, half a bin apart), the fullest bin counted; directions 2.5 degrees apart over
-    the whole cone, then 0.5 and 0.1 degrees apart around the best.
+    ``bin_m`` of: for each direction tried, the points' heights along it, the fullest slab of
+    ``bin_m`` counted (:func:`_fullest_slab`) and weighed by the cosine of the direction's lean
+    from ``near_normal`` (a leaning slab cuts a vertical face in a band as much wider: a wall of
+    box fronts seen from the door otherwise leans gravity 20-30 degrees); directions 2.5 degrees
+    apart over the whole cone, then 0.5 and 0.1 degrees apart around the best.
 
     What a noisy cloud needs: three neighbouring points a centimetre apart with depth noise of
     centimetres propose planes in every direction, while a floor 3 m across, its heights binned
-    along a direction 1 degree off, spreads over five 4 cm bins.
+    along a direction 1 degree off, spreads over 9 cm of heights.
 
     Examples
     --------
@@ -268,29 +373,36 @@ def plane_by_heights(
     if len(points) > PLANE_SAMPLE // 2:
         points = points[rng.choice(len(points), PLANE_SAMPLE // 2, replace=False)]
     reference = np.asarray(near_normal, dtype=np.float64) / np.linalg.norm(near_normal)
-    best = (reference, 0.0, -1)
+    best = (reference, 0.0, -1.0)
     inside_cone = np.cos(np.radians(tolerance_deg)) - 1e-12
     for centre, radius, step in ((reference, tolerance_deg, 2.5), (None, 2.5, 0.5), (None, 0.5, 0.1)):
         directions = _directions_around(best[0] if centre is None else centre, radius, step)
         for direction in directions[directions @ reference >= inside_cone]:  # the finer grids stay in the cone
             offset, count = _fullest_slab(points @ direction, bin_m)
-            if count > best[2]:
-                best = (direction, offset, count)
+            # a slab leaning by t cuts a vertical face in a band 1 / cos(t) as wide: that much more
+            # of a wall of box fronts is no evidence of a lean
+            score = count * float(direction @ reference)
+            if score > best[2]:
+                best = (direction, offset, score)
+    level_offset, level_count = _fullest_slab(points @ reference, bin_m)
+    if best[2] < LEAN_EVIDENCE * level_count:  # too little for a lean: the slabs of faces and noise make as much
+        return reference, level_offset
     return best[0], best[1]
 
 
 def _fullest_slab(heights: np.ndarray, bin_m: float) -> tuple[float, int]:
-    """The centre of the bin of ``bin_m`` holding the most ``heights`` (two grids, half a bin
-    apart; the first on a tie), and how many it holds."""
-    best = (0.0, -1)
-    for phase in (0.0, 0.5):
-        bins = np.floor(heights / bin_m + phase).astype(np.int64)
-        lowest = int(bins.min())
-        counts = np.bincount(bins - lowest)
-        k = int(np.argmax(counts))
-        if counts[k] > best[1]:
-            best = (float((k + lowest + 0.5 - phase) * bin_m), int(counts[k]))
-    return best
+    """The centre of the slab ``bin_m`` thick that holds the most ``heights`` (a window sliding
+    over them; the lowest on a tie), and how many it holds.
+
+    Examples
+    --------
+    >>> _fullest_slab(np.array([0.0, 0.01, 0.5, 0.51, 0.52, 0.9]), 0.04)
+    (0.52, 3)
+    """
+    ordered = np.sort(np.asarray(heights, dtype=np.float64))
+    counts = np.searchsorted(ordered, ordered + bin_m, side="right") - np.arange(len(ordered))
+    k = int(np.argmax(counts))
+    return float(ordered[k] + bin_m / 2), int(counts[k])
 
 
 @dataclass(frozen=True)
@@ -391,9 +503,19 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
                 normal, offset = plane_by_heights(remaining, up_guess, rng=rng)
                 inliers = np.abs(remaining @ normal - offset) < PLANE_THRESHOLD
             if inliers.sum() >= 3:
-                normal, offset, inliers = plane_within_noise(remaining, normal, offset, inliers)
+                normal, offset, inliers = plane_within_noise(
+                    remaining, normal, offset, inliers, max_turn_deg=LEVEL_TURN_DEG
+                )
+            if not noisy and inliers.sum() >= 3:  # RANSAC's plane leans only on evidence
+                normal, offset, inliers = _level_unless_leaning(
+                    remaining, normal, offset, inliers, up_guess if first_up is None else first_up
+                )
         if inliers.sum() < MIN_PLANE_SHARE * len(points):
             break
+        band = float(np.max(np.abs(remaining[inliers] @ normal - offset)))
+        if not _stands_out(points @ normal, offset, band):  # a slice of a wall, not a plane
+            remaining = remaining[~inliers]
+            continue
         found.append((normal, offset, int(inliers.sum())))
         noisy_planes.append(noisy)
         if first_up is None:
@@ -436,7 +558,8 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
     )
     floor_level = float(floor_heights[lowest])
     floor_inliers = found[lowest][2]
-    if np.mean(heights < floor_level - NOISE_BAND) > FLOOR_BELOW_SHARE:  # not under the cloud: no floor plane
+    under = heights < floor_level - NOISE_BAND
+    if under.mean() > FLOOR_BELOW_SHARE and _surfaces(points, under, rng):  # a hidden floor: not under the cloud
         floor_level, floor_inliers = _lowest_level(heights), 0
     tilt = float(np.degrees(np.arccos(np.clip(up @ up_guess, -1.0, 1.0))))
     plane_heights = tuple(
