@@ -525,6 +525,36 @@ def test_a_floor_not_seen_is_said_in_the_doubts(floor_seen: bool) -> None:
     assert bool(said) is not floor_seen
 
 
+def test_a_front_cut_off_by_the_image_or_a_box_in_front_is_seen_in_part() -> None:
+    # three rows of cartons 0.2 m apart: the top row shows 0.28 of its 0.4 m fronts under the
+    # image's top edge, and a box in front hides part of one front; fitted to a smaller carton's
+    # face, 15-30 cm off, such fronts were taken as seen whole
+    from tests.camera.conftest import looking_in, render_boxes
+    from unstack.scene import Box
+
+    wall = [
+        Box(f"w{row}{column}", [0.6, 0.4, 0.4], [2.5, -0.9 + 0.6 * column, 0.2 + 0.4 * row], [0, 0, 0, 1])
+        for row in range(3)
+        for column in range(4)
+    ]
+    in_front = Box("f", [0.4, 0.3, 0.3], [1.6, -0.7, 0.15], [0, 0, 0, 1])
+    pose = looking_in(height=1.6, pitch_deg=35.0)
+    depth, masks = render_boxes([*wall, in_front], pose)
+    sizes = [(0.6, 0.4, 0.4), (0.4, 0.3, 0.3)]
+    built = scene_from_depth(
+        depth, INTRINSICS, pose, masks, ids=[box.id for box in [*wall, in_front]], known_sizes=sizes
+    )
+    fitted = {item.box.id: item for item in built.fitted}
+    assert all(fitted[f"w2{column}"].partial for column in range(4))  # under the image's edge
+    assert fitted["w00"].partial  # behind the box in front
+    seen_whole = [fitted[box_id] for box_id in ("w10", "w11", "w12", "w13", "f")]
+    assert not any(item.partial for item in seen_whole)
+    assert all(
+        np.linalg.norm(item.box.position - box.position) < 0.01
+        for item, box in zip(seen_whole, [wall[4], wall[5], wall[6], wall[7], in_front], strict=True)
+    )
+
+
 @pytest.mark.parametrize("tilt_deg", [3.0, 6.0])
 def test_plane_by_heights_keeps_to_its_cone(tilt_deg: float) -> None:
     # the finer grids around the best direction of the coarse one reached 2.5 degrees past the cone

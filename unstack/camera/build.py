@@ -14,6 +14,7 @@ Examples
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -334,6 +335,40 @@ def _boxes_holding_their_points(
     return kept, unfitted
 
 
+#: A surface this much nearer than a mask's pixels beside it (metres) hides part of the box ...
+OCCLUDER_M = 0.1
+#: ... when it borders this share of the mask's outline, or more.
+OCCLUDED_SHARE = 0.05
+
+
+def _cut_off(depth_m: np.ndarray, mask: np.ndarray) -> bool:
+    """Whether a mask meets the image's edge, or a surface nearer than all but 2 % of its
+    readings by :data:`OCCLUDER_M` along :data:`OCCLUDED_SHARE` of its outline (a box in
+    front): its box may reach on, out of sight.
+
+    Examples
+    --------
+    >>> depth = np.full((20, 20), 3.0)
+    >>> mask = np.zeros((20, 20), bool); mask[5:15, 5:15] = True
+    >>> _cut_off(depth, mask)
+    False
+    >>> depth[5:15, 12:18] = 2.5  # a box in front hides its right side
+    >>> _cut_off(depth, mask & (depth > 2.9))
+    True
+    """
+    from scipy.ndimage import binary_dilation
+
+    if mask[0].any() or mask[-1].any() or mask[:, 0].any() or mask[:, -1].any():
+        return True
+    readings = depth_m[mask & (depth_m > 0)]
+    if len(readings) == 0:
+        return False
+    outline = binary_dilation(mask) & ~mask
+    # nearer than (almost) all the box shows: a box's own faces seen at a grazing angle are not
+    nearer = outline & (depth_m > 0) & (depth_m < np.percentile(readings, 2) - OCCLUDER_M)
+    return bool(nearer.sum() >= OCCLUDED_SHARE * outline.sum())
+
+
 def _window(mask: np.ndarray) -> tuple[slice, slice] | None:
     """The rows and columns of the rectangle around ``mask``'s pixels (None when it has none)."""
     rows, columns = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
@@ -506,6 +541,12 @@ def scene_from_depth(
     if not fitted:
         raise UnstackError(f"no box could be fitted: {'; '.join(f'{k}: {why}' for k, why in unfitted.items())}")
     fitted = _without_overlaps(fitted, unfitted)
+    cut_off = {names[k] for k in kept if _cut_off(depth_m, masks[k])}
+    # a front seen whole fixes its face only: one cut off by the image or a box in front is seen in part
+    fitted = [
+        dataclasses.replace(item, partial=True) if item.face == "front" and item.box.id in cut_off else item
+        for item in fitted
+    ]
     boxes: list[Box] = [item.box for item in fitted]
     metadata = {
         "camera": {

@@ -118,13 +118,16 @@ def fit_plane(
     rng: np.random.Generator,
     near_normal: np.ndarray | None = None,
     tolerance_deg: float = HORIZONTAL_TOLERANCE_DEG,
+    in_cone: bool = False,
 ) -> tuple[np.ndarray, float, np.ndarray]:
     """The plane ``normal . p = offset`` holding the most points within ``threshold`` (RANSAC).
 
     Three nearby points (an anchor and two of its nearest neighbours) propose a plane; the one
     with most inliers is refined by a least-squares fit (the smallest principal axis of its
     inliers). With ``near_normal``, only planes whose normal is within ``tolerance_deg`` of it
-    are proposed (the normal is returned pointing its way).
+    are proposed (the normal is returned pointing its way); with ``in_cone`` too, a refinement
+    that leaves that cone is not taken (the inliers were mostly another surface the proposal
+    crossed, as a wall of box fronts).
 
     Returns
     -------
@@ -169,9 +172,7 @@ def fit_plane(
         centre = points[inliers].mean(axis=0)
         refined = np.linalg.svd(points[inliers] - centre, full_matrices=False)[2][-1]
         refined *= np.sign(refined @ normal) or 1.0
-        # refined out of the cone, the inliers were mostly another surface the proposal crossed (a
-        # wall of box fronts): the proposal stands
-        if near_normal is None or refined @ reference >= np.cos(np.radians(tolerance_deg)):
+        if not in_cone or near_normal is None or refined @ reference >= np.cos(np.radians(tolerance_deg)):
             normal, offset = refined, float(refined @ centre)
             inliers = np.abs(points @ normal - offset) < threshold
     return normal, offset, inliers
@@ -487,7 +488,7 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
     for _ in range(MAX_PLANES):
         if len(remaining) < max(3, MIN_PLANE_SHARE * len(points)):
             break
-        normal, offset, inliers = fit_plane(remaining, rng=rng, near_normal=up_guess)
+        normal, offset, inliers = fit_plane(remaining, rng=rng, near_normal=up_guess, in_cone=True)
         # depth noise grows with distance: each plane tells whether noise fills its band
         noisy = bool(inliers.sum() >= 3 and _fills_band(remaining, normal, offset))
         if noisy and first_up is not None:
