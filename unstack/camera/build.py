@@ -133,7 +133,8 @@ def _check_upright(frame: GravityFrame, pose: np.ndarray, box_points: Sequence[n
         raise UnstackError(
             f"{seen_from_below} of the {seen_from_above + seen_from_below} boxes that show a level top show it as "
             "their lowest face with the rest of the box above (a camera sees tops from above): the pose's z points "
-            "down; expected a camera-to-world pose whose z is up"
+            "down, or the masks reach past their boxes onto the floor under them; expected a camera-to-world pose "
+            "whose z is up, and masks on their boxes"
         )
     if seen_from_above >= 1 and seen_from_above >= SIDE_MARGIN * seen_from_below:
         return
@@ -328,7 +329,7 @@ def _boxes_holding_their_points(
             unfitted[item.box.id] = (
                 f"the box fitted to its mask holds {100 * held:.0f} % of the mask's points, which lie {low:.2f} "
                 f"to {high:.2f} m high over {np.ptp(points[:, 0]):.1f} x {np.ptp(points[:, 1]):.1f} m: a detection "
-                "of the floor, of several boxes or of the whole image?"
+                "of the floor, of several boxes or of the whole image, or a mask reaching far past its box?"
             )
         else:
             kept.append(item)
