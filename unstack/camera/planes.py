@@ -179,7 +179,13 @@ def fit_plane(
 
 
 def plane_within_noise(
-    points: np.ndarray, normal: np.ndarray, offset: float, inliers: np.ndarray, *, max_turn_deg: float = NOISE_TURN_DEG
+    points: np.ndarray,
+    normal: np.ndarray,
+    offset: float,
+    inliers: np.ndarray,
+    *,
+    max_turn_deg: float = NOISE_TURN_DEG,
+    level: bool = False,
 ) -> tuple[np.ndarray, float, np.ndarray]:
     """The plane refitted in a wider band when the depth noise fills the band it was fitted in
     (else the plane as given).
@@ -191,7 +197,8 @@ def plane_within_noise(
     noise of a centimetre or more puts most of a face outside a 1 cm band, and the band's points
     lean the fit towards the three that proposed it: a floor 4 m away, its depth 2.5 cm off,
     tilts gravity by degrees. A refit turning more than ``max_turn_deg`` took in another surface:
-    the plane then keeps its direction, and only its height is refitted in the widening band.
+    the plane stays as it was, or, ``level``, keeps its direction and has only its height
+    refitted in the widening band (gravity's level planes).
 
     Examples
     --------
@@ -209,9 +216,10 @@ def plane_within_noise(
         centre = points[wide].mean(axis=0)
         refined = np.linalg.svd(points[wide] - centre, full_matrices=False)[2][-1]
         refined *= np.sign(refined @ normal) or 1.0
-        if refined @ normal < np.cos(np.radians(max_turn_deg)):
-            # the wider band holds another surface (a wall's foot): the plane keeps its direction
-            return (normal, *_widened(points @ normal, offset, band / 2.0))
+        if refined @ normal < np.cos(np.radians(max_turn_deg)):  # the wider band holds another surface
+            if level:  # a wall's foot beside a floor: the floor keeps its direction
+                return (normal, *_widened(points @ normal, offset, band / 2.0))
+            break
         normal, offset = refined, float(refined @ centre)
         inliers = np.abs(points @ normal - offset) < band
     return normal, offset, inliers
@@ -505,7 +513,7 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
                 inliers = np.abs(remaining @ normal - offset) < PLANE_THRESHOLD
             if inliers.sum() >= 3:
                 normal, offset, inliers = plane_within_noise(
-                    remaining, normal, offset, inliers, max_turn_deg=LEVEL_TURN_DEG
+                    remaining, normal, offset, inliers, max_turn_deg=LEVEL_TURN_DEG, level=True
                 )
             if not noisy and inliers.sum() >= 3:  # RANSAC's plane leans only on evidence
                 normal, offset, inliers = _level_unless_leaning(
