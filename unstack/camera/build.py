@@ -336,7 +336,7 @@ def _boxes_holding_their_points(
     return kept, unfitted
 
 
-#: A surface this much nearer than a mask's pixels beside it (metres) hides part of the box ...
+#: A surface this much nearer than all but 2 % of a mask's readings (metres) hides part of its box ...
 OCCLUDER_M = 0.1
 #: ... when it borders this share of the mask's outline, or more.
 OCCLUDED_SHARE = 0.05
@@ -542,7 +542,8 @@ def scene_from_depth(
     if not fitted:
         raise UnstackError(f"no box could be fitted: {'; '.join(f'{k}: {why}' for k, why in unfitted.items())}")
     fitted = _without_overlaps(fitted, unfitted)
-    cut_off = {names[k] for k in kept if _cut_off(depth_m, masks[k])}
+    fronts = {item.box.id for item in fitted if item.face == "front"}
+    cut_off = {names[k] for k in kept if names[k] in fronts and _cut_off(depth_m, masks[k])}
     # a front seen whole fixes its face only: one cut off by the image or a box in front is seen in part
     fitted = [
         dataclasses.replace(item, partial=True) if item.face == "front" and item.box.id in cut_off else item

@@ -226,9 +226,9 @@ def plane_within_noise(
 
 
 def _level_within_noise(points: np.ndarray, normal: np.ndarray) -> tuple[float, np.ndarray]:
-    """The height along ``normal`` of the fullest slab of the points (:func:`plane_by_heights`'s
-    bins, in that one direction), refitted in a band doubled while the noise fills it (up to
-    :data:`NOISE_BAND`), and the points within that band."""
+    """The height along ``normal`` of the fullest 4 cm slab of the points (:func:`_fullest_slab`,
+    as :func:`plane_by_heights` counts in one direction), refitted in a band doubled while the
+    noise fills it (up to :data:`NOISE_BAND`), and the points within that band."""
     heights = points @ normal
     return _widened(heights, _fullest_slab(heights, 4 * PLANE_THRESHOLD)[0], PLANE_THRESHOLD)
 
@@ -433,7 +433,7 @@ class GravityFrame:
         Each of those horizontal planes' height in the gravity frame (metres) and its points.
     noisy : bool
         The depth's noise filled the lead plane's band (:data:`PLANE_THRESHOLD`; the plane with
-        the most points): it was found by binning the points' heights and refitted in a band as
+        the most points): it was found by the points' heights and refitted in a band as
         wide as the noise (:func:`plane_by_heights`, :func:`plane_within_noise`).
     """
 
