@@ -555,6 +555,53 @@ def test_a_front_cut_off_by_the_image_or_a_box_in_front_is_seen_in_part() -> Non
     )
 
 
+def _stacked(layers: int) -> list:
+    """A 2 x 2 stack of 0.6 x 0.4 x 0.4 cartons, ``layers`` high, under the camera of ``looking_down``."""
+    from unstack.scene import Box
+
+    return [
+        Box(f"b{layer}{i}{j}", [0.6, 0.4, 0.4], [-0.3 + 0.6 * i, -0.2 + 0.4 * j, 0.2 + 0.4 * layer], [0, 0, 0, 1])
+        for layer in range(layers)
+        for i in range(2)
+        for j in range(2)
+    ]
+
+
+@pytest.mark.parametrize(
+    ("layers", "noise", "tilt_deg"), [(3, 0.005, 3.0), (3, 0.0, 1.5), (4, 0.0, 1.5), (4, 0.005, 3.0)]
+)
+def test_a_pose_leaning_over_a_small_layer_of_tops_is_levelled(layers: int, noise: float, tilt_deg: float) -> None:
+    # a layer of tops 1.2 x 0.8 m, the largest plane, leaning 1.5-3 degrees in the pose's frame: a
+    # rule that leaned only when the leaning slab held 1.2 times the level one's points kept the
+    # pose's z (1.5-3 degrees off; the floor cut in two)
+    from scipy.spatial.transform import Rotation
+
+    from tests.camera.conftest import looking_down, render_boxes
+    from unstack.camera.planes import depth_points, gravity_frame
+
+    depth, _ = render_boxes(_stacked(layers), looking_down())
+    rng = np.random.default_rng(1)
+    noisy = np.where(depth > 0, depth + rng.normal(0.0, noise, depth.shape), 0.0) if noise else depth
+    tilt = np.eye(4)
+    tilt[:3, :3] = Rotation.from_rotvec(np.radians(tilt_deg) * np.array([1.0, 0.0, 0.0])).as_matrix()
+    frame = gravity_frame(depth_points(noisy, INTRINSICS, tilt @ looking_down()), door=np.array([-1.0, 0.0, 0.0]))
+    assert abs(frame.tilt_deg - tilt_deg) < 0.5
+
+
+@pytest.mark.parametrize("millimetres", [False, True])
+def test_an_exactly_flat_layer_of_tops_filling_the_view_is_a_plane(millimetres: bool) -> None:
+    # exact depth puts a plane's points a 1e-14 m band: the band beside it, as thin, held as many
+    # and the plane was dropped ("no horizontal plane")
+    from tests.camera.conftest import looking_down, render_boxes
+    from unstack.camera.planes import depth_points, gravity_frame
+
+    depth, _ = render_boxes(_stacked(4), looking_down())
+    if millimetres:
+        depth = np.round(depth, 3)
+    frame = gravity_frame(depth_points(depth, INTRINSICS, looking_down()), door=np.array([-1.0, 0.0, 0.0]))
+    assert frame.tilt_deg < 0.1 and frame.planes == 1
+
+
 @pytest.mark.parametrize("tilt_deg", [3.0, 6.0])
 def test_plane_by_heights_keeps_to_its_cone(tilt_deg: float) -> None:
     # the finer grids around the best direction of the coarse one reached 2.5 degrees past the cone

@@ -71,8 +71,8 @@ FLOOR_BELOW_SHARE = 0.01
 SURFACE_NEIGHBOURS = 8
 SURFACE_SPREAD = 3.0
 SURFACE_SAMPLE = 5_000
-#: :func:`plane_by_heights` leans from the direction it is given only when the leaning slab
-#: holds this many times the points of the level one (weighed by the lean's cosine).
+#: A plane leans from the direction it is given only when its points' heights spread this many
+#: times as far along that direction as along the plane's normal (:func:`_spread`).
 LEAN_EVIDENCE = 1.2
 #: A level plane's band holds at least this many times the points of the bands beside it.
 LEVEL_PEAK = 2.0
@@ -249,10 +249,11 @@ def _widened(heights: np.ndarray, offset: float, band: float) -> tuple[float, np
 def _level_unless_leaning(
     points: np.ndarray, normal: np.ndarray, offset: float, inliers: np.ndarray, reference: np.ndarray
 ) -> tuple[np.ndarray, float, np.ndarray]:
-    """The plane (``normal``, ``offset``) with its ``inliers``, or the plane level along ``reference`` through
-    the same points when that holds as many within :data:`PLANE_THRESHOLD` but for
-    :data:`LEAN_EVIDENCE`: a strip of floor before a wall of box fronts fits any lean about its
-    length, and the wall's foot in its band leans the least-squares fit by degrees.
+    """The plane (``normal``, ``offset``) with its ``inliers``, or the plane level along
+    ``reference`` through the same points when their heights along it spread less than
+    :data:`LEAN_EVIDENCE` times as far as along ``normal`` (:func:`_spread`): a strip of floor
+    before a wall of box fronts fits any lean about its length, and the wall's foot in its band
+    leans the least-squares fit by degrees; a plane truly leaning spreads along the level.
 
     Examples
     --------
@@ -267,10 +268,9 @@ def _level_unless_leaning(
     ([0.0, 0.0, 1.0], 0.0)
     """
     heights = points @ reference
-    level_offset = float(np.mean(heights[inliers]))
-    level = np.abs(heights - level_offset) < PLANE_THRESHOLD
-    if inliers.sum() < LEAN_EVIDENCE * level.sum():
-        return reference, level_offset, level
+    if _spread(heights[inliers]) < LEAN_EVIDENCE * _spread(points[inliers] @ normal):  # no lean shows
+        level_offset = float(np.mean(heights[inliers]))
+        return reference, level_offset, np.abs(heights - level_offset) < PLANE_THRESHOLD
     return normal, offset, inliers
 
 
@@ -364,7 +364,9 @@ def plane_by_heights(
     ``bin_m`` counted (:func:`_fullest_slab`) and weighed by the cosine of the direction's lean
     from ``near_normal`` (a leaning slab cuts a vertical face in a band as much wider: a wall of
     box fronts seen from the door otherwise leans gravity 20-30 degrees); directions 2.5 degrees
-    apart over the whole cone, then 0.5 and 0.1 degrees apart around the best.
+    apart over the whole cone, then 0.5 and 0.1 degrees apart around the best. The best leans
+    from ``near_normal`` only when its slab's heights spread :data:`LEAN_EVIDENCE` times as far
+    along ``near_normal`` as along it; else ``near_normal`` and its fullest slab are returned.
 
     What a noisy cloud needs: three neighbouring points a centimetre apart with depth noise of
     centimetres propose planes in every direction, while a floor 3 m across, its heights binned
@@ -393,10 +395,16 @@ def plane_by_heights(
             score = count * float(direction @ reference)
             if score > best[2]:
                 best = (direction, offset, score)
-    level_offset, level_count = _fullest_slab(points @ reference, bin_m)
-    if best[2] < LEAN_EVIDENCE * level_count:  # too little for a lean: the slabs of faces and noise make as much
-        return reference, level_offset
-    return best[0], best[1]
+    direction, offset = best[0], best[1]
+    slab = points[np.abs(points @ direction - offset) < bin_m / 2]
+    if _spread(slab @ reference) < LEAN_EVIDENCE * _spread(slab @ direction):  # no lean shows in the slab
+        return reference, _fullest_slab(points @ reference, bin_m)[0]
+    return direction, offset
+
+
+def _spread(heights: np.ndarray) -> float:
+    """The median absolute deviation of ``heights`` (0 for none)."""
+    return float(np.median(np.abs(heights - np.median(heights)))) if len(heights) else 0.0
 
 
 def _fullest_slab(heights: np.ndarray, bin_m: float) -> tuple[float, int]:
@@ -521,7 +529,7 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
                 )
         if inliers.sum() < MIN_PLANE_SHARE * len(points):
             break
-        band = float(np.max(np.abs(remaining[inliers] @ normal - offset)))
+        band = max(float(np.max(np.abs(remaining[inliers] @ normal - offset))), PLANE_THRESHOLD)
         if not _stands_out(points @ normal, offset, band):  # a slice of a wall, not a plane
             remaining = remaining[~inliers]
             continue
