@@ -103,7 +103,9 @@ def test_a_statics_finding_the_consistent_worlds_make_unlikely_is_warned_about(
         [[0.0, 0.2, 0.05], [found_probability, 0.0, 0.05], [0.9, 0.9, 0.0]],
         metadata={"tip_supports": [finding]},
     )
-    decision = unstack.decide(supports, seed=0)
+    from unstack.api import _statics_outweighed
+
+    decision = _statics_outweighed(unstack.decide(supports, seed=0), supports)  # as decide on a scene does
     said = [
         warning for warning in decision.warnings if "statics found that 'top' cannot stand without 'side'" in warning
     ]
@@ -111,6 +113,18 @@ def test_a_statics_finding_the_consistent_worlds_make_unlikely_is_warned_about(
     if warned:
         final = decision.marginals[1, 0]
         assert f"P(side supports top) is {final:.2f}" in said[0] and final < 0.5
+
+
+@pytest.mark.parametrize(
+    "findings",
+    [5, "xy", [{"supporter": "top"}], [{"supporter": "bottom", "held": "top"}]],
+    ids=["number", "text", "no-held", "well-formed"],
+)
+def test_statics_findings_in_a_supports_files_metadata_are_not_read(findings: object) -> None:
+    """A supports file's metadata is free-form: statics ran on no scene here, so nothing is said of it."""
+    supports = unstack.Supports(["top", "bottom"], [[0.0, 0.1], [0.3, 0.0]], metadata={"tip_supports": findings})
+    decision = unstack.decide(supports, seed=0)
+    assert decision.choice == "top" and not any("statics" in warning for warning in decision.warnings)
 
 
 def test_plan_from_a_scene_and_from_supports(examples: Path) -> None:

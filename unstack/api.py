@@ -425,7 +425,8 @@ def decide(
         )
         decision = _free_highest(decision, scene_or_supports, supports, free_cost, near_tie_margin)
         decision = _doubting_free_cost(decision, supports, free_cost)
-        decision = _statics_outweighed(decision, supports)
+        if isinstance(scene_or_supports, Scene):  # statics ran here; a file's metadata is free-form
+            decision = _statics_outweighed(decision, supports)
     if veto_scene is not None:
         from unstack.height_veto import FREE_COST
         from unstack.physics_veto import physics_veto as vetoed
@@ -492,7 +493,11 @@ def _doubting_free_cost(decision: Decision, supports: Supports, free_cost: float
 
 def _statics_outweighed(decision: Decision, supports: Supports) -> Decision:
     """The decision warning where statics found a box holding another up that the consistent
-    worlds then make unlikely: the raise said 0.65, the decision rests on the lower figure."""
+    worlds then make unlikely: the raise said 0.65, the decision rests on the lower figure.
+
+    ``supports`` comes from :func:`support_probabilities` on a scene in this call (its
+    ``metadata["tip_supports"]`` is statics' own finding), never from a file: a supports file's
+    metadata is free-form."""
     import dataclasses
 
     position = {box_id: k for k, box_id in enumerate(decision.objects)}
