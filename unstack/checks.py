@@ -114,6 +114,47 @@ def finite_number(value: Any) -> float | None:
     return number if math.isfinite(number) else None
 
 
+def float_array(
+    value: Any, *, source: str = "<array>", path: str = "$", error: type[InvalidFile] = InvalidScene
+) -> np.ndarray:
+    """``numpy.asarray(value, dtype=float64)``, an integer too large for a float refused by its path.
+
+    Raises
+    ------
+    InvalidFile
+        ``error`` at the first such integer (a JSON number of 309 digits or more parses as one).
+    TypeError, ValueError
+        As :func:`numpy.asarray` for what is not numbers (the caller says what it expected).
+
+    Examples
+    --------
+    >>> float_array([[1, 2.5]]).tolist()
+    [[1.0, 2.5]]
+    >>> float_array([[0, 10**400]], path="$.points")
+    Traceback (most recent call last):
+    ...
+    unstack.errors.InvalidScene: <array>: $.points[0][1]: expected a finite number, got an integer of about 401 digits
+    """
+    try:
+        return np.asarray(value, dtype=np.float64)
+    except OverflowError:
+        where, number = _first_huge_integer(value, path)
+        raise error(source, where, f"expected a finite number, got {number_text(number)}") from None
+
+
+def _first_huge_integer(value: Any, path: str) -> tuple[str, Any]:
+    """The path and value of the first integer in nested lists that no float holds."""
+    if isinstance(value, int | np.integer) and not isinstance(value, bool):
+        if finite_number(value) is None:
+            return path, value
+    elif isinstance(value, Sequence) and not isinstance(value, str):
+        for index, item in enumerate(value):
+            found = _first_huge_integer(item, f"{path}[{index}]")
+            if found[0]:
+                return found
+    return "", None
+
+
 def light_boxes(ids: Sequence[str], masses: Any) -> str | None:
     """A warning naming the boxes lighter than :data:`LIGHT_BOX` (``None`` when there are none);
     the caller puts the source before it.
@@ -177,7 +218,7 @@ def _matrix(value: Any, n_objects: int, source: str, path: str, error: type[Inva
                 raise error(source, f"{path}[{i}][{j}]", f"expected a number, got {cell!r}")
             if isinstance(cell, np.complexfloating):
                 raise error(source, f"{path}[{i}][{j}]", f"expected a real number, got {cell!r}")
-    return np.array(value, dtype=np.float64).reshape(n_objects, n_objects)
+    return float_array(value, source=source, path=path, error=error).reshape(n_objects, n_objects)
 
 
 def check_probability_matrix(
@@ -412,13 +453,16 @@ def check_points(
         if isinstance(value, Sequence) and len(value) == 0:
             return np.zeros((0, 3))
         try:
-            array = np.asarray(value, dtype=np.float64)
+            array = np.asarray(value)  # numbers stay numbers: text and true/false are refused below
+            if array.dtype == object:  # integers too large for int64, or anything mixed in
+                array = float_array(value, source=source, path=path, error=error)
         except (TypeError, ValueError):
             raise error(source, path, "expected an N x 3 array of numbers") from None
     if array.ndim != 2 or array.shape[1] != 3:
         raise error(source, path, f"expected an N x 3 array of points, got shape {array.shape}")
     if not np.issubdtype(array.dtype, np.number) or np.issubdtype(array.dtype, np.complexfloating):
-        raise error(source, path, f"expected real numbers, got dtype {array.dtype}")
+        kind = {"U": "text", "S": "text", "b": "true or false"}.get(array.dtype.kind, f"dtype {array.dtype}")
+        raise error(source, path, f"expected real numbers, got {kind}")
     points = np.ascontiguousarray(array, dtype=np.float64)
     bad = np.argwhere(~np.isfinite(points))
     if bad.size:
@@ -452,9 +496,12 @@ def check_decision_document(document: Document) -> None:
     for key in ("expected_costs", "expected_cost_errors"):
         if key in data and len(data[key]) != n:
             raise InvalidFile(source, f"$.{key}", f"expected {n} numbers (one per object), got {len(data[key])}")
+        if key in data:
+            float_array(data[key], source=source, path=f"$.{key}", error=InvalidFile)
     marginals = data["marginals"]
     if len(marginals) != n or any(len(row) != n for row in marginals):
         raise InvalidFile(source, "$.marginals", f"expected a {n} x {n} matrix (one row and column per object)")
+    float_array(marginals, source=source, path="$.marginals", error=InvalidFile)
     known = set(objects)
     if data["choice"] not in known:
         raise InvalidFile(source, "$.choice", f"expected one of the objects, got {data['choice']!r}")

@@ -37,7 +37,6 @@ True
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
@@ -151,18 +150,19 @@ def world_settings(scene: Scene) -> Any:
         from unstack.errors import InvalidScene
 
         raise InvalidScene(scene.source, "$.metadata.container", f"expected an object with {', '.join(keys)}")
+    from unstack.checks import finite_number, number_text
     from unstack.errors import InvalidScene, UnstackError
     from unstack.sim.settings import MAX_EXTENT
 
     extent = []
     for key in keys:
         value = given[key]
-        number = float(value) if isinstance(value, int | float) and not isinstance(value, bool) else math.nan
-        if not 0.0 < number <= MAX_EXTENT:
+        number = finite_number(value)
+        if number is None or not 0.0 < number <= MAX_EXTENT:
             raise InvalidScene(
                 scene.source,
                 f"$.metadata.container.{key}",
-                f"expected a positive extent of at most {MAX_EXTENT:g} m (metres?), got {value!r}",
+                f"expected a positive extent of at most {MAX_EXTENT:g} m (metres?), got {number_text(value)}",
             )
         extent.append(number)
     container = Container(*extent)

@@ -230,7 +230,7 @@ def load_points(
         raise
     except Exception as error:  # noqa: BLE001 - any reader failure is the file's fault
         raise InvalidScene(source, json_path, f"cannot read point cloud {file.name!r}: {error}") from None
-    if len(array) > MAX_POINTS:
+    if array.ndim and len(array) > MAX_POINTS:  # a 0-d array (one number) is refused by check_points
         raise InvalidScene(
             source, json_path, f"expected at most {MAX_POINTS:,} points, {file.name!r} has {len(array):,}"
         )

@@ -53,7 +53,8 @@ class Camera:
 
 
 def point_box_labels(scene: Scene, base_dir: str | os.PathLike[str] | None) -> np.ndarray | None:
-    """Per-point box index of a simulated scene (``metadata["point_boxes_file"]``; -1: container), or None.
+    """Per-point box index of a simulated scene (``metadata["point_boxes_file"]``; -1: container), or
+    None (no such file, or not one integer from -1 to the number of boxes less one per point).
 
     Examples
     --------
@@ -71,4 +72,7 @@ def point_box_labels(scene: Scene, base_dir: str | os.PathLike[str] | None) -> n
         labels = np.load(path, allow_pickle=False)
     except (OSError, ValueError):
         return None
-    return labels if labels.shape == (len(scene.points),) else None
+    if labels.shape != (len(scene.points),) or not np.issubdtype(labels.dtype, np.integer):
+        return None
+    # -1 the container, else a box's index: other labels are not this scene's
+    return labels if labels.size == 0 or (labels.min() >= -1 and labels.max() < len(scene.boxes)) else None

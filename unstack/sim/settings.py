@@ -20,7 +20,6 @@ error (:func:`settings_from_json`).
 from __future__ import annotations
 
 import dataclasses
-import math
 import numbers
 import typing
 from dataclasses import dataclass, field
@@ -28,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from unstack.checks import finite_number, number_text
 from unstack.errors import InvalidArgument, InvalidFile, InvalidScene, UnstackError
 
 __all__ = [
@@ -354,9 +354,11 @@ def _field_value(value: Any, kind: Any, name: str, where: str, fail: Any) -> Any
             fail(where, f"expected {'true or false' if kind is bool else 'a string'}, got {value!r:.40}")
         return value
     number = isinstance(value, numbers.Real) and not isinstance(value, bool | np.bool_)
+    if number and finite_number(value) is None:  # NaN, an infinity, an integer too large for a float
+        fail(where, f"expected a finite number, got {number_text(value):.40}")
     if kind is int and not (number and float(value).is_integer()):
         fail(where, f"expected a whole number, got {value!r:.40}")
-    if not number or not math.isfinite(value):
+    if not number:
         fail(where, f"expected a finite number, got {value!r:.40}")
     limit = FIELD_LIMITS.get(name)
     if limit == "extent" and not 0.0 < value <= MAX_EXTENT:
