@@ -5,9 +5,12 @@ from __future__ import annotations
 import io
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 import unstack
 from tests.conftest import assert_one_line_error
@@ -130,3 +133,38 @@ def test_a_document_too_large_even_on_one_line_is_not_written(tmp_path: Path, mo
     assert list(tmp_path.iterdir()) == []
     cloud_scene.save(tmp_path / "small.json", points_file="small.npy")
     assert unstack.load(tmp_path / "small.json").points.shape == (50, 3)
+
+
+def _reference_paths(value: Any, path: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
+    """Every nested value's path, depth first in document order (recursive: the oracle)."""
+    children = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
+    return [found for key, child in children for found in [(*path, key), *_reference_paths(child, (*path, key))]]
+
+
+json_values = st.recursive(
+    st.none() | st.booleans() | st.integers() | st.floats(allow_nan=True, allow_infinity=True) | st.text(max_size=3),
+    lambda inner: st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=3), inner, max_size=4),
+    max_leaves=30,
+)
+
+
+@given(json_values)
+def test_the_walk_of_a_document_meets_every_value_in_document_order(value: Any) -> None:
+    from unstack.jsonio import _find_non_finite, _too_deep, _walk
+
+    reference = _reference_paths(value)
+    assert [tuple(path) for path, _ in _walk(value)] == reference
+    bad = [path for path in reference if isinstance(_get(value, path), float) and not np.isfinite(_get(value, path))]
+    assert [tuple(path) for path in _find_non_finite(value, [])] == ([()] if _is_bad(value) else []) + bad
+    deepest = [path for path in reference if len(path) > 2]
+    assert _too_deep(value, 2) == (list(deepest[0]) if deepest else None)
+
+
+def _get(value: Any, path: tuple[Any, ...]) -> Any:
+    for key in path:
+        value = value[key]
+    return value
+
+
+def _is_bad(value: Any) -> bool:
+    return isinstance(value, float) and not np.isfinite(value)

@@ -102,30 +102,49 @@ def _short(value: Any, limit: int = 40) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
+def _walk(value: Any) -> Iterator[tuple[list[str | int], Any]]:
+    """Every value nested in ``value`` with its JSON path, depth first in the document's order.
+
+    Iterative, with one iterator per open container and one shared path (the caller copies a
+    path it keeps): work in proportion to the values, memory to the depth, so a wide document
+    deep down costs no copy of its path per value.
+    """
+    keys: list[str | int] = []
+    open_containers: list[Iterator[tuple[Any, Any]]] = [_children(value)] if isinstance(value, dict | list) else []
+    while open_containers:
+        step = next(open_containers[-1], None)
+        if step is None:  # this container is done: back to its parent
+            open_containers.pop()
+            if keys:
+                keys.pop()
+            continue
+        key, child = step
+        keys.append(key)
+        yield keys, child
+        if isinstance(child, dict | list):
+            open_containers.append(_children(child))
+        else:
+            keys.pop()
+
+
+def _children(container: dict[str, Any] | list[Any]) -> Iterator[tuple[Any, Any]]:
+    return iter(container.items()) if isinstance(container, dict) else enumerate(container)
+
+
 def _find_non_finite(value: Any, path: list[str | int]) -> Iterator[list[str | int]]:
-    """JSON paths of non-finite numbers, depth first (iterative: no recursion limit)."""
-    stack: list[tuple[Any, list[str | int]]] = [(value, path)]
-    while stack:
-        item, where = stack.pop()
+    """JSON paths of non-finite numbers, in the document's order."""
+    if isinstance(value, float) and not math.isfinite(value):
+        yield path
+    for keys, item in _walk(value):
         if isinstance(item, float) and not math.isfinite(item):
-            yield where
-        elif isinstance(item, dict):
-            stack.extend((child, [*where, key]) for key, child in reversed(list(item.items())))
-        elif isinstance(item, list):
-            stack.extend((child, [*where, index]) for index, child in reversed(list(enumerate(item))))
+            yield [*path, *keys]
 
 
 def _too_deep(value: Any, limit: int) -> list[str | int] | None:
     """The JSON path of the first value nested deeper than ``limit``, or None."""
-    stack: list[tuple[Any, list[str | int]]] = [(value, [])]
-    while stack:
-        item, where = stack.pop()
-        if len(where) > limit:
-            return where
-        if isinstance(item, dict):
-            stack.extend((child, [*where, key]) for key, child in item.items())
-        elif isinstance(item, list):
-            stack.extend((child, [*where, index]) for index, child in enumerate(item))
+    for keys, _ in _walk(value):
+        if len(keys) > limit:
+            return list(keys)
     return None
 
 

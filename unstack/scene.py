@@ -266,6 +266,15 @@ def _ply_vertices(file: Path, source: str, json_path: str) -> tuple[int, int] | 
         raise InvalidScene(
             source, json_path, f"{named}expected a vertex count from 0 to {MAX_POINTS:,}, got {declared:,}"
         )
+    data_bytes = file.stat().st_size - start
+    for name, count in counts.items():  # every row of any element takes a byte at least: plyfile allocates first
+        if not count.isdigit():
+            raise InvalidScene(
+                source, json_path, f"{named}expected a row count of element {name[:40]!r}, got {count[:20]!r}"
+            )
+        if int(count) > data_bytes:
+            raise InvalidScene(source, json_path, f"{named}the header declares {int(count):,} rows of element "
+                               f"{name[:40]!r}, more than the {data_bytes:,} bytes of data after it")  # fmt: skip
     ascii_data = any(line.split()[1:2] == ["ascii"] for line in lines if line.startswith("format"))
     if ascii_data and len(elements) == 1:
         rows = sum(1 for line in file.read_bytes()[start:].splitlines() if line.strip())

@@ -234,6 +234,24 @@ def test_a_ply_whose_header_and_data_disagree_is_refused_in_one_line(
         load_cloud(path)
 
 
+@pytest.mark.parametrize(
+    ("faces", "message"),
+    [("200000000", r"the header declares 200,000,000 rows of element 'face', more than the 24 bytes of data after it"),
+     ("many", r"expected a row count of element 'face', got 'many'")],
+)  # fmt: skip
+def test_a_ply_declaring_more_rows_of_any_element_than_its_bytes_is_refused_before_reading(
+    tmp_path: Path, faces: str, message: str
+) -> None:
+    """plyfile allocates what the header declares before it reads: 200 million faces took 1.6 GB."""
+    header = (
+        "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+        f"property float z\nelement face {faces}\nproperty list uchar int vertex_indices\nend_header\n"
+    )
+    (tmp_path / "cloud.ply").write_bytes(header.encode() + b"\0" * 24)
+    with pytest.raises(InvalidFile, match=rf"cloud.ply: \$: {message}$"):
+        load_cloud(tmp_path / "cloud.ply")
+
+
 @pytest.mark.parametrize("binary", [False, True])
 def test_a_ply_whose_header_and_data_agree_is_read(tmp_path: Path, binary: bool) -> None:
     assert load_cloud(_ply(tmp_path / "cloud.ply", 12, 12, binary=binary)).shape == (12, 3)
