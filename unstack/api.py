@@ -274,8 +274,9 @@ def payoff(scene_or_supports: Scene | Supports, model: ModelArgument = None, *, 
         A scene (its probabilities come from ``model``) or support probabilities.
     model : str, path-like or SupportModel, optional
         For a scene only (default: the default model).
-    cost : {"count", "mass"}
-        Eq. 11's count of supported boxes, or their mass.
+    cost : {"count", "mass", "load"}
+        Eq. 11's count of supported boxes, their mass, or :func:`decide`'s ``load`` (each box with
+        the hidden load on it, the box taken out with its own: the same expected costs).
 
     Returns
     -------

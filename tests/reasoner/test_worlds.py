@@ -58,6 +58,25 @@ def test_mass_weighted_payoff(rng: np.random.Generator) -> None:
     np.testing.assert_allclose(table.expected_costs(), expected, rtol=1e-12)
 
 
+@pytest.mark.parametrize("cost", ["count", "load"])
+def test_the_payoff_matrix_gives_decides_expected_costs(rng: np.random.Generator, cost: str) -> None:
+    """The load cost counts the picked box's own hidden load in every world, as decide does."""
+    from unstack.reasoner.decision import decide
+
+    probabilities = rng.uniform(0.0, 1.0, (4, 4))
+    np.fill_diagonal(probabilities, 0.0)
+    supports = Supports(["a", "b", "c", "d"], probabilities, hidden_load=rng.uniform(0.0, 3.0, 4))
+    table = payoff_matrix(supports, cost=cost)
+    np.testing.assert_allclose(table.expected_costs(), decide(supports, method="exact", cost=cost).expected_costs)
+
+
+def test_the_payoff_matrix_doubts_masses_lighter_than_a_carton_as_decide_does() -> None:
+    supports = Supports(["a", "b"], [[0, 0.5], [0.2, 0]], masses=[1e-300, 12.0])
+    light = "box 'a' (1e-300 kg) weighs less than 0.01 kg, lighter than a carton"
+    assert any(light in warning for warning in payoff_matrix(supports, cost="mass").warnings)
+    assert not payoff_matrix(supports, cost="count").warnings
+
+
 def test_the_payoff_matrix_carries_the_inputs_warnings_into_its_document() -> None:
     doubtful = Supports(["a", "b"], [[0, 0.9], [0.0, 0]], metadata={"warnings": ["box 'a' floats"]})
     table = payoff_matrix(doubtful)

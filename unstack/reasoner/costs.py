@@ -34,6 +34,7 @@ __all__ = [
     "largest_expected_cost",
     "margin_beyond_every_cost",
     "own_costs",
+    "weight_doubts",
 ]
 
 #: The cost models: what unloading a box first costs for each box it supports.
@@ -121,3 +122,20 @@ def margin_beyond_every_cost(supports: Supports, cost: str, name: str, margin: f
         f"{name} {margin:g} is above any expected cost these boxes can have ({bound:.3g} for the {cost} cost): "
         f"every box {what} whatever it holds up, and the highest is taken"
     )
+
+
+def weight_doubts(supports: Supports, cost: str) -> tuple[str, ...]:
+    """What is doubtful in the weights ``cost`` gives the boxes, one sentence each: boxes lighter
+    than a carton for ``"mass"``, more undetected boxes on a box than a stack holds for ``"load"``.
+
+    Examples
+    --------
+    >>> weight_doubts(Supports(["a", "b"], [[0, 0.5], [0.2, 0]], masses=[12.0, 1e-9]), "mass")
+    ("box 'b' (1e-09 kg) weighs less than 0.01 kg, lighter than a carton; masses in kg?",)
+    """
+    from unstack.checks import heavy_loads, light_boxes
+
+    light = light_boxes(supports.objects, supports.masses) if cost == "mass" and supports.masses is not None else None
+    loaded = supports.hidden_load is not None and cost == "load"
+    heavy = heavy_loads(supports.objects, supports.hidden_load) if loaded else None
+    return tuple(supports.named(doubt) for doubt in (light, heavy) if doubt is not None)

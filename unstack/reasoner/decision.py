@@ -51,6 +51,7 @@ from unstack.reasoner.costs import (
     expected_costs,
     margin_beyond_every_cost,
     own_costs,
+    weight_doubts,
 )
 from unstack.reasoner.marginals import EXACT_MAX_BOXES
 from unstack.reasoner.pruning import Evidence, hard_evidence
@@ -676,13 +677,8 @@ def _input_doubts(supports: Supports, cost: str, near_tie_margin: float | None) 
     """What is doubtful in the arguments given with ``supports``: boxes lighter than a carton
     for the mass cost, more undetected boxes on a box than a stack holds for the load cost, a
     near-tie margin above every expected cost."""
-    from unstack.checks import heavy_loads, light_boxes
-
-    light = light_boxes(supports.objects, supports.masses) if cost == "mass" and supports.masses is not None else None
-    loaded = supports.hidden_load is not None and cost == "load"
-    heavy = heavy_loads(supports.objects, supports.hidden_load) if loaded else None
-    doubts = (light, heavy, margin_beyond_every_cost(supports, cost, "near_tie_margin", near_tie_margin))
-    return tuple(supports.named(doubt) for doubt in doubts if doubt is not None)
+    beyond = margin_beyond_every_cost(supports, cost, "near_tie_margin", near_tie_margin)
+    return weight_doubts(supports, cost) + ((supports.named(beyond),) if beyond is not None else ())
 
 
 def _near_tie_margin(supports: Supports, margin: float | None) -> float:

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from unstack.reasoner.costs import cost_weights
+from unstack.reasoner.costs import cost_weights, own_costs, weight_doubts
 from unstack.reasoner.worlds import SAT_MAX_BOXES, WorldSet, enumerate_worlds
 from unstack.supports import Supports
 
@@ -44,7 +44,7 @@ class PayoffMatrix:
     costs : numpy.ndarray, shape (q', n)
         ``costs[i, j]`` = cost of unloading box ``j`` first in world ``i``.
     cost : str
-        ``"count"`` (Eq. 11) or ``"mass"``.
+        ``"count"`` (Eq. 11), ``"mass"`` or ``"load"``.
     warnings : tuple of str
         Doubts about the input (:attr:`unstack.supports.Supports.warnings`), one sentence each.
     """
@@ -106,12 +106,13 @@ def payoff_matrix(supports: Supports, *, cost: str = "count", max_boxes: int = S
     ----------
     supports : Supports
         The detected boxes and their support probabilities.
-    cost : {"count", "mass"}
-        Eq. 11 (number of supported boxes) or the total supported mass.
+    cost : {"count", "mass", "load"}
+        Eq. 11 (number of supported boxes), the total supported mass, or decide's ``load``: each
+        box counted with the hidden load on it, the box taken out with its own.
     max_boxes : int
         Largest scene accepted.
     """
     weights = cost_weights(supports, cost)
     worlds = enumerate_worlds(supports, max_boxes=max_boxes)
-    costs = worlds.worlds.astype(np.float64) @ weights
-    return PayoffMatrix(worlds, costs, cost, supports.warnings)
+    costs = worlds.worlds.astype(np.float64) @ weights + own_costs(supports, cost)  # load: the box's own too
+    return PayoffMatrix(worlds, costs, cost, supports.warnings + weight_doubts(supports, cost))
