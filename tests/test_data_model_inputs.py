@@ -113,6 +113,31 @@ def test_a_mass_above_what_the_schemas_allow_is_refused_in_the_library_too(mass:
         unstack.Box("a", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2], mass=mass)
 
 
+@pytest.mark.parametrize(
+    ("field", "values", "message"),
+    [
+        ("heights", [-100.0, 0.0, 0.0], r"\$\.heights\[0\]: expected a height from -1 to 100 m, got -100"),
+        ("heights", [0.0, 0.0, 1e9], r"\$\.heights\[2\]: expected a height from -1 to 100 m, got 1e\+09"),
+        ("hidden_load", [0.0, 1e9, 0.0], r"\$\.hidden_load\[1\]: expected at most 1,000 boxes, got 1e\+09"),
+    ],
+)
+def test_heights_and_loads_the_schema_refuses_are_refused_in_the_library_too(
+    field: str, values: list[float], message: str
+) -> None:
+    """What the library accepts, it saves as a file it loads again."""
+    with pytest.raises(InvalidSupports, match=message):
+        unstack.Supports(IDS, PROBABILITIES, **{field: values})
+
+
+def test_the_librarys_bounds_on_heights_and_loads_are_the_schemas() -> None:
+    from unstack.checks import HEIGHT_RANGE, REFUSED_HIDDEN_LOAD
+    from unstack.jsonio import load_schema
+
+    fields = load_schema("unstack.supports/1")["properties"]
+    assert (fields["heights"]["items"]["minimum"], fields["heights"]["items"]["maximum"]) == HEIGHT_RANGE
+    assert fields["hidden_load"]["items"]["maximum"] == REFUSED_HIDDEN_LOAD
+
+
 def test_an_empty_file_name_is_said_to_be_empty_not_a_folder() -> None:
     from unstack.errors import InvalidFile
 

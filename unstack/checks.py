@@ -27,6 +27,7 @@ if TYPE_CHECKING:
     from unstack.jsonio import Document
 
 __all__ = [
+    "HEIGHT_RANGE",
     "LIGHT_BOX",
     "MAX_BOX_EDGE",
     "MAX_COORDINATE",
@@ -35,6 +36,7 @@ __all__ = [
     "MAX_MASS",
     "MIN_BOX_EDGE",
     "QUATERNION_NORM_TOLERANCE",
+    "REFUSED_HIDDEN_LOAD",
     "REFUSED_OVERLAP",
     "check_decision_document",
     "check_ids",
@@ -81,6 +83,11 @@ LIGHT_BOX = 0.01
 MAX_HIDDEN_LOAD = 50.0
 #: A box heavier than this (kg) is refused, as the schemas refuse it: a unit error.
 MAX_MASS = 10_000.0
+#: Most undetected boxes one box may carry in a supports document (``hidden_load``; the schema's
+#: maximum): beyond it the number is no load (:data:`MAX_HIDDEN_LOAD` is warned about).
+REFUSED_HIDDEN_LOAD = 1_000.0
+#: The heights a box may rest at in a supports document, metres (``heights``; the schema's bounds).
+HEIGHT_RANGE = (-1.0, 100.0)
 
 
 def number_text(value: Any) -> str:

@@ -21,7 +21,15 @@ from typing import Any
 import numpy as np
 
 from unstack.atomic import atomic_write_text
-from unstack.checks import MAX_MASS, check_ids, check_metadata, check_probability_matrix, check_vector
+from unstack.checks import (
+    HEIGHT_RANGE,
+    MAX_MASS,
+    REFUSED_HIDDEN_LOAD,
+    check_ids,
+    check_metadata,
+    check_probability_matrix,
+    check_vector,
+)
 from unstack.errors import InvalidSupports
 from unstack.frozen import read_only, set_frozen_fields
 from unstack.jsonio import Document, read_document, validate_document
@@ -105,10 +113,20 @@ class Supports:
                 hidden_load, len(ids), source=source, path="$.hidden_load", error=InvalidSupports
             )
             _refuse_first(load_vector, load_vector < 0, source, "$.hidden_load", "a non-negative number")
+            _refuse_first(
+                load_vector,
+                load_vector > REFUSED_HIDDEN_LOAD,
+                source,
+                "$.hidden_load",
+                f"at most {REFUSED_HIDDEN_LOAD:,.0f} boxes",
+            )
             load_vector = read_only(load_vector, hidden_load)
         height_vector = None
         if heights is not None:
             height_vector = check_vector(heights, len(ids), source=source, path="$.heights", error=InvalidSupports)
+            low, high = HEIGHT_RANGE
+            outside = (height_vector < low) | (height_vector > high)
+            _refuse_first(height_vector, outside, source, "$.heights", f"a height from {low:g} to {high:g} m")
             height_vector = read_only(height_vector, heights)
         set_frozen_fields(
             self,
