@@ -41,6 +41,7 @@ __all__ = [
     "check_decision_document",
     "check_ids",
     "check_metadata",
+    "check_payoff_document",
     "check_plan_document",
     "check_points",
     "check_probability_matrix",
@@ -500,6 +501,7 @@ def check_decision_document(document: Document) -> None:
     data, source = document.data, document.source
     objects = data["objects"]
     n = len(objects)
+    _check_unique(objects, source, "$.objects")
     for key in ("expected_costs", "expected_cost_errors"):
         if key in data and len(data[key]) != n:
             raise InvalidFile(source, f"$.{key}", f"expected {n} numbers (one per object), got {len(data[key])}")
@@ -508,16 +510,109 @@ def check_decision_document(document: Document) -> None:
     marginals = data["marginals"]
     if len(marginals) != n or any(len(row) != n for row in marginals):
         raise InvalidFile(source, "$.marginals", f"expected a {n} x {n} matrix (one row and column per object)")
-    float_array(marginals, source=source, path="$.marginals", error=InvalidFile)
+    diagonal = np.flatnonzero(np.diag(float_array(marginals, source=source, path="$.marginals", error=InvalidFile)))
+    if diagonal.size:
+        k = int(diagonal[0])
+        raise InvalidFile(source, f"$.marginals[{k}][{k}]", f"expected 0 on the diagonal, got {marginals[k][k]}")
+    errors = data.get("marginal_errors")
+    if errors is not None and (len(errors) != n or any(len(row) != n for row in errors)):
+        raise InvalidFile(source, "$.marginal_errors", f"expected a {n} x {n} matrix (one row and column per object)")
     known = set(objects)
     if data["choice"] not in known:
         raise InvalidFile(source, "$.choice", f"expected one of the objects, got {data['choice']!r}")
-    for index, box in enumerate(data.get("ties", [])):
-        if box not in known:
-            raise InvalidFile(source, f"$.ties[{index}]", f"expected one of the objects, got {box!r}")
+    _check_known(data.get("ties", []), known, source, "$.ties")
+    components = data.get("components", [])
+    for index, component in enumerate(components):
+        _check_known(component, known, source, f"$.components[{index}]")
+    _check_unique([box for component in components for box in component], source, "$.components")
+    methods = data.get("component_methods")
+    if methods is not None and len(methods) != len(components):
+        raise InvalidFile(source, "$.component_methods", f"expected one method per component ({len(components)})")
+    for kind, pairs in data.get("evidence", {}).items():
+        for index, pair in enumerate(pairs):
+            _check_known(pair, known, source, f"$.evidence.{kind}[{index}]")
+    if "reasons" in data:
+        _check_reasons(data["reasons"], objects, source)
+    pick = data.get("pick", {})
+    if pick.get("height_rank", 1) > pick.get("boxes", n):
+        raise InvalidFile(source, "$.pick.height_rank", f"expected at most the {pick.get('boxes', n)} boxes ranked")
     veto = data.get("physics_veto")
     if veto is not None:
         _check_physics_veto(veto, source)
+
+
+def _check_unique(boxes: Sequence[str], source: str, path: str) -> None:
+    seen: set[str] = set()
+    for box in boxes:
+        if box in seen:
+            raise InvalidFile(source, path, f"expected each box once, {box!r} appears twice")
+        seen.add(box)
+
+
+def _check_known(boxes: Sequence[str], known: set[str], source: str, path: str) -> None:
+    for index, box in enumerate(boxes):
+        if box not in known:
+            raise InvalidFile(source, f"{path}[{index}]", f"expected one of the objects, got {box!r}")
+
+
+def _check_reasons(reasons: list[dict[str, Any]], objects: Sequence[str], source: str) -> None:
+    """One reason per object, in their order; the boxes they name are objects, with probabilities."""
+    if [reason["box"] for reason in reasons] != list(objects):
+        raise InvalidFile(
+            source, "$.reasons", f"expected one reason per object, in the objects' order ({len(objects)})"
+        )
+    known = set(objects)
+    for index, reason in enumerate(reasons):
+        where = f"$.reasons[{index}]"
+        named: list[tuple[str, int | None, Any]] = [
+            ("holds_up", k, entry) for k, entry in enumerate(reason["holds_up"])
+        ]
+        named += [("held_by", None, reason["held_by"])] if reason["held_by"] is not None else []
+        named += [("may_hold_up", None, reason["may_hold_up"])] if "may_hold_up" in reason else []
+        for key, k, entry in named:
+            path = f"{where}.{key}" + ("" if k is None else f"[{k}]")
+            _check_known(entry[:1], known, source, path)
+            probability = finite_number(entry[1])
+            if probability is None or not 0.0 <= probability <= 1.0:
+                raise InvalidFile(
+                    source, f"{path}[1]", f"expected a probability from 0 to 1, got {number_text(entry[1])}"
+                )
+
+
+def check_payoff_document(document: Document) -> None:
+    """What the ``unstack.payoff/1`` schema cannot say: each object once, one expected cost and
+    one cost per world for each, worlds of objects counted as ``consistent_worlds``, their
+    probabilities summing to 1 and the expected costs their weighted sums (Eq. 13).
+
+    Raises
+    ------
+    InvalidFile
+        At the first part that disagrees.
+    """
+    data, source = document.data, document.source
+    objects, worlds = data["objects"], data["worlds"]
+    n, known = len(objects), set(data["objects"])
+    _check_unique(objects, source, "$.objects")
+    if data["consistent_worlds"] != len(worlds):
+        raise InvalidFile(source, "$.consistent_worlds", f"expected the {len(worlds):,} worlds listed")
+    if len(data["expected_costs"]) != n:
+        raise InvalidFile(source, "$.expected_costs", f"expected {n} numbers (one per object)")
+    for index, world in enumerate(worlds):
+        if len(world["costs"]) != n:
+            raise InvalidFile(source, f"$.worlds[{index}].costs", f"expected {n} numbers (one per object)")
+        for k, pair in enumerate(world["supports"]):
+            _check_known(pair, known, source, f"$.worlds[{index}].supports[{k}]")
+    probabilities = float_array([world["probability"] for world in worlds], source=source, error=InvalidFile)
+    if abs(float(probabilities.sum()) - 1.0) > 1e-6:
+        raise InvalidFile(source, "$.worlds", f"expected probabilities summing to 1, got {probabilities.sum():.6g}")
+    costs = float_array([world["costs"] for world in worlds], source=source, path="$.worlds", error=InvalidFile)
+    given = float_array(data["expected_costs"], source=source, path="$.expected_costs", error=InvalidFile)
+    weighted = probabilities @ costs.reshape(len(worlds), n)
+    off = np.flatnonzero(~np.isclose(given, weighted, rtol=1e-6, atol=1e-9))
+    if off.size:
+        k = int(off[0])
+        raise InvalidFile(source, f"$.expected_costs[{k}]", f"expected the worlds' weighted cost {weighted[k]:.6g}, "
+                          f"got {given[k]:.6g}")  # fmt: skip
 
 
 def _check_physics_veto(veto: dict[str, Any], source: str) -> None:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 
-from unstack.checks import check_decision_document, check_plan_document
+from unstack.checks import check_decision_document, check_payoff_document, check_plan_document
 from unstack.jsonio import read_document, validate_document
 
 __all__ = ["Validated", "validate"]
@@ -97,6 +97,7 @@ def validate(path: str | os.PathLike[str]) -> Validated:
         settings_from_json(document.data["settings"], source=document.source, path="$.settings")
         detail = f"{document.data['configs']} configurations, seed {document.data['seed']}"
     elif tag == "unstack.payoff/1":
+        check_payoff_document(document)
         detail = f"{document.data['consistent_worlds']} consistent worlds"
     else:
         check_decision_document(document)
