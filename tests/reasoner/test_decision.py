@@ -257,3 +257,19 @@ def test_a_time_limit_for_a_method_that_cannot_stop_early_is_refused(method: str
 def test_a_progress_that_cannot_be_called_is_refused_before_any_step() -> None:
     with pytest.raises(InvalidArgument, match="progress must be a callable progress\\(done, total\\), got int"):
         unloading_plan(Supports(["a", "b"], [[0, 0.2], [0.7, 0]]), progress=42)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("seconds", "methods", "said"),
+    [
+        (1.1, ["approx"], None),  # within 1.5 times the limit and a second
+        (5.6, ["approx"], "the least sampling of a group of 3 linked boxes"),
+        (5.6, ["exact"], "reading the evidence and counting took longer"),
+    ],
+)
+def test_a_decision_far_past_its_time_limit_says_why(seconds: float, methods: list[str], said: str | None) -> None:
+    from unstack.reasoner.decision import _overrun
+
+    warning = _overrun(0.1, seconds, [[0, 1, 2]], methods)
+    assert (warning == ()) if said is None else (said in warning[0] and f"took {seconds:.1f} s" in warning[0])
+    assert _overrun(None, 100.0, [[0, 1, 2]], methods) == ()

@@ -94,6 +94,9 @@ HIGH_RHAT = 1.1
 NEAR_CERTAIN = 1e-3
 #: Near-certain relations named one by one in that warning, before "and N more".
 NAMED_PAIRS = 3
+#: A decision taking this many times its time limit (and a second more) says so: the least a
+#: sampled group needs (scattering, burn-in, two batches of sweeps) can exceed any budget.
+OVERRUN = 1.5
 #: Relative tolerance under which two expected costs count as tied.
 TIE_TOLERANCE = 1e-12
 #: Expected costs within this many boxes of the lowest count as tied when heights are known;
@@ -617,6 +620,7 @@ def decide(
     sampling_warning: tuple[str, ...] = (sampling["warning"],) if sampling and "warning" in sampling else ()
     sampled_groups = [group for group, used in zip(groups, methods, strict=True) if used == "approx" and len(group) > 1]
     sampling_warning += _near_certain_doubt(supports, evidence.probabilities, sampled_groups)
+    sampling_warning += _overrun(time_limit, time.perf_counter() - start, groups, methods)
     return Decision(
         objects=supports.objects,
         choice=choice,
@@ -641,6 +645,20 @@ def decide(
         near_tie_margin=margin,
         reasons=tuple(pick_reasons(supports, marginals, costs)) if cost in REASON_COSTS else (),
     )
+
+
+def _overrun(time_limit: float | None, seconds: float, groups: list[Any], methods: list[str]) -> tuple[str, ...]:
+    """A warning when the decision took well past its time limit, naming the largest sampled group."""
+    if time_limit is None or seconds <= OVERRUN * time_limit + 1.0:
+        return ()
+    sampled = max((len(group) for group, used in zip(groups, methods, strict=True) if used == "approx"), default=0)
+    cause = (
+        f"the least sampling of a group of {sampled} linked boxes (scattering, burn-in and two batches of sweeps) "
+        "takes longer"
+        if sampled
+        else "reading the evidence and counting took longer"
+    )
+    return (f"the decision took {seconds:.1f} s against a time limit of {time_limit:g} s: {cause}",)
 
 
 def _near_certain_doubt(
