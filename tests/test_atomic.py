@@ -88,18 +88,27 @@ def test_an_output_with_the_longest_name_the_file_system_allows_is_written(tmp_p
     assert target.read_text() == "{}" and [path.name for path in tmp_path.iterdir()] == [target.name]
 
 
-@pytest.mark.parametrize("kind", ["fifo", "loop"])
+@pytest.mark.parametrize("kind", ["fifo", "link-to-a-pipe", "loop"])
 def test_an_output_that_is_a_pipe_or_a_symlink_loop_is_refused(tmp_path: Path, kind: str) -> None:
+    """A link to a pipe is what /dev/stdout is when the output goes into one."""
     import os
 
     target = tmp_path / "out.json"
     if kind == "fifo":
         os.mkfifo(target)
+    elif kind == "link-to-a-pipe":
+        pipe = os.pipe()
+        target.symlink_to(f"/proc/self/fd/{pipe[1]}")  # the pipe's end through /proc, as /dev/stdout links it
     else:
         target.symlink_to(tmp_path / "other.json")
         (tmp_path / "other.json").symlink_to(target)
-    with pytest.raises(InvalidArgument, match=r"cannot write there: it is a (pipe|symlink loop)"):
-        check_output_path(target)
+    try:
+        with pytest.raises(InvalidArgument, match=r"cannot write there: it is a (pipe|symlink loop)"):
+            check_output_path(target)
+    finally:
+        if kind == "link-to-a-pipe":
+            os.close(pipe[0])
+            os.close(pipe[1])
 
 
 def test_a_folder_writer_excludes_a_second_writer_and_leaves_no_lock(tmp_path: Path) -> None:

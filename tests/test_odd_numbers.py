@@ -113,3 +113,10 @@ def test_point_labels_of_no_box_are_not_used(tmp_path: Path, labels: np.ndarray)
     assert point_box_labels(scene, tmp_path) is None
     np.save(tmp_path / "labels.npy", np.array([-1, 0, 0]))
     assert point_box_labels(scene, tmp_path).tolist() == [-1, 0, 0]
+
+
+def test_validate_checks_the_physics_vetos_container_as_the_veto_does(tmp_path: Path) -> None:
+    file = tmp_path / "scene.json"
+    file.write_text(json.dumps(_scene_document(metadata={"container": {"depth": -1, "width": 2.35, "height": 2.39}})))
+    with pytest.raises(UnstackError, match=r"\$\.metadata\.container\.depth: expected a positive extent"):
+        unstack.validate(file)

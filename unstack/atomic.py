@@ -117,11 +117,11 @@ def check_output_path(path: str | os.PathLike[str], *, inputs: Iterable[str | os
     if str(path).endswith(("/", os.sep)):
         raise InvalidArgument(f"{path}: expected a file name for the output, got a folder's (it ends with '/')")
     target = Path(path)
-    if target.is_symlink():  # write through the link: a rename onto it would replace the link itself
-        target = Path(os.path.realpath(target))
-    kind = special_file(target)
+    kind = special_file(target)  # through any link: /dev/stdout is a pipe or a terminal
     if kind is not None:  # a rename would replace a pipe or a device with a file
         raise InvalidArgument(f"{path}: cannot write there: it is {kind}, not a regular file")
+    if target.is_symlink():  # write through the link: a rename onto it would replace the link itself
+        target = Path(os.path.realpath(target))
     for given in inputs:
         if given is not None and str(given) != "-" and _same_file(target, Path(given)):
             raise InvalidArgument(f"{path}: cannot write there: it is the input file {given}")

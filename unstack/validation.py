@@ -86,6 +86,10 @@ def validate(path: str | os.PathLike[str]) -> Validated:
 
         scene = Scene.from_document(document)
         scene_settings(scene)
+        if "container" in scene.metadata:  # the physics veto's container, checked as the veto checks it
+            from unstack.physics_veto import world_settings
+
+            world_settings(scene)
         detail = f"{len(scene.boxes)} boxes, {len(scene.detected)} detected, {len(scene.points):,} points"
         return Validated(document.source, tag, detail, tuple(scene_warnings(scene)))
     elif tag == "unstack.plan/1":
