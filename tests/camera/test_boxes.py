@@ -115,3 +115,35 @@ def test_a_box_seen_from_the_front_only_takes_the_deeper_of_two_sizes_sharing_it
     assert sorted(fitted.box.size) == pytest.approx([0.3, 0.3, 0.4])
     assert fitted.box.position[0] == pytest.approx(2.2, abs=0.01)  # the box lies behind its front
     assert fitted.partial
+
+
+def _top_grid() -> np.ndarray:
+    """A 0.5 x 0.4 m top at 0.4 m, one point a centimetre, 3.5-4 m from :data:`CAMERA`."""
+    x, y = np.meshgrid(np.arange(1.0, 1.5001, 0.01), np.arange(-0.2, 0.2001, 0.01))
+    return np.column_stack([x.ravel(), y.ravel(), np.full(x.size, 0.4)])
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_top_blurred_along_the_rays_is_measured_to_its_edges(seed: int) -> None:
+    """Noise of 1.4 cm along the rays (a Kinect at 3 m) spreads the top 5-6 cm past its edges."""
+    from unstack.camera.boxes import _spacing, _unblurred, min_area_rectangle
+
+    top = _top_grid()
+    rays = (top - CAMERA) / np.linalg.norm(top - CAMERA, axis=1, keepdims=True)
+    blurred = (top + rays * np.random.default_rng(seed).normal(0.0, 0.014, (len(top), 1)))[:, :2]
+    centre, yaw, extents = min_area_rectangle(blurred)
+    extents = extents + _spacing(blurred)
+    assert extents[0] > 0.55  # the extreme points: 5 cm long and more
+    centre, unblurred = _unblurred(blurred, centre, yaw, extents)
+    assert unblurred == pytest.approx([0.51, 0.41], abs=0.012)
+    assert centre == pytest.approx([1.25, 0.0], abs=0.01)
+
+
+def test_a_sharp_top_keeps_its_rectangle() -> None:
+    from unstack.camera.boxes import _spacing, _unblurred, min_area_rectangle
+
+    flat = _top_grid()[:, :2]
+    centre, yaw, extents = min_area_rectangle(flat)
+    extents = extents + _spacing(flat)
+    kept_centre, kept = _unblurred(flat, centre, yaw, extents)
+    assert np.array_equal(kept, extents) and np.array_equal(kept_centre, centre)

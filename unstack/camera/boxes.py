@@ -90,6 +90,15 @@ SQUARE_TOLERANCE_DEG = 20.0
 #: A level plane under the rest of a mask's points, holding less than this share of them, is a
 #: surface the mask bled onto (left out).
 BLEED_SHARE = 0.35
+#: Depth noise moves a top's points along the camera's rays, and a door camera sees tops at a
+#: grazing angle: the points stay in the face's band but spread centimetres past its edges. An
+#: edge whose outer points lie this many times sparser than the face's (third-neighbour distances)
+#: is put where the points' density falls to half of that just inside it; a sharp edge (exact
+#: depth, or a top cut off by a box in front) is kept.
+BLURRED_EDGE_SPARSITY = 1.2
+#: The density profile along a top's edges is counted in bins this wide at least (metres), or the
+#: points' spacing.
+EDGE_BIN_M = 0.005
 #: A point whose third nearest neighbour is this many times further than the median is a stray
 #: (a flying pixel), left out of a top's rectangle and of a tilted box's extents.
 STRAY_SPREAD = 3.0
@@ -462,6 +471,7 @@ def _fit_from_top(
     residual = float(np.sqrt(np.mean((face @ normal - offset) ** 2)))
     centre, yaw, extents = min_area_rectangle(face[:, :2])
     extents = extents + _spacing(face[:, :2])  # pixel samples stop half a spacing short of each edge
+    centre, extents = _unblurred(face[:, :2], centre, yaw, extents)
     front = _front_face(points[~inliers], rng, TOP_SHARE)
     seen_height = 0.0
     if front is not None:
@@ -485,7 +495,7 @@ def _fit_from_top(
         toward = front[0][:2] / np.linalg.norm(front[0][:2])  # out of the box, towards the door
         along = int(np.argmax(np.abs(axes @ toward)))
         direction = axes[along] * np.sign(axes[along] @ toward)
-        near_now = float(np.max((face[:, :2] - centre) @ direction))
+        near_now = min(float(np.max((face[:, :2] - centre) @ direction)), extents[along] / 2)  # a blurred edge
         centre = centre + direction * (near_now - size[along] / 2)
     if turned:
         yaw += np.pi / 2
@@ -493,6 +503,41 @@ def _fit_from_top(
     partial = fill < PARTIAL_FILL or bool(np.any(np.sort(size[:2])[::-1] - extents > PARTIAL_EDGE))
     box = Box(box_id, size, [centre[0], centre[1], top - size[2] / 2], _yaw_quaternion(yaw))
     return FittedBox(box, "top", residual, fill, size_error, len(points), partial)
+
+
+def _unblurred(xy: np.ndarray, centre: np.ndarray, yaw: float, extents: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The rectangle ``(centre, extents)`` of a top's points ``xy`` with each edge that depth noise
+    blurred moved in (see :data:`BLURRED_EDGE_SPARSITY`)."""
+    from scipy.spatial import cKDTree
+
+    axes = np.array([[np.cos(yaw), np.sin(yaw)], [-np.sin(yaw), np.cos(yaw)]])
+    local = (xy - centre) @ axes.T
+    crowding = cKDTree(xy).query(xy, k=4)[0][:, 3]
+    sparse_from = BLURRED_EDGE_SPARSITY * float(np.median(crowding))
+    width = max(EDGE_BIN_M, _spacing(xy))
+    lows, highs = -extents / 2, extents / 2
+    for k in range(2):
+        counts, edges = np.histogram(
+            local[:, k], bins=max(4, int(np.ceil(extents[k] / width))), range=(lows[k], highs[k])
+        )
+        n = len(counts)
+        if n < 8:
+            continue
+        skip, band = max(1, n // 10), max(3, n // 4)
+        inside = (float(np.median(counts[skip : skip + band])), float(np.median(counts[n - skip - band : n - skip])))
+        low = 0
+        while low < n // 2 and counts[low] < 0.5 * inside[0]:
+            low += 1
+        beyond = local[:, k] < edges[low]
+        if low >= 2 and beyond.sum() >= 3 and np.median(crowding[beyond]) > sparse_from:
+            lows[k] = edges[low]
+        high = n - 1
+        while high > n // 2 and counts[high] < 0.5 * inside[1]:
+            high -= 1
+        beyond = local[:, k] > edges[high + 1]
+        if n - 1 - high >= 2 and beyond.sum() >= 3 and np.median(crowding[beyond]) > sparse_from:
+            highs[k] = edges[high + 1]
+    return centre + (lows + highs) / 2 @ axes, highs - lows
 
 
 def _strays(flat: np.ndarray) -> np.ndarray:
