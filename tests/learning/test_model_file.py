@@ -70,12 +70,96 @@ def test_bad_files_are_one_line_errors(tmp_path: Path, fitted: tuple[SupportClas
         ): r"\$.format: unsupported model format 'unstack.model/9'",
         write_payload(
             tmp_path / "nometa.skops", {"format": MODEL_FORMAT, "estimator": classifier.estimator_}
-        ): r"\$.metadata: expected the model's metadata and estimator",
+        ): r"\$: expected the keys format, metadata, estimator; missing: metadata",
     }
     for path, message in cases.items():
         with pytest.raises(InvalidModel, match=message) as caught:
             load_model(path)
         assert "\n" not in str(caught.value)
+
+
+GOOD_METADATA = {"features": FeatureSettings().to_dict()}
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"metadata": json.dumps("hello")}, r"\$\.metadata: expected a JSON object, got a string"),
+        ({"metadata": "null"}, r"\$\.metadata: expected a JSON object, got null"),
+        ({"metadata": "[" * 100_000 + "]" * 100_000}, r"\$\.metadata: expected JSON nested at most 64 levels deep"),
+        ({"metadata": json.dumps({**GOOD_METADATA, "x": [[[[[[[[[[0]]]]]]]]]] * 7})}, None),  # 10 deep: read
+        ({"format": np.array([MODEL_FORMAT])}, r"\$\.format: unsupported model format array"),
+        ({"padding": np.zeros(8)}, r"\$: expected the keys format, metadata, estimator; unknown: padding"),
+        (
+            {"metadata": json.dumps({"features": {**FeatureSettings().to_dict(), "offset": True}})},
+            r"\$\.metadata\.features\.offset: expected a finite number, got True",
+        ),
+        (
+            {"metadata": json.dumps({"features": {**FeatureSettings().to_dict(), "sigma": -1}})},
+            r"\$\.metadata\.features: feature settings need 0 < sigma",
+        ),
+    ],
+    ids=["text", "null", "deep", "shallow", "format-array", "unknown-key", "bool-offset", "negative-sigma"],
+)
+def test_a_payload_at_odds_with_the_model_format_is_refused_by_path(
+    tmp_path: Path, fitted: tuple[SupportClassifier, np.ndarray], change: dict[str, object], message: str | None
+) -> None:
+    classifier, _ = fitted
+    payload = {"format": MODEL_FORMAT, "metadata": json.dumps(GOOD_METADATA), "estimator": classifier.estimator_}
+    path = write_payload(tmp_path / "model.skops", {**payload, **change})
+    if message is None:
+        assert load_model(path).features == FeatureSettings()
+        return
+    with pytest.raises(InvalidModel, match=message):
+        load_model(path)
+
+
+@pytest.mark.parametrize(
+    "bounds", [[0.0, "1"], [False, True], {"lo": 0, "hi": 1}, [1.0, 0.0], [0.0, 1.0, 2.0], [float("nan"), 1.0]]
+)
+def test_feature_ranges_of_no_two_ordered_numbers_are_refused(
+    tmp_path: Path, fitted: tuple[SupportClassifier, np.ndarray], bounds: object
+) -> None:
+    from unstack.learning.features import feature_names
+
+    classifier, _ = fitted
+    names = feature_names(FeatureSettings())
+    ranges = {name: [0.0, 1.0] for name in names} | {names[3]: bounds}
+    metadata = json.dumps({**GOOD_METADATA, "feature_ranges": ranges})
+    path = write_payload(
+        tmp_path / "m.skops", {"format": MODEL_FORMAT, "metadata": metadata, "estimator": classifier.estimator_}
+    )
+    with pytest.raises(InvalidModel, match=rf"\$\.metadata\.feature_ranges\.{names[3]}: expected \[low, high\]"):
+        load_model(path)
+
+
+def test_a_small_file_that_unpacks_to_more_than_a_model_may_hold_is_refused_unread(
+    tmp_path: Path, fitted: tuple[SupportClassifier, np.ndarray], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from unstack.learning import model_file
+
+    classifier, _ = fitted
+    payload = {"format": MODEL_FORMAT, "metadata": json.dumps(GOOD_METADATA), "estimator": classifier.estimator_}
+    path = tmp_path / "m.skops"
+    path.write_bytes(skops.io.dumps(payload, compression=zipfile.ZIP_DEFLATED, compresslevel=9))
+    unpacked = sum(member.file_size for member in zipfile.ZipFile(path).infolist())
+    monkeypatch.setattr(model_file, "MAX_MODEL_BYTES", unpacked - 1)  # a limit this file passes by one byte
+    with pytest.raises(InvalidModel, match=r"\$: expected a model of at most 0 MiB, this one unpacks to"):
+        load_model(path)
+    monkeypatch.setattr(model_file, "MAX_MODEL_BYTES", unpacked)
+    assert load_model(path).features == FeatureSettings()
+
+
+def test_a_three_class_estimator_is_no_support_model(tmp_path: Path) -> None:
+    from sklearn.linear_model import LogisticRegression
+
+    rng = np.random.default_rng(3)
+    three = LogisticRegression().fit(rng.normal(size=(60, 19)), np.arange(60) % 3)
+    path = write_payload(
+        tmp_path / "m.skops", {"format": MODEL_FORMAT, "metadata": json.dumps(GOOD_METADATA), "estimator": three}
+    )
+    with pytest.raises(InvalidModel, match=r"\$\.estimator: expected the classes 0 and 1 \(1: supports\), got 0, 1, 2"):
+        load_model(path)
 
 
 def test_a_file_with_untrusted_types_is_refused_naming_them(tmp_path: Path) -> None:

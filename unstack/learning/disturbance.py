@@ -36,7 +36,7 @@ from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from unstack.atomic import atomic_write_bytes
-from unstack.learning.model_file import InvalidModel, openmp_limit, read_payload
+from unstack.learning.model_file import InvalidModel, openmp_limit, read_metadata, read_payload
 from unstack.learning.pick_features import PICK_FEATURES
 
 __all__ = [
@@ -177,12 +177,10 @@ def load_disturbance_model(path: str | os.PathLike[str] | None = None) -> Distur
     path = default_disturbance_path() if path is None else path
     source = str(path)
     payload = read_payload(path, DISTURBANCE_FORMAT)
-    try:
-        metadata = json.loads(payload["metadata"])
-        features = tuple(metadata.pop("features"))
-        estimator = payload["estimator"]
-    except (KeyError, TypeError, ValueError) as error:
-        raise InvalidModel(source, "$.metadata", f"expected the model's metadata and estimator: {error}") from error
+    metadata = read_metadata(payload, source)
+    given = metadata.pop("features", None)
+    features = tuple(given) if isinstance(given, list) else ()
+    estimator = payload["estimator"]
     if features != PICK_FEATURES:
         raise InvalidModel(
             source, "$.metadata.features", f"expected the {len(PICK_FEATURES)} pick features of this version"

@@ -39,6 +39,7 @@ import numpy as np
 from threadpoolctl import ThreadpoolController
 
 from unstack.atomic import atomic_write_bytes
+from unstack.checks import finite_number
 from unstack.errors import InvalidFile
 from unstack.jsonio import refuse_special_file
 from unstack.learning.classifier import SupportClassifier
@@ -122,6 +123,13 @@ EXTRA_TRUSTED_TYPES = (
     "sklearn.calibration._SigmoidCalibration",
     "sklearn.ensemble._hist_gradient_boosting.predictor.TreePredictor",
 )
+
+
+#: What a model file may unpack to at most (bytes, the zip members' sizes summed): the shipped
+#: models unpack to under 1 MB; a small file that unpacks to gigabytes is refused before it is.
+MAX_MODEL_BYTES = 256 * 2**20
+#: The keys of a model file's payload.
+PAYLOAD_KEYS = ("format", "metadata", "estimator")
 
 
 class InvalidModel(InvalidFile):
@@ -313,19 +321,55 @@ def load_model(path: str | os.PathLike[str]) -> SupportModel:
         Not a readable file, not a skops file, types skops does not trust, not an
         ``unstack.model/1`` payload, or a model of another version.
     """
+    from unstack.errors import UnstackError
+
     source = str(path)
     payload = read_payload(path, MODEL_FORMAT)
+    metadata = read_metadata(payload, source)
+    given = metadata.pop("features", None)
+    if not isinstance(given, dict):
+        raise InvalidModel(source, "$.metadata.features", "expected the feature settings (a JSON object)")
+    for key, value in given.items():
+        if key != "feature_set" and key != "dbaf_method" and finite_number(value) is None:
+            raise InvalidModel(source, f"$.metadata.features.{key}", f"expected a finite number, got {value!r:.40}")
     try:
-        metadata = json.loads(payload["metadata"])
-        features = FeatureSettings(**metadata.pop("features"))
-        estimator = payload["estimator"]
-    except (KeyError, TypeError, ValueError) as error:
-        raise InvalidModel(source, "$.metadata", f"expected the model's metadata and estimator: {error}") from error
+        features = FeatureSettings(**given)
+    except TypeError as error:
+        raise InvalidModel(source, "$.metadata.features", f"expected the feature settings: {error}") from None
+    except UnstackError as error:
+        raise InvalidModel(source, "$.metadata.features", str(error)) from None
+    estimator = payload["estimator"]
     if not hasattr(estimator, "predict_proba"):
         raise InvalidModel(source, "$.estimator", "expected a fitted classifier with predict_proba")
     model = SupportModel(estimator, features, metadata, source=source)
     _check_usable(model)
     return model
+
+
+def read_metadata(payload: dict[str, Any], source: str) -> dict[str, Any]:
+    """The JSON object a model file's ``metadata`` text holds (NaN allowed: a score not measured).
+
+    Raises
+    ------
+    InvalidModel
+        Not JSON text, nested deeper than files may be, or not an object.
+    """
+    from unstack.jsonio import MAX_DEPTH, _json_kind, _too_deep
+
+    text = payload["metadata"]
+    if not isinstance(text, str):
+        raise InvalidModel(source, "$.metadata", f"expected JSON text, got {type(text).__name__}")
+    try:
+        metadata = json.loads(text)
+    except RecursionError:
+        raise InvalidModel(source, "$.metadata", f"expected JSON nested at most {MAX_DEPTH} levels deep") from None
+    except ValueError as error:
+        raise InvalidModel(source, "$.metadata", f"expected JSON text: {error}") from None
+    if not isinstance(metadata, dict):
+        raise InvalidModel(source, "$.metadata", f"expected a JSON object, got {_json_kind(metadata)}")
+    if _too_deep(metadata, MAX_DEPTH) is not None:
+        raise InvalidModel(source, "$.metadata", f"expected JSON nested at most {MAX_DEPTH} levels deep")
+    return metadata
 
 
 def read_payload(path: str | os.PathLike[str], expected_format: str) -> dict[str, Any]:
@@ -353,6 +397,16 @@ def read_payload(path: str | os.PathLike[str], expected_format: str) -> dict[str
     if not zipfile.is_zipfile(io.BytesIO(data)):
         raise InvalidModel(source, "$", "expected an unstack model file (a skops file), got something else")
     try:
+        with zipfile.ZipFile(io.BytesIO(data)) as archive:
+            unpacked = sum(member.file_size for member in archive.infolist())
+    except (zipfile.BadZipFile, OSError) as error:
+        raise InvalidModel(source, "$", f"expected an unstack model file (a skops file): {error}") from None
+    if len(data) > MAX_MODEL_BYTES or unpacked > MAX_MODEL_BYTES:
+        raise InvalidModel(
+            source, "$", f"expected a model of at most {MAX_MODEL_BYTES / 2**20:.0f} MiB, this one unpacks to "
+            f"{max(unpacked, len(data)) / 2**20:,.0f} MiB"
+        )  # fmt: skip
+    try:
         untrusted = skops.io.get_untrusted_types(data=data)
     except Exception as error:  # any failure to parse means "not a model"
         raise InvalidModel(source, "$", f"expected an unstack model file (a skops file): {error}") from error
@@ -365,10 +419,15 @@ def read_payload(path: str | os.PathLike[str], expected_format: str) -> dict[str
         raise InvalidModel(source, "$", f"the skops file does not load: {error}") from error
     if not isinstance(payload, dict) or "format" not in payload:
         raise InvalidModel(source, "$", "expected an unstack model (a dict with 'format'), got another skops object")
-    if payload["format"] != expected_format:
+    if not isinstance(payload["format"], str) or payload["format"] != expected_format:
         raise InvalidModel(
-            source, "$.format", f"unsupported model format {payload['format']!r}; expected {expected_format}"
+            source, "$.format", f"unsupported model format {payload['format']!r:.80}; expected {expected_format}"
         )
+    unknown = sorted(str(key) for key in payload if key not in PAYLOAD_KEYS)
+    missing = [key for key in PAYLOAD_KEYS if key not in payload]
+    if unknown or missing:
+        odd = f"unknown: {', '.join(unknown)[:80]}" if unknown else f"missing: {', '.join(missing)}"
+        raise InvalidModel(source, "$", f"expected the keys {', '.join(PAYLOAD_KEYS)}; {odd}")
     return payload
 
 
@@ -384,9 +443,9 @@ def _check_usable(model: SupportModel) -> None:
     classes = getattr(estimator, "classes_", None)
     if classes is None:
         raise InvalidModel(source, "$.estimator", "expected a fitted classifier, got one that was never fitted")
-    if 1 not in list(classes):  # what support_probability looks up
+    if sorted(np.asarray(classes).tolist()) != [0, 1]:  # support_probability reads the class 1
         labels = ", ".join(str(label) for label in classes)
-        raise InvalidModel(source, "$.estimator", f"expected the classes 0 and 1 (1: supports), got {labels}")
+        raise InvalidModel(source, "$.estimator", f"expected the classes 0 and 1 (1: supports), got {labels:.80}")
     width = getattr(estimator, "n_features_in_", None)
     if width is not None and int(width) != len(names):
         raise InvalidModel(
@@ -400,10 +459,16 @@ def _check_usable(model: SupportModel) -> None:
             raise InvalidModel(
                 source, "$.metadata.feature_ranges", f"expected a [low, high] range for each of: {', '.join(names)}"
             )
-        try:
-            middle = np.array([[(float(ranges[name][0]) + float(ranges[name][1])) / 2 for name in names]])
-        except (TypeError, ValueError, IndexError) as error:
-            raise InvalidModel(source, "$.metadata.feature_ranges", f"expected [low, high] numbers: {error}") from error
+        for name in names:
+            bounds = ranges[name]
+            pair = [finite_number(bound) for bound in bounds] if isinstance(bounds, list) and len(bounds) == 2 else []
+            if len(pair) != 2 or pair[0] is None or pair[1] is None or pair[0] > pair[1]:
+                raise InvalidModel(
+                    source,
+                    f"$.metadata.feature_ranges.{name}",
+                    f"expected [low, high]: two finite numbers, low <= high, got {bounds!r:.60}",
+                )
+        middle = np.array([[(float(ranges[name][0]) + float(ranges[name][1])) / 2 for name in names]])
     else:
         middle = np.zeros((1, len(names)))
     model.support_probability(middle)
