@@ -43,6 +43,7 @@ __all__ = [
     "FOLDS",
     "ISET_SIZE",
     "JOBS",
+    "LEARNING_SEED",
     "MAX_CONFIGS",
     "MAX_FOLDS",
     "MAX_JOBS",
@@ -199,6 +200,8 @@ COUNT = Interval(int, 1)
 OPTIONAL_COUNT = Interval(int, 1, optional=True)
 #: A seed: a non-negative integer.
 SEED = Interval(int, 0)
+#: A seed scikit-learn takes as ``random_state``: 0 to 2**32 - 1 (numpy's legacy seeding).
+LEARNING_SEED = Interval(int, 0, 2**32 - 1)
 #: The most worker processes a call starts (beyond, a typing slip: each is a whole Python).
 MAX_JOBS = 256
 #: Worker processes: at least one, at most :data:`MAX_JOBS`.

@@ -60,6 +60,11 @@ REFUSALS = [
     ([*DETECTED, "--sizes", "0.4x0.3x0.3", "--ids", "a,b"], "--sizes and --ids apply to mask files and a depth image"),
     ([*DETECTED, "--depth-units", "mm"], "--depth-units apply to mask files and a depth image"),
     ([*DETECTED, "--intrinsics", "{tmp}/k.json"], "--intrinsics: for a depth image, not for --cloud (a cloud takes"),
+    (["train", "{tmp}", "-o", "{tmp}/m.skops", "--seed", "4294967296"], "seed must be at most 4,294,967,295"),
+    (
+        ["experiment", "fig5a", "{tmp}", "--out", "{tmp}/r", "--seed", "4294967296"],
+        "seed must be at most 4,294,967,295",
+    ),
     ([*SIMULATE, "--sizes", "paper3"], "'paper3' is not one of 'paper2', 'four', 'mixed'"),
     ([*SIMULATE, "--boxes", "40-30"], "box range 40-30 is reversed"),
     ([*SIMULATE, "--boxes", "many"], "--boxes: expected COUNT or LOW-HIGH (for example 30-40), got 'many'"),

@@ -103,3 +103,15 @@ def test_isets_larger_than_a_pile_can_give_are_warned_about_with_the_sizes_drawn
     with pytest.warns(UserWarning, match=r"r = 100 is more than 8 of the 8 piles can give: their ISets hold \d+(-\d+)? "
                       r"boxes \(one fewer than the pile's detected boxes\)"):  # fmt: skip
         dataset_examples(small_dataset, r=100, isets=1, seed=0)
+
+
+@pytest.mark.parametrize("width", [15, 36])
+def test_a_pile_that_gives_no_examples_stacks_with_the_features_of_any_set(width: int) -> None:
+    """A pile of one detected box gives no ISet; its empty part was 19 columns wide whatever the set."""
+    from unstack.learning.training_data import SupportExamples
+
+    none = SupportExamples.concatenate([])
+    some = SupportExamples(np.ones((2, width)), np.array([0, 1]), np.zeros(2, np.int64), np.zeros(2, np.int64),
+                           [("a", "b"), ("b", "a")])  # fmt: skip
+    assert SupportExamples.concatenate([none, some, none]).features.shape == (2, width)
+    assert SupportExamples.concatenate([none], width=width).features.shape == (0, width)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 from pathlib import Path
@@ -13,14 +14,14 @@ from rich.table import Table
 from rich.text import Text
 
 from unstack.cli.main import STATICS_HELP, data_dir_argument, model_path_option
-from unstack.cli.options import constrained
+from unstack.cli.options import Checked, constrained
 from unstack.cli.text import counted
 from unstack.errors import UnstackError
 from unstack.jsonio import report_text
 from unstack.learning.choices import LEARNERS, SPLITS
 from unstack.learning.features import FEATURE_SETS
 from unstack.learning.training_data import ISET_DRAWS, dataset_examples
-from unstack.parameters import MAX_FOLDS, MAX_JOBS
+from unstack.parameters import LEARNING_SEED, MAX_FOLDS, MAX_JOBS
 
 __all__ = ["evaluate", "load_support_model", "metrics_view", "probabilities", "scene_supports", "train"]
 
@@ -137,8 +138,8 @@ def _files_in(folder: str) -> list[Path]:
               help="Show each ISet its cloud as another sensor might: sparser, noisier, with holes.")  # fmt: skip
 @click.option("--pose-noise", type=constrained(dataset_examples, "pose_noise"), default=0.0, show_default=True,
               help="Show each ISet its boxes as a detector reports them: errors of this many m (0-0.1).")  # fmt: skip
-@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
-              help="Seed of the ISets, the split and the folds.")  # fmt: skip
+@click.option("--seed", type=Checked(int, functools.partial(LEARNING_SEED.check, name="seed")), default=0,
+              show_default=True, help="Seed of the ISets, the split and the folds (0 to 2**32 - 1).")  # fmt: skip
 @click.option("--split-by", type=click.Choice(list(SPLITS)), default="pairs", show_default=True,
               help="pairs: the paper's split of the relations; configuration: whole piles on one side.")  # fmt: skip
 @click.option("--cv", type=int, default=10, show_default=True,

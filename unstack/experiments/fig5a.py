@@ -25,7 +25,7 @@ import numpy as np
 from unstack.learning.choices import LEARNERS, SPLITS
 from unstack.learning.features import FEATURE_SETS
 from unstack.learning.training_data import ISET_DRAWS
-from unstack.parameters import COUNT, FOLDS, ISET_SIZE, JOBS, SEED, OneOf, validate_params
+from unstack.parameters import COUNT, FOLDS, ISET_SIZE, JOBS, LEARNING_SEED, OneOf, validate_params
 
 #: The paper's size of Fig. 5a (§V): 200 simulated configurations (its 493 test ISets for Fig. 4
 #: are :data:`unstack.experiments.decisions.PAPER_TEST_ISETS`).
@@ -178,7 +178,7 @@ def require_paper_size(data_dir: str | os.PathLike[str], cv: int) -> None:
 
 
 @validate_params({
-    "r": ISET_SIZE, "isets": COUNT, "seed": SEED, "cv": FOLDS, "n_jobs": JOBS, "draw": OneOf(ISET_DRAWS),
+    "r": ISET_SIZE, "isets": COUNT, "seed": LEARNING_SEED, "cv": FOLDS, "n_jobs": JOBS, "draw": OneOf(ISET_DRAWS),
     "learner": OneOf(LEARNERS), "split_by": OneOf(SPLITS), "feature_set": OneOf(FEATURE_SETS),
 })  # fmt: skip
 def fig5a(

@@ -28,6 +28,7 @@ from unstack.learning.features import FeatureSettings
 from unstack.learning.holdout import HoldoutResult
 from unstack.learning.model_file import SupportModel
 from unstack.learning.training_data import SupportExamples
+from unstack.parameters import LEARNING_SEED, validate_params
 
 __all__ = [
     "CONFIGURATION_OFFSET",
@@ -128,6 +129,7 @@ class TrainingRun:
     warnings: tuple[str, ...] = ()
 
 
+@validate_params({"seed": LEARNING_SEED})
 def train_support_model(
     examples: SupportExamples,
     settings: FeatureSettings,

@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from unstack.errors import UnstackError
-from unstack.learning.features import FeatureSettings, pair_features
+from unstack.learning.features import FeatureSettings, feature_names, pair_features
 from unstack.parameters import COUNT, DETECTOR_NOISE, ISET_SIZE, JOBS, validate_params
 from unstack.scene import Scene, load_scene
 from unstack.understanding.detector import detector_poses
@@ -67,10 +67,12 @@ class SupportExamples:
     pairs: list[tuple[str, str]]
 
     @staticmethod
-    def concatenate(parts: Sequence[SupportExamples]) -> SupportExamples:
-        """Stack several sets of examples."""
+    def concatenate(parts: Sequence[SupportExamples], width: int = 19) -> SupportExamples:
+        """Stack several sets of examples (those of no rows left out: a pile of one detected box
+        gives none); ``width``: the features of the set of none."""
+        parts = [part for part in parts if len(part.labels)]
         if not parts:
-            return SupportExamples(np.zeros((0, 19)), np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64),
+            return SupportExamples(np.zeros((0, width)), np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64),
                                    np.zeros(0, dtype=np.int64), [])  # fmt: skip
         return SupportExamples(
             np.concatenate([part.features for part in parts]),
@@ -283,14 +285,15 @@ def dataset_examples(
         parts.append(part)
         if progress is not None:
             progress(len(parts), len(files))
-    examples = SupportExamples.concatenate(parts)
+    examples = SupportExamples.concatenate(parts, width=len(feature_names(settings)))
     _warn_smaller_isets(examples, r, folder, len(files))
     drawn, repeated = repeated_isets(examples)
     if repeated > REPEATED_ISETS * drawn:
         warnings.warn(
             f"{folder}: {repeated:,} of the {drawn:,} ISets drawn repeat an earlier one of their pile (n detected "
-            "boxes have only C(n, k) distinct sets of k): their relations are the same rows again, and a "
-            "split by pairs scores rows it was trained on; ask for fewer ISets or split by configuration",
+            "boxes have only C(n, k) distinct sets of k): their relations are the same rows again, and a model "
+            "trained on a split by pairs is scored on rows it was trained on; ask for fewer ISets (--isets), and "
+            "train with a split by configuration",
             stacklevel=2,
         )
     return examples
