@@ -93,6 +93,17 @@ def test_a_folder_of_another_data_set_is_refused(tmp_path: Path, change: dict[st
     assert len(list_configurations(tmp_path)) == 1
 
 
+@pytest.mark.parametrize("content", ["{not json", '{"format": "unstack.scene/1"}'], ids=["garbage", "foreign"])
+def test_configurations_without_a_manifest_are_no_data_set_to_add_to(tmp_path: Path, content: str) -> None:
+    """A run writes its manifest first: configurations without one are another's (they were taken as finished)."""
+    (tmp_path / "config-0000.json").write_text(content)
+    with pytest.raises(
+        DatasetConflict, match=r"holds 1 configuration file\(s\) \(config-0000.json, ...\) and no manifest"
+    ):
+        simulate_dataset(tmp_path, small_settings(), configs=2, seed=21)
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["config-0000.json"]
+
+
 def test_a_folder_holding_only_the_manifest_of_a_stopped_run_takes_another_data_set(
     reference: Path, tmp_path: Path
 ) -> None:

@@ -112,6 +112,23 @@ class DatasetSummary:
     seconds: float
 
 
+def _check_resumable(folder: Path, settings: SimulationSettings, seed: int) -> None:
+    """Refuse a folder whose configurations another data set made: a manifest of other settings or
+    another seed, or configurations with no manifest (a run writes its manifest before its first
+    configuration, so these are no run of this command). A manifest alone: a run stopped before
+    its first configuration."""
+    found = list_configurations(folder)
+    if not found:
+        return
+    manifest = read_manifest(folder)
+    if manifest is None:
+        raise DatasetConflict(
+            f"{folder}: holds {len(found):,} configuration file(s) ({found[0].name}, ...) and no {MANIFEST}: no data "
+            "set this command made or can add to; choose another folder"
+        )
+    _check_same_dataset(folder, manifest, settings, seed)
+
+
 def _check_same_dataset(folder: Path, manifest: dict[str, Any], settings: SimulationSettings, seed: int) -> None:
     theirs = manifest.get("settings")
     ours = settings.to_dict()
@@ -378,9 +395,8 @@ def simulate_dataset(
     if target.exists() and not target.is_dir():
         raise DatasetConflict(f"{target}: expected a folder for the data set, got a file")
     check_folder_path(target, "the data set")
-    manifest = read_manifest(target) if target.is_dir() else None
-    if manifest is not None and list_configurations(target):  # a manifest alone: a run stopped before its first
-        _check_same_dataset(target, manifest, settings, seed)
+    if target.is_dir():
+        _check_resumable(target, settings, seed)
     check_jobs_or_scheduler(jobs, scheduler)
     client = connect_scheduler(scheduler) if scheduler is not None else None
     target.mkdir(parents=True, exist_ok=True)
@@ -403,9 +419,7 @@ def _fill_dataset(
     start: float,
 ) -> DatasetSummary:
     """:func:`simulate_dataset`'s work in a folder it holds: the configurations still missing."""
-    manifest = read_manifest(target)
-    if manifest is not None and list_configurations(target):  # again, now that no other run writes the folder
-        _check_same_dataset(target, manifest, settings, seed)
+    _check_resumable(target, settings, seed)  # again, now that no other run writes the folder
     _clean_temporaries(target)
     _write_manifest(target, settings, seed, configs)
     done = {int(path.stem.split("-")[1]) for path in list_configurations(target)}
