@@ -36,3 +36,36 @@ def test_results_are_written_as_strict_json_with_null_for_undefined_values(tmp_p
     text = written.read_text()
     assert "NaN" not in text and json.loads(text)["reliability"]["mean_predicted"] == [0.1, None]
     assert read_document(written).data["spearman"] is None  # unstack's own reader takes it
+
+
+def test_a_pile_whose_cloud_changed_is_another_pile(tmp_path: Path, examples: Path) -> None:
+    """The key hashed the scene's JSON alone: a changed points file reused the old result."""
+    import shutil
+
+    import numpy as np
+
+    from unstack.experiments.outputs import scene_digest
+
+    scene = json.loads((examples / "scene3.json").read_text())
+    shutil.copy(examples / scene["points_file"], tmp_path / scene["points_file"])
+    (tmp_path / "scene.json").write_text(json.dumps(scene))
+    before = scene_digest(tmp_path / "scene.json")
+    cloud = np.load(tmp_path / scene["points_file"])
+    np.save(tmp_path / scene["points_file"], cloud + np.array([0.0, 0.0, 0.5]))
+    assert scene_digest(tmp_path / "scene.json") != before
+
+
+def test_two_model_files_of_one_metadata_are_two_models(tmp_path: Path) -> None:
+    """The key hashed the metadata alone: another estimator under the same metadata reused the results."""
+    import shutil
+
+    from unstack.experiments.outputs import model_digest
+    from unstack.learning.model_file import default_model_path, load_model
+
+    shutil.copy(default_model_path(), tmp_path / "a.skops")
+    model = load_model(tmp_path / "a.skops")
+    same = model_digest(model)
+    assert model_digest(load_model(tmp_path / "a.skops")) == same
+    (tmp_path / "b.skops").write_bytes((tmp_path / "a.skops").read_bytes() + b"\0")  # other bytes, one metadata
+    other = type(model)(model.estimator, model.features, model.metadata, source=str(tmp_path / "b.skops"))
+    assert model_digest(other) != same

@@ -729,7 +729,7 @@ def container_experiment(
     from unstack.atomic import atomic_write_text
     from unstack.dataset_folders import first_configurations
     from unstack.experiments.decisions import paired_difference
-    from unstack.experiments.outputs import checkpoint_folder, stored_result
+    from unstack.experiments.outputs import checkpoint_folder, model_digest, scene_digest, stored_result
 
     container_policies(model, seed=seed, makers=makers)  # unknown makers fail before any work
     if disturbance is not None and not isinstance(disturbance, str | os.PathLike):
@@ -740,18 +740,18 @@ def container_experiment(
         disturbance_path = Path(default_disturbance_path() if disturbance is None else disturbance)
         disturbance_digest = hashlib.sha256(disturbance_path.read_bytes()).hexdigest()
     files = first_configurations(data_dir, piles)
-    model_digest = hashlib.sha256(json.dumps(model.metadata, sort_keys=True, default=str).encode()).hexdigest()
+    model_sha256 = model_digest(model)
     settings = {"detector_noise": detector_noise, "detector_misses": detector_misses, "reach": reach,
                 "max_picks": max_picks, "samples": samples, "occupancy": occupancy}  # fmt: skip
 
     def key(number: int, path: Path) -> dict[str, Any]:
-        digest = hashlib.sha256(path.read_bytes()).hexdigest()
+        digest = scene_digest(path)
         # detector_misses and occupancy join the key only when set: earlier runs keep their checkpoints
         unset = {"detector_misses": 0.0, "occupancy": None}
         kept = {name: value for name, value in settings.items() if name not in unset or value != unset[name]}
         if set(MOVES_MAKERS) & set(makers):  # the disturbance model joins the key only where it is used
             kept["disturbance_sha256"] = disturbance_digest
-        return {"scene_sha256": digest, "model_sha256": model_digest, "makers": list(makers),
+        return {"scene_sha256": digest, "model_sha256": model_sha256, "makers": list(makers),
                 **kept, "seed": seed + number}  # fmt: skip
 
     def finished(number: int, path: Path) -> dict[str, Any] | None:

@@ -132,3 +132,41 @@ def stored_result(path: Path, key: dict[str, Any]) -> dict[str, Any] | None:
         return None
     result: dict[str, Any] = stored["result"]
     return result
+
+
+def scene_digest(path: Path) -> str:
+    """SHA-256 of a scene file with the files it names (its cloud, its points' box labels): what a
+    pile's stored result rests on, so a changed cloud is run again.
+
+    Examples
+    --------
+    >>> len(scene_digest(Path("examples/pile5.scene.json")))
+    64
+    """
+    import hashlib
+
+    digest = hashlib.sha256(path.read_bytes())
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):  # no scene: the bytes alone
+        return digest.hexdigest()
+    metadata = data.get("metadata") if isinstance(data, dict) else None
+    named = [data.get("points_file") if isinstance(data, dict) else None]
+    named.append(metadata.get("point_boxes_file") if isinstance(metadata, dict) else None)
+    for name in named:
+        if isinstance(name, str) and (path.parent / name).is_file():
+            digest.update((path.parent / name).read_bytes())
+    return digest.hexdigest()
+
+
+def model_digest(model: Any) -> str:
+    """SHA-256 of a support model: its metadata, its feature settings and its file's bytes (two
+    files of one metadata hold other estimators)."""
+    import hashlib
+
+    digest = hashlib.sha256(json.dumps(model.metadata, sort_keys=True, default=str).encode())
+    digest.update(json.dumps(model.features.to_dict(), sort_keys=True).encode())
+    source = Path(str(model.source)) if getattr(model, "source", "") else None
+    if source is not None and source.is_file():
+        digest.update(source.read_bytes())
+    return digest.hexdigest()

@@ -166,14 +166,12 @@ def unloading_orders(scene: Any, model: Any, settings: DecisionSettings) -> dict
 def _pile_key(path: Path, model: Any, settings: DecisionSettings, closed_loop: bool) -> dict[str, Any]:
     """What a pile's result depends on: the scene file, the model, the decisions' settings and
     the makers."""
-    import hashlib
-    import json
+    from unstack.experiments.outputs import model_digest, scene_digest
 
-    model_digest = hashlib.sha256(json.dumps(model.metadata, sort_keys=True, default=str).encode()).hexdigest()
     return {
         "scene": path.name,
-        "scene_sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
-        "model_sha256": model_digest,
+        "scene_sha256": scene_digest(path),
+        "model_sha256": model_digest(model),
         "samples": settings.samples,
         "time_limit": settings.time_limit,
         "seed": settings.seed,
