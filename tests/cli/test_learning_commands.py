@@ -183,3 +183,15 @@ def test_a_model_is_not_written_over_a_file_of_its_data_set(small_dataset: Path,
     result = unstack("train", str(data), "-o", str(target))
     assert_one_line_error(result, f"{target}: cannot write there: it is the input file")
     assert target.read_bytes() == before
+
+
+@pytest.mark.slow  # a subprocess
+def test_train_does_not_write_over_the_shipped_models(small_dataset: Path) -> None:
+    """Every later decide would have used it: `train -o <package>/learning/models/general-mix.skops`."""
+    from unstack.learning.model_file import default_model_path
+
+    shipped = default_model_path()
+    before = shipped.read_bytes()
+    result = unstack("train", str(small_dataset), "-o", str(shipped), "--cv", "3")
+    assert_one_line_error(result, "cannot write there: the folder of the models shipped with unstack")
+    assert shipped.read_bytes() == before

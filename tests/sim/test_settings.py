@@ -45,7 +45,7 @@ def test_round_trip_through_json(sizes: str) -> None:
         ({"boxes": (300, 400)}, r"400 boxes of size set 'paper2' do not fit a 2.0 x 2.35 x 2.39 m container"),
         (
             {"container": Container(depth=0.2)},
-            r"\(smallest edges 0\.3 m\) do not fit a 0\.2 x 2\.35 x 2\.39 m container",
+            r"do not all fit a 0\.2 x 2\.35 x 2\.39 m container \(depth x width x height\): one's smallest edge is 0\.4 m",
         ),
         ({"container": Container(depth=-1.0)}, r"settings\.container\.depth: expected a positive extent"),
         (
@@ -122,9 +122,7 @@ def test_settings_from_json_gives_left_out_keys_their_defaults() -> None:
 
 def test_settings_from_json_turns_a_refused_combination_into_a_path_error() -> None:
     data = {"sizes": "four", "container": {"depth": 0.2}}
-    with pytest.raises(
-        InvalidScene, match=r"a\.json: \$\.metadata\.settings: boxes of size set 'four' \(smallest edges"
-    ):
+    with pytest.raises(InvalidScene, match=r"a\.json: \$\.metadata\.settings: boxes of size set 'four' do not all fit"):
         settings_from_json(data, source="a.json", path="$.metadata.settings", error=InvalidScene)
 
 

@@ -196,6 +196,14 @@ def train(
     if repeated is not None:
         raise UnstackError(f"{repeated}: the data set is given twice (each pile would count twice)")
     check_output_path(output, inputs=[path for folder in data_dirs for path in _files_in(folder)])
+    from unstack.learning.model_file import default_model_path
+
+    shipped = default_model_path().parent.resolve()
+    if Path(output).resolve().parent == shipped:
+        raise UnstackError(
+            f"{output}: cannot write there: the folder of the models shipped with unstack ({shipped}); "
+            "choose another file and pass it with --model"
+        )
     settings = FeatureSettings(offset=offset, sigma=sigma, feature_set=feature_set)
     examples = _examples(data_dirs, r, isets, seed, jobs, settings, draw, vary_clouds, pose_noise)
     console = Console(stderr=as_json)

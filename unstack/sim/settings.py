@@ -271,8 +271,9 @@ class SimulationSettings:
             sizes.min(axis=1) > container.height
         ):
             raise InvalidSettings(
-                f"boxes of size set {self.sizes!r} (smallest edges {sizes.min(axis=1).min():g} m) do not fit a "
-                f"{container.depth:g} x {container.width:g} x {container.height:g} m container (depth x width x height)"
+                f"boxes of size set {self.sizes!r} do not all fit a {container.depth:g} x {container.width:g} x "
+                f"{container.height:g} m container (depth x width x height): one's smallest edge is "
+                f"{sizes.min(axis=1).max():g} m"
             )
         capacity = self.capacity()
         if high > capacity:
