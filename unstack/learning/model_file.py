@@ -115,6 +115,11 @@ DEFAULT_MODEL_NAME = "general"
 DEFAULT_MODEL = BUNDLED_MODELS[DEFAULT_MODEL_NAME]
 
 
+#: What a model file may unpack to at most (bytes, the zip members' sizes summed): the shipped
+#: models unpack to under 1 MB; a small file that unpacks to gigabytes is refused before it is.
+MAX_MODEL_BYTES = 256 * 2**20
+#: The keys of a model file's payload.
+PAYLOAD_KEYS = ("format", "metadata", "estimator")
 #: scikit-learn types a model may hold beyond those skops trusts by default: the internals
 #: of ``CalibratedClassifierCV`` and of the histogram gradient boosting's trees (plain data
 #: holders, reviewed; no callables). Anything else that skops does not trust is refused.
@@ -123,13 +128,6 @@ EXTRA_TRUSTED_TYPES = (
     "sklearn.calibration._SigmoidCalibration",
     "sklearn.ensemble._hist_gradient_boosting.predictor.TreePredictor",
 )
-
-
-#: What a model file may unpack to at most (bytes, the zip members' sizes summed): the shipped
-#: models unpack to under 1 MB; a small file that unpacks to gigabytes is refused before it is.
-MAX_MODEL_BYTES = 256 * 2**20
-#: The keys of a model file's payload.
-PAYLOAD_KEYS = ("format", "metadata", "estimator")
 
 
 class InvalidModel(InvalidFile):
