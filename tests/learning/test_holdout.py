@@ -81,3 +81,12 @@ def test_a_validation_share_that_leaves_a_side_without_a_class_is_refused_with_t
         holdout_split([0, 1] * 72, validation_size=size)
     train, held = holdout_split([0, 1] * 72, validation_size=0.014, random_state=0)
     assert len(held) == 3 and len(train) == 141
+
+
+@pytest.mark.parametrize(("labels", "rare"), [([0] * 7 + [1], "supported"), ([1] * 7 + [0], "unsupported")])
+def test_a_class_of_one_relation_cannot_be_split_and_says_so(labels: list[int], rare: str) -> None:
+    """scikit-learn's stratified split raised its own ValueError (a traceback from fig5a)."""
+    from unstack.learning.holdout import holdout_split
+
+    with pytest.raises(InvalidArgument, match=rf"the 8 relations drawn hold 1 {rare} one only"):
+        holdout_split(np.array(labels), validation_size=0.3, random_state=0)

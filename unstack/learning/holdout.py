@@ -105,6 +105,14 @@ def _require_each_class_on_each_side(labels: np.ndarray, validation_size: float)
     """Raise where a stratified split of ``labels`` cannot put every class on both sides (the
     held-out part takes ``ceil(validation_size * n)`` rows, as scikit-learn's split does)."""
     total, classes = len(labels), len(np.unique(labels))
+    values, counts = np.unique(labels, return_counts=True)
+    if counts.min() < 2:  # a stratified split puts a member of each class on each side
+        rare = values[int(np.argmin(counts))]
+        name = "supported" if rare == 1 else "unsupported" if rare == 0 else repr(rare)
+        raise InvalidArgument(
+            f"the {total} relations drawn hold {counts.min()} {name} one only: a split that keeps each class on "
+            "both sides needs two; draw more ISets (isets) or use more piles"
+        )
     held_out = math.ceil(validation_size * total)
     if min(held_out, total - held_out) < classes:
         smallest = math.ceil(classes / total * 1000) / 1000
