@@ -84,6 +84,23 @@ def test_the_collection_resumes_without_work(small_dataset: Path, states: Path) 
     assert sorted(path.stat().st_mtime_ns for path in states.glob("*/*/step-*.npz")) == before
 
 
+@pytest.mark.parametrize("change", [{"max_picks": 1}, {"seed": 2}], ids=["fewer-picks", "another-seed"])
+def test_a_collection_resumed_with_other_settings_collects_again_and_keeps_no_old_state(
+    small_dataset: Path, states: Path, tmp_path: Path, change: dict[str, int]
+) -> None:
+    """A pile counted as done whatever the settings, and steps of a longer run stayed beside a shorter one's."""
+    import shutil
+
+    out = tmp_path / "states"
+    shutil.copytree(states, out)  # the module's collection: seed 1, three picks
+    summaries = collect_pick_responses([small_dataset], out, piles=2, **{"seed": 1, "max_picks": 3, **change})
+    fresh = collect_pick_responses(
+        [small_dataset], tmp_path / "fresh", piles=2, **{"seed": 1, "max_picks": 3, **change}
+    )
+    assert [summary["states"] for summary in summaries] == [summary["states"] for summary in fresh]
+    assert len(list(load_states(out))) == sum(summary["states"] for summary in fresh)
+
+
 def test_a_decision_maker_as_behaviour_takes_every_pick(small_dataset: Path, tmp_path: Path) -> None:
     """With ``behaviour="highest"`` every saved state is followed by the removal of the box
     that maker picks there: the next state no longer holds it."""

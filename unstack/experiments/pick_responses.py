@@ -27,6 +27,7 @@ Examples
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 from collections.abc import Callable, Iterator, Mapping
@@ -149,11 +150,47 @@ def _maker(behaviour: str, model: Any, disturbance: Any, seed: int) -> Callable[
 _MIXED = ("mixed", None, None)
 
 
+def _pile_key(
+    path: Path, seed: int, max_picks: int | None, behaviour: str, model: Any, disturbance: Any
+) -> dict[str, Any]:
+    """What a pile's states depend on: the scene with its cloud, the seed, the picks allowed, the
+    behaviour and (for a decision maker) its models."""
+    from unstack.experiments.outputs import model_digest, scene_digest
+
+    key: dict[str, Any] = {"scene_sha256": scene_digest(path), "seed": seed, "max_picks": max_picks,
+                           "behaviour": behaviour}  # fmt: skip
+    if behaviour != "mixed":
+        for name, given in (("model", model), ("disturbance", disturbance)):
+            if hasattr(given, "metadata") and hasattr(given, "features"):
+                key[name] = model_digest(given)
+            elif given is not None:
+                source = Path(str(getattr(given, "source", given)))
+                key[name] = hashlib.sha256(source.read_bytes()).hexdigest() if source.is_file() else str(source)
+    return key
+
+
+def _finished(done: Path, key: dict[str, Any]) -> dict[str, Any] | None:
+    """A pile's summary when its states were collected with the same key, else None."""
+    try:
+        summary = json.loads(done.read_text())
+    except (OSError, ValueError):
+        return None
+    return summary if isinstance(summary, dict) and summary.get("key") == json.loads(json.dumps(key)) else None
+
+
 def _collect_pile(
-    path: Path, number: int, out: Path, seed: int, max_picks: int | None, behaviour: tuple[str, Any, Any] = _MIXED
+    path: Path,
+    number: int,
+    out: Path,
+    seed: int,
+    max_picks: int | None,
+    behaviour: tuple[str, Any, Any] = _MIXED,
+    key: dict[str, Any] | None = None,
 ) -> tuple[int, dict[str, Any]]:
-    """Empty one pile with the probe, saving every state; the run's summary comes back.
-    ``behaviour``: its name, the support model and the disturbance model of a decision maker."""
+    """Empty one pile with the probe, saving every state; the run's summary (with ``key``, what
+    the states depend on) comes back. ``behaviour``: its name, the support model and the
+    disturbance model of a decision maker. States an earlier run left in the pile's folder are
+    removed first."""
     from unstack.atomic import atomic_write_bytes, atomic_write_text
     from unstack.geometry import bounding_boxes
     from unstack.scene import load_scene
@@ -162,6 +199,8 @@ def _collect_pile(
     scene = load_scene(path)
     folder = out / path.stem
     folder.mkdir(parents=True, exist_ok=True)
+    for left in [*folder.glob("step-*.npz"), folder / "done.json"]:  # another run's, or an interrupted one's
+        left.unlink(missing_ok=True)
     rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(number,)))
     steps = [0]
     maker = _maker(*behaviour, seed)
@@ -185,6 +224,8 @@ def _collect_pile(
                "stopped": run.stopped}  # fmt: skip
     if maker is not None:
         summary["behaviour"] = behaviour[0]
+    if key is not None:
+        summary["key"] = key
     atomic_write_text(folder / "done.json", json.dumps(summary) + "\n")
     return number, summary
 
@@ -276,11 +317,12 @@ def _collect_into(
     summaries: list[dict[str, Any] | None] = [None] * len(files)
     for number, path in enumerate(files):
         pile_folder = folder / Path(path).parent.name  # one sub-folder per data set, one below it per pile
-        done = pile_folder / path.stem / "done.json"
-        if done.is_file():
-            summaries[number] = json.loads(done.read_text())
+        key = _pile_key(path, seed, max_picks, behaviour, model, disturbance)
+        finished = _finished(pile_folder / path.stem / "done.json", key)
+        if finished is not None:
+            summaries[number] = finished
         else:
-            tasks.append((path, number, pile_folder, seed, max_picks, (behaviour, model, disturbance)))
+            tasks.append((path, number, pile_folder, seed, max_picks, (behaviour, model, disturbance), key))
     if progress is not None:
         progress(len(files) - len(tasks), len(files))
     for number, summary in run_unordered(_collect_pile, tasks, n_jobs=n_jobs, client=client):
