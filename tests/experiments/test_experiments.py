@@ -62,6 +62,13 @@ def test_decisions_on_simulated_piles(small_dataset: Path) -> None:
 
 
 @pytest.mark.slow  # runs experiments on a simulated data set
+def test_decisions_with_isets_larger_than_the_piles_say_the_sizes_drawn(small_dataset: Path) -> None:
+    """evaluate and fig5a warned of this; decisions reported "ISets of 50 boxes" without a word."""
+    with pytest.warns(UserWarning, match=r"r = 50 is more than some piles can give: 2 of the 2 ISets hold"):
+        evaluate_decisions(small_dataset, load_model(default_model_path()), r=50, isets=2, seed=2)
+
+
+@pytest.mark.slow  # runs experiments on a simulated data set
 def test_per_iset_records_pair_two_models_on_the_same_isets(small_dataset: Path) -> None:
     from unstack.api import load_model
     from unstack.experiments.decisions import paired_between_runs
@@ -198,6 +205,18 @@ def test_real7_command(small_dataset: Path, tmp_path: Path) -> None:
     assert result.returncode == 0, result.stderr
     assert "90.5 %" in result.stdout and "worst MSE(cost) over r" in result.stdout
     assert set(json.loads((tmp_path / "real7.json").read_text())["by_r"]) == {"3", "4", "5"}
+
+
+@pytest.mark.slow  # runs experiments on a simulated data set
+@pytest.mark.parametrize(("samples", "recorded"), [([], None), (["--samples", "64"], 64)], ids=["default", "given"])
+def test_unload_with_a_time_limit_keeps_samples_given_with_it(
+    small_dataset: Path, tmp_path: Path, samples: list[str], recorded: int | None
+) -> None:
+    """An explicit --samples with --time-limit was dropped without a word; the default still gives way."""
+    result = unstack("experiment", "unload", str(small_dataset), "--out", str(tmp_path), "--configs", "1",
+                     "--time-limit", "0.05", *samples)  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert json.loads((tmp_path / "unloading.json").read_text())["samples"] == recorded
 
 
 @pytest.mark.slow  # runs experiments on a simulated data set

@@ -349,7 +349,8 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
 @click.option("--samples", type=SAMPLES, default=UNLOAD_SAMPLES, show_default=True,
               help="Recorded sweeps per sampled group in each decision (reproducible with the seed).")  # fmt: skip
 @click.option("--time-limit", type=SECONDS, default=None,
-              help="Seconds per decision instead of --samples (not reproducible).")  # fmt: skip
+              help="Seconds per decision instead of the default --samples; with --samples given too, whichever "
+              "ends first (not reproducible).")  # fmt: skip
 @_seed_option(UNLOAD("seed"), "the sampler and the random order")
 @click.option("--full", is_flag=True, help="Every configuration of the data set (overrides --configs).")
 @click.option("--cost", type=UNLOAD("cost"), default=DEFAULT_COST, show_default=True,
@@ -387,9 +388,10 @@ def unload(
     if full:
         configs = found
     model, name = load_model_option(model_path)
-    folder, result = _run_piles(
+    given = click.get_current_context().get_parameter_source("samples") == click.core.ParameterSource.COMMANDLINE
+    folder, result = _run_piles(  # with both given, each decision stops at whichever ends first, as plan's
         unloading_experiment, scheduler, out, "unloading-piles", data_dir=data_dir, model=model, configs=configs,
-        samples=None if time_limit else samples, time_limit=time_limit, seed=seed, closed_loop=closed_loop,
+        samples=samples if given or not time_limit else None, time_limit=time_limit, seed=seed, closed_loop=closed_loop,
         cost=cost, statics=statics, n_jobs=jobs,
     )  # fmt: skip
     result["model"] = name

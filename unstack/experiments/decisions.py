@@ -303,6 +303,16 @@ def evaluate_decisions(
                 progress(len(results), isets)
     if not results:
         raise UnstackError(f"{data_dir}: no ISet of at least 2 detected boxes (r = {r}); nothing to decide on")
+    smaller = sorted({len(outcome.ids) for outcome in results if len(outcome.ids) < r})
+    if smaller:  # the paper's draw takes one box fewer than a small pile's detected boxes
+        import warnings
+
+        held = f"{smaller[0]}" if len(smaller) == 1 else f"{smaller[0]}-{smaller[-1]}"
+        warnings.warn(
+            f"{data_dir}: r = {r} is more than some piles can give: "
+            f"{sum(len(outcome.ids) < r for outcome in results)} of the {len(results)} ISets hold {held} boxes",
+            stacklevel=2,
+        )
     scores = {maker: decision_scores(results, maker) for maker in DECISION_MAKERS}
     summary = {
         maker: {
