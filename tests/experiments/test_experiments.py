@@ -304,3 +304,17 @@ def test_unloading_orders_are_reproducible_for_a_seed(small_dataset: Path) -> No
     first = unloading_orders(scene, model, DecisionSettings(seed=3, samples=64))
     assert first == unloading_orders(scene, model, DecisionSettings(seed=3, samples=64))
     assert sorted(first["reasoner"]) == sorted(scene.detected)
+
+
+def test_real7_rows_of_a_size_the_piles_do_not_hold_are_dashes() -> None:
+    """An r of no ISet gave numpy's empty-mean warnings and 'nan %' in the table."""
+    from unstack.experiments.real7 import summary_rows
+
+    none = {maker: {"first_pick_right": None, "mse_cost": None, "boxes_moved": None} for maker in DECISION_MAKERS}
+    some = {maker: {"first_pick_right": 0.5, "mse_cost": 1.0, "boxes_moved": 0.5} for maker in DECISION_MAKERS}
+    result = {"by_r": {"4": {"isets": 2, **some, "paper_first_pick_right": 0.81},
+                       "5": {"isets": 0, **none, "paper_first_pick_right": 0.62}}}  # fmt: skip
+    assert summary_rows(result) == [
+        ["4", "2", "81.0 %", "50.0 %", "50.0 %", "50.0 %"],
+        ["5", "0", "62.0 %", "-", "-", "-"],
+    ]

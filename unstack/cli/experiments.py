@@ -329,15 +329,15 @@ def real7(data_dir: str, out: str, model_path: str | None, piles: int | None) ->
     result["model"] = name
     written = save_results(results_folder(out), "real7.json", result)
     table = number_table(
-        f"first pick right, {result['piles']} simulated 7-box piles ({data_dir})",
+        f"first pick right, {result['piles']} simulated {'pile' if result['piles'] == 1 else 'piles'} ({data_dir})",
         ("r", "ISets", "paper", "unstack", "highest first", "random"),
         summary_rows(result),
     )
-    worst = result["worst_mse"]
+    worst = {maker: "-" if mse is None else f"{mse:.3f}" for maker, mse in result["worst_mse"].items()}
     _print_results(
         table,
         written,
-        f"worst MSE(cost) over r: unstack {worst['reasoner']:.3f}, random {worst['random']:.3f} (paper 0.5 vs 3.5)",
+        f"worst MSE(cost) over r: unstack {worst['reasoner']}, random {worst['random']} (paper 0.5 vs 3.5)",
     )
 
 

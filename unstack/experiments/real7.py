@@ -72,16 +72,19 @@ def real7(
         per_size[str(r)] = {
             "isets": len(results),
             **{
-                maker: {
-                    "first_pick_right": float(values["first_pick_right"].mean()),
-                    "mse_cost": float(values["squared_regret"].mean()),
-                    "boxes_moved": float(values["moved"].mean()),
+                maker: {  # None where the piles hold no ISet of r boxes
+                    "first_pick_right": float(values["first_pick_right"].mean()) if results else None,
+                    "mse_cost": float(values["squared_regret"].mean()) if results else None,
+                    "boxes_moved": float(values["moved"].mean()) if results else None,
                 }
                 for maker, values in scores.items()
             },
             "paper_first_pick_right": PAPER_FIRST_PICK_RIGHT.get(r),
         }
-    worst = {maker: max(per_size[str(r)][maker]["mse_cost"] for r in sizes) for maker in DECISION_MAKERS}
+    worst = {
+        maker: max((per_size[str(r)][maker]["mse_cost"] for r in sizes if per_size[str(r)]["isets"]), default=None)
+        for maker in DECISION_MAKERS
+    }
     return {"data": str(data_dir), "piles": len(scenes), "by_r": per_size, "worst_mse": worst, "paper": PAPER_REAL7}
 
 
@@ -95,9 +98,12 @@ def summary_rows(result: dict[str, Any]) -> list[list[str]]:
                 r,
                 str(values["isets"]),
                 f"{100 * paper:.1f} %" if paper is not None else "-",
-                f"{100 * values['reasoner']['first_pick_right']:.1f} %",
-                f"{100 * values['highest']['first_pick_right']:.1f} %",
-                f"{100 * values['random']['first_pick_right']:.1f} %",
+                *(
+                    "-"
+                    if values[maker]["first_pick_right"] is None
+                    else f"{100 * values[maker]['first_pick_right']:.1f} %"
+                    for maker in ("reasoner", "highest", "random")
+                ),
             ]
         )
     return rows
