@@ -145,6 +145,12 @@ def test_training_reports_held_out_figures_and_the_lookahead_is_the_floor(record
     json.dumps(report)  # the report is JSON
 
 
+def test_the_report_records_the_folds_used_not_those_asked_for(records: list[dict[str, object]]) -> None:
+    """100 folds asked of 2 piles ran 2 (a pile a fold at most) and the report said 100."""
+    _, report = train_disturbance(records, folds=100, max_iter=20)
+    assert report["folds"] == report["piles"] == 2
+
+
 def test_the_behaviour_takes_the_probe_best_the_highest_or_a_random_box() -> None:
     moved, resting = {"a": 3, "b": 0, "c": 1}, {"a": 0.6, "b": 0.0, "c": 0.3}
     assert behaviour_pick(moved, resting, 0.0) == "b"

@@ -118,7 +118,7 @@ def train_disturbance(
         "rows": len(moved),
         "piles": len(np.unique(groups)),
         "records": len(records),
-        "folds": folds,
+        "folds": min(folds, len(np.unique(groups))),  # a fold per pile at most (GroupKFold): the folds used
         "calibration": calibration(held_out, moved),
         "pick_scores": pick_scores(records, per_record),
     }
