@@ -145,3 +145,21 @@ def test_the_pick_is_painted_last_in_the_oblique_view(wall: Scene, wall_decision
     assert oblique.computed_zorder is False
     last = oblique.collections[-1]  # painted over every other box
     assert last.get_linewidth()[0] == max(collection.get_linewidth()[0] for collection in oblique.collections)
+
+
+@pytest.mark.parametrize("side_m", [5.0, 50.0])
+def test_a_box_out_of_the_sensors_view_is_labelled_at_the_panels_edge(side_m: float) -> None:
+    """Its label was drawn where it projects, beyond the panel: at 50 m the picture grew to 11,399 px."""
+    from unstack.scene import Box
+    from unstack.understanding.clouds import surface_cloud
+
+    near, far = Box("b00", [0.4, 0.4, 0.4], [1.5, 0.0, 0.2]), Box("b01", [0.4, 0.4, 0.4], [1.5, side_m, 0.2])
+    scene = Scene([near, far], surface_cloud([near], spacing=0.02, seed=0), ["b00", "b01"])
+    values = DecisionValues(["b00", "b01"], [0.5, 0.0], choice="b01")
+    figure = draw_scene(scene, values=values)
+    sensor = figure.axes[1]
+    frame = sensor.get_window_extent(figure.canvas.get_renderer())
+    [label] = [text for text in _box_labels(figure) if text.get_text().startswith("b01")]
+    assert label.get_text().endswith("(out of view)")
+    x, y = sensor.transData.transform(label.xy)
+    assert frame.x0 - 1 <= x <= frame.x1 + 1 and frame.y0 - 1 <= y <= frame.y1 + 1

@@ -51,6 +51,17 @@ def _candidates(step: float, rings: int) -> list[tuple[float, float]]:
     return offsets
 
 
+def _in_frame(axes: Any, frame: Any, anchor: Sequence[float], text: str) -> tuple[tuple[float, float], str]:
+    """An anchor outside the axes pinned to their edge, its label saying so (a box out of the
+    sensor's view was labelled far off the panel, and the picture grew to hold the label)."""
+    x, y = axes.transData.transform(tuple(anchor))
+    inside_x, inside_y = min(max(x, frame.x0), frame.x1), min(max(y, frame.y0), frame.y1)
+    if (inside_x, inside_y) == (x, y):
+        return (float(anchor[0]), float(anchor[1])), text
+    pinned = axes.transData.inverted().transform((inside_x, inside_y))
+    return (float(pinned[0]), float(pinned[1])), f"{text} (out of view)"
+
+
 def place_labels(
     axes: Any,
     anchors: Sequence[Sequence[float]],
@@ -66,7 +77,8 @@ def place_labels(
 
     Labels are placed in the given order (put the important ones first). A label that
     finds no free place within ``rings`` rings is put at its anchor (the overlap is then
-    visible rather than hidden).
+    visible rather than hidden). An anchor outside the axes is pinned to their edge and its
+    label ends "(out of view)".
 
     Parameters
     ----------
@@ -94,7 +106,8 @@ def place_labels(
     pixels_per_point = figure.dpi / 72.0
     margin = 1.5 * pixels_per_point
     style = {"boxstyle": "round,pad=0.15", "facecolor": "white", "edgecolor": "none", "alpha": 0.85}
-    for index, (anchor, text) in enumerate(zip(anchors, texts, strict=True)):
+    for index, (given, label_text) in enumerate(zip(anchors, texts, strict=True)):
+        anchor, text = _in_frame(axes, frame, given, label_text)
         weight = weights[index] if weights is not None else "normal"
         colour = colours[index] if colours is not None else "black"
         annotate = functools.partial(
