@@ -104,6 +104,27 @@ def test_runs_on_the_same_folder_spelt_differently_pair(spelling: str) -> None:
         paired_between_runs(run, {**other, "data": "piles2"})
 
 
+def test_runs_with_data_digests_pair_by_the_data_not_the_folders_name() -> None:
+    """The same data given by an absolute path was refused as other data; two folders of one name passed."""
+    from unstack.experiments.decisions import paired_between_runs
+
+    rows = [{"scene": "s", "boxes": ["a", "b"], "moved": {"reasoner": 2.0}}]
+    run = {"data": "piles", "data_sha256": "ab", "r": 2, "seed": 0, "draw": "random", "per_iset": rows}
+    assert paired_between_runs(run, {**run, "data": "/elsewhere/piles"})["mean"] == 0.0
+    with pytest.raises(ValueError, match=r"drew their ISets differently \(data\)"):
+        paired_between_runs(run, {**run, "data_sha256": "cd"})
+
+
+@pytest.mark.slow  # a subprocess
+def test_pairing_with_a_run_of_another_r_is_refused_before_the_run(small_dataset: Path, tmp_path: Path) -> None:
+    earlier = tmp_path / "decisions.json"
+    earlier.write_text(json.dumps({"data": str(small_dataset), "r": 3, "seed": 0, "draw": "random", "per_iset": []}))
+    result = unstack("experiment", "decisions", str(small_dataset), "--out", str(tmp_path / "out"), "--r", "4",
+                     "--pair-with", str(earlier))  # fmt: skip
+    assert result.returncode == 2 and "the runs drew their ISets differently (r)" in result.stderr, result.stderr
+    assert not (tmp_path / "out").exists()
+
+
 @pytest.mark.slow  # runs experiments on a simulated data set
 def test_experiment_commands(small_dataset: Path, tmp_path: Path) -> None:
     result = unstack("experiment", "table1", "--out", str(tmp_path), "--max-n", "5")

@@ -331,8 +331,11 @@ def evaluate_decisions(
         for maker in DECISION_MAKERS
         if maker != "reasoner"
     }
+    from unstack.experiments.outputs import dataset_digest
+
     return {
         "data": str(data_dir),
+        "data_sha256": dataset_digest(files),
         "r": r,
         "isets": len(results),
         "seed": seed,
@@ -361,6 +364,31 @@ def _iset_record(outcome: IsetOutcome, scores: dict[str, dict[str, np.ndarray]],
     }
 
 
+def require_same_draw(first: dict[str, Any], second: dict[str, Any]) -> None:
+    """Raise ``ValueError`` unless two decisions runs drew their ISets alike: the same data (by
+    the digest of its configurations where both runs carry one, else by the folder's name as
+    given), ``r``, seed and draw.
+
+    Examples
+    --------
+    >>> require_same_draw({"data": "d", "r": 2, "seed": 0, "draw": "random"}, {"data": "./d", "r": 3, "seed": 0})
+    Traceback (most recent call last):
+    ...
+    ValueError: the runs drew their ISets differently (r, draw): nothing to pair
+    """
+    both = all("data_sha256" in run for run in (first, second))
+    settings = ("data_sha256" if both else "data", "r", "seed", "draw")
+
+    def setting(run: dict[str, Any], key: str) -> Any:
+        value = run.get(key)
+        # The same folder written as "piles", "./piles" or "piles/" draws the same ISets.
+        return os.path.normpath(value) if key == "data" and isinstance(value, str) else value
+
+    differing = [key.removesuffix("_sha256") for key in settings if setting(first, key) != setting(second, key)]
+    if differing:
+        raise ValueError(f"the runs drew their ISets differently ({', '.join(differing)}): nothing to pair")
+
+
 def check_decisions_run(run: dict[str, Any]) -> None:
     """Raise ``ValueError`` unless ``run`` is a result of :func:`evaluate_decisions` with its
     per-ISet records (what :func:`paired_between_runs` pairs).
@@ -375,7 +403,7 @@ def check_decisions_run(run: dict[str, Any]) -> None:
     """
     if "per_iset" in run:
         return
-    if "against_reasoner" in run:
+    if "against_reasoner" in run and "bins" in run:
         raise ValueError("a decisions run with no per-ISet records (made before they were kept): run it again")
     keys = ", ".join(sorted(run)[:6]) + (", ..." if len(run) > 6 else "")
     raise ValueError(
@@ -407,16 +435,7 @@ def paired_between_runs(
     """
     for run in (first, second):
         check_decisions_run(run)
-    settings = ("data", "r", "seed", "draw")
-
-    def setting(run: dict[str, Any], key: str) -> Any:
-        value = run.get(key)
-        # The same folder written as "piles", "./piles" or "piles/" draws the same ISets.
-        return os.path.normpath(value) if key == "data" and isinstance(value, str) else value
-
-    if any(setting(first, key) != setting(second, key) for key in settings):
-        differing = ", ".join(key for key in settings if setting(first, key) != setting(second, key))
-        raise ValueError(f"the runs drew their ISets differently ({differing}): nothing to pair")
+    require_same_draw(first, second)
 
     def by_iset(run: dict[str, Any]) -> dict[tuple[str, tuple[str, ...]], float]:
         return {(row["scene"], tuple(row["boxes"])): float(row["moved"][maker]) for row in run["per_iset"]}
