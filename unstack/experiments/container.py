@@ -723,13 +723,12 @@ def container_experiment(
     ``occupancy``: the ``sampled`` fill's share of unseen space kept solid (default
     :data:`~unstack.sim.belief.OCCUPANCY`).
     """
-    import hashlib
     import json
 
     from unstack.atomic import atomic_write_text
     from unstack.dataset_folders import first_configurations
     from unstack.experiments.decisions import paired_difference
-    from unstack.experiments.outputs import checkpoint_folder, model_digest, scene_digest, stored_result
+    from unstack.experiments.outputs import checkpoint_folder, file_digest, model_digest, scene_digest, stored_result
 
     container_policies(model, seed=seed, makers=makers)  # unknown makers fail before any work
     if disturbance is not None and not isinstance(disturbance, str | os.PathLike):
@@ -738,7 +737,7 @@ def container_experiment(
         from unstack.learning.disturbance import default_disturbance_path
 
         disturbance_path = Path(default_disturbance_path() if disturbance is None else disturbance)
-        disturbance_digest = hashlib.sha256(disturbance_path.read_bytes()).hexdigest()
+        disturbance_digest = file_digest(disturbance_path)
     files = first_configurations(data_dir, piles)
     model_sha256 = model_digest(model)
     settings = {"detector_noise": detector_noise, "detector_misses": detector_misses, "reach": reach,

@@ -18,6 +18,7 @@ Examples
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
 import os
 from collections.abc import Callable, Iterator
@@ -143,8 +144,6 @@ def scene_digest(path: Path) -> str:
     >>> len(scene_digest(Path("examples/pile5.scene.json")))
     64
     """
-    import hashlib
-
     digest = hashlib.sha256(path.read_bytes())
     try:
         data = json.loads(path.read_text())
@@ -159,11 +158,14 @@ def scene_digest(path: Path) -> str:
     return digest.hexdigest()
 
 
+def file_digest(path: Path) -> str:
+    """SHA-256 of a file's bytes (a model or a disturbance model a run's results rest on)."""
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
 def model_digest(model: Any) -> str:
     """SHA-256 of a support model: its metadata, its feature settings and its file's bytes (two
     files of one metadata hold other estimators)."""
-    import hashlib
-
     digest = hashlib.sha256(json.dumps(model.metadata, sort_keys=True, default=str).encode())
     digest.update(json.dumps(model.features.to_dict(), sort_keys=True).encode())
     source = Path(str(model.source)) if getattr(model, "source", "") else None
@@ -181,8 +183,6 @@ def dataset_digest(files: list[Path]) -> str:
     >>> dataset_digest([Path("examples/pile5.scene.json")]) == dataset_digest([Path("./examples/pile5.scene.json")])
     True
     """
-    import hashlib
-
     digest = hashlib.sha256()
     for path in sorted(files, key=lambda file: file.name):
         digest.update(f"{path.name}:{scene_digest(path)};".encode())

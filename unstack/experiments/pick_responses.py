@@ -27,7 +27,6 @@ Examples
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 from collections.abc import Callable, Iterator, Mapping
@@ -155,7 +154,7 @@ def _pile_key(
 ) -> dict[str, Any]:
     """What a pile's states depend on: the scene with its cloud, the seed, the picks allowed, the
     behaviour and (for a decision maker) its models."""
-    from unstack.experiments.outputs import model_digest, scene_digest
+    from unstack.experiments.outputs import file_digest, model_digest, scene_digest
 
     key: dict[str, Any] = {"scene_sha256": scene_digest(path), "seed": seed, "max_picks": max_picks,
                            "behaviour": behaviour}  # fmt: skip
@@ -165,7 +164,7 @@ def _pile_key(
                 key[name] = model_digest(given)
             elif given is not None:
                 source = Path(str(getattr(given, "source", given)))
-                key[name] = hashlib.sha256(source.read_bytes()).hexdigest() if source.is_file() else str(source)
+                key[name] = file_digest(source) if source.is_file() else str(source)
     return key
 
 

@@ -40,7 +40,7 @@ from threadpoolctl import ThreadpoolController
 
 from unstack.atomic import atomic_write_bytes
 from unstack.checks import finite_number
-from unstack.errors import InvalidFile
+from unstack.errors import InvalidFile, UnstackError
 from unstack.jsonio import refuse_special_file
 from unstack.learning.classifier import SupportClassifier
 from unstack.learning.features import FeatureSettings
@@ -319,8 +319,6 @@ def load_model(path: str | os.PathLike[str]) -> SupportModel:
         Not a readable file, not a skops file, types skops does not trust, not an
         ``unstack.model/1`` payload, or a model of another version.
     """
-    from unstack.errors import UnstackError
-
     source = str(path)
     payload = read_payload(path, MODEL_FORMAT)
     metadata = read_metadata(payload, source)
