@@ -93,8 +93,9 @@ def test_a_plan_whose_steps_do_not_follow_its_order_is_invalid(tmp_path: Path, c
             r"holds_up\[0\]\[1\]: expected a proba",
         ),
         (lambda reasons: [{**reasons[0], "held_by": ["z", 0.1]}, *reasons[1:]], r"\$\.reasons\[0\]\.held_by\[0\]"),
+        (lambda reasons: [{**reasons[0], "holds_up": [[[], 0.5]]}, *reasons[1:]], r"holds_up\[0\]\[0\]: expected one"),
     ],
-    ids=["short", "unknown-box", "not-a-probability", "unknown-holder"],
+    ids=["short", "unknown-box", "not-a-probability", "unknown-holder", "a-list-for-a-box"],
 )
 def test_a_decisions_reasons_name_its_objects_with_probabilities(tmp_path: Path, change: Any, message: str) -> None:
     decision = unstack.decide(SUPPORTS).to_dict()

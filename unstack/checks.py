@@ -544,6 +544,8 @@ def check_decision_document(document: Document) -> None:
 def _check_unique(boxes: Sequence[str], source: str, path: str) -> None:
     seen: set[str] = set()
     for box in boxes:
+        if not isinstance(box, str):
+            raise InvalidFile(source, path, f"expected box ids, got {box!r:.60}")
         if box in seen:
             raise InvalidFile(source, path, f"expected each box once, {box!r} appears twice")
         seen.add(box)
@@ -551,8 +553,8 @@ def _check_unique(boxes: Sequence[str], source: str, path: str) -> None:
 
 def _check_known(boxes: Sequence[str], known: set[str], source: str, path: str) -> None:
     for index, box in enumerate(boxes):
-        if box not in known:
-            raise InvalidFile(source, f"{path}[{index}]", f"expected one of the objects, got {box!r}")
+        if not isinstance(box, str) or box not in known:  # where the schema leaves an id untyped: a list, say
+            raise InvalidFile(source, f"{path}[{index}]", f"expected one of the objects, got {box!r:.60}")
 
 
 def _check_reasons(reasons: list[dict[str, Any]], objects: Sequence[str], source: str) -> None:
