@@ -139,3 +139,10 @@ def test_a_decision_and_a_plan_as_written_are_valid(tmp_path: Path) -> None:
     assert unstack.validate(_written(tmp_path, unstack.decide(SUPPORTS).to_dict())).format == "unstack.decision/1"
     assert unstack.validate(_written(tmp_path, unstack.plan(SUPPORTS).to_dict())).format == "unstack.plan/1"
     assert unstack.validate(_written(tmp_path, PAYOFF)).format == "unstack.payoff/1"
+
+
+def test_keys_of_a_decisions_evidence_beyond_its_two_lists_are_not_read(tmp_path: Path) -> None:
+    """The schema lets the evidence object hold more; the check iterated them (a TypeError on a number)."""
+    decision = unstack.decide(SUPPORTS).to_dict()
+    document = {**decision, "evidence": {**decision["evidence"], "note": 1}}
+    assert unstack.validate(_written(tmp_path, document)).format == "unstack.decision/1"

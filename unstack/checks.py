@@ -528,8 +528,9 @@ def check_decision_document(document: Document) -> None:
     methods = data.get("component_methods")
     if methods is not None and len(methods) != len(components):
         raise InvalidFile(source, "$.component_methods", f"expected one method per component ({len(components)})")
-    for kind, pairs in data.get("evidence", {}).items():
-        for index, pair in enumerate(pairs):
+    evidence = data.get("evidence", {})
+    for kind in ("forced", "forbidden"):  # the schema's two lists (other keys are not read)
+        for index, pair in enumerate(evidence.get(kind, [])):
             _check_known(pair, known, source, f"$.evidence.{kind}[{index}]")
     if "reasons" in data:
         _check_reasons(data["reasons"], objects, source)
