@@ -150,14 +150,14 @@ json_values = st.recursive(
 
 @given(json_values)
 def test_the_walk_of_a_document_meets_every_value_in_document_order(value: Any) -> None:
-    from unstack.jsonio import _find_non_finite, _too_deep, _walk
+    from unstack.jsonio import _find_non_finite, _walk, too_deep
 
     reference = _reference_paths(value)
     assert [tuple(path) for path, _ in _walk(value)] == reference
     bad = [path for path in reference if isinstance(_get(value, path), float) and not np.isfinite(_get(value, path))]
     assert [tuple(path) for path in _find_non_finite(value, [])] == ([()] if _is_bad(value) else []) + bad
     deepest = [path for path in reference if len(path) > 2]
-    assert _too_deep(value, 2) == (list(deepest[0]) if deepest else None)
+    assert too_deep(value, 2) == (list(deepest[0]) if deepest else None)
 
 
 def _get(value: Any, path: tuple[Any, ...]) -> Any:

@@ -36,12 +36,14 @@ __all__ = [
     "document_text",
     "finite_json",
     "format_json_path",
+    "json_kind",
     "load_schema",
     "parse_json",
     "read_document",
     "refuse_special_file",
     "report_text",
     "special_file",
+    "too_deep",
     "validate_document",
 ]
 
@@ -140,8 +142,16 @@ def _find_non_finite(value: Any, path: list[str | int]) -> Iterator[list[str | i
             yield [*path, *keys]
 
 
-def _too_deep(value: Any, limit: int) -> list[str | int] | None:
-    """The JSON path of the first value nested deeper than ``limit``, or None."""
+def too_deep(value: Any, limit: int) -> list[str | int] | None:
+    """The keys to the first value nested deeper than ``limit`` levels, or None.
+
+    Examples
+    --------
+    >>> too_deep({"a": [[1]]}, 2)
+    ['a', 0, 0]
+    >>> too_deep({"a": [1]}, 2) is None
+    True
+    """
     for keys, _ in _walk(value):
         if len(keys) > limit:
             return list(keys)
@@ -216,8 +226,14 @@ def parse_json(text: str, source: str) -> Any:
         ) from None
 
 
-def _json_kind(value: Any) -> str:
-    """What a JSON value is, in JSON's words (``null``, a list, ...)."""
+def json_kind(value: Any) -> str:
+    """What a JSON value is, in JSON's words (``null``, a list, ...), for a message.
+
+    Examples
+    --------
+    >>> json_kind(None), json_kind([1]), json_kind(True)
+    ('null', 'a list', 'true')
+    """
     if value is None:
         return "null"
     if isinstance(value, bool):
@@ -378,8 +394,8 @@ def read_document(path: str | os.PathLike[str]) -> Document:
         base_dir = file.resolve().parent
     data = parse_json(text, source)
     if not isinstance(data, dict):
-        raise InvalidFile(source, "$", f"expected a JSON object, got {_json_kind(data)}: not an unstack document")
-    deep = _too_deep(data, MAX_DEPTH)
+        raise InvalidFile(source, "$", f"expected a JSON object, got {json_kind(data)}: not an unstack document")
+    deep = too_deep(data, MAX_DEPTH)
     if deep is not None:
         where = format_json_path(deep[:8]) + "..."
         raise InvalidFile(source, where, f"expected JSON nested at most {MAX_DEPTH} levels deep")

@@ -350,7 +350,7 @@ def read_metadata(payload: dict[str, Any], source: str) -> dict[str, Any]:
     InvalidModel
         Not JSON text, nested deeper than files may be, or not an object.
     """
-    from unstack.jsonio import MAX_DEPTH, _json_kind, _too_deep
+    from unstack.jsonio import MAX_DEPTH, json_kind, too_deep
 
     text = payload["metadata"]
     if not isinstance(text, str):
@@ -362,8 +362,8 @@ def read_metadata(payload: dict[str, Any], source: str) -> dict[str, Any]:
     except ValueError as error:
         raise InvalidModel(source, "$.metadata", f"expected JSON text: {error}") from None
     if not isinstance(metadata, dict):
-        raise InvalidModel(source, "$.metadata", f"expected a JSON object, got {_json_kind(metadata)}")
-    if _too_deep(metadata, MAX_DEPTH) is not None:
+        raise InvalidModel(source, "$.metadata", f"expected a JSON object, got {json_kind(metadata)}")
+    if too_deep(metadata, MAX_DEPTH) is not None:
         raise InvalidModel(source, "$.metadata", f"expected JSON nested at most {MAX_DEPTH} levels deep")
     return metadata
 
