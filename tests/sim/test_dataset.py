@@ -15,6 +15,7 @@ import pytest
 
 from tests.sim.conftest import small_settings
 from unstack.dataset_folders import list_configurations, read_manifest
+from unstack.errors import UnstackError
 from unstack.scene import load_scene
 from unstack.sim.dataset import DatasetConflict, SchedulerUnavailable, simulate_dataset
 from unstack.sim.settings import SimulationSettings
@@ -91,6 +92,12 @@ def test_a_folder_of_another_data_set_is_refused(tmp_path: Path, change: dict[st
     with pytest.raises(DatasetConflict, match=message):
         simulate_dataset(tmp_path, arguments["settings"], configs=2, seed=arguments["seed"])  # type: ignore[arg-type]
     assert len(list_configurations(tmp_path)) == 1
+
+
+def test_a_data_set_of_one_box_piles_is_refused_by_the_settings_name(tmp_path: Path) -> None:
+    with pytest.raises(UnstackError, match=r"^settings\.boxes: 1-4: a pile of one box supports nothing"):
+        simulate_dataset(tmp_path, small_settings(boxes=(1, 4)), configs=1, seed=21)
+    assert not any(tmp_path.iterdir())
 
 
 @pytest.mark.parametrize("content", ["{not json", '{"format": "unstack.scene/1"}'], ids=["garbage", "foreign"])

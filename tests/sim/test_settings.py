@@ -39,7 +39,7 @@ def test_round_trip_through_json(sizes: str) -> None:
     ("arguments", "message"),
     [
         ({"sizes": "paper3"}, r"unknown size set 'paper3'; expected one of paper2, four"),
-        ({"boxes": (40, 30)}, r"box range 40-30 is reversed"),
+        ({"boxes": (40, 30)}, r"settings\.boxes: the range 40-30 is reversed"),
         ({"boxes": (-1, 5)}, r"settings\.boxes\[0\]: expected a number at least 1, got -1"),
         ({"boxes": (0, 0)}, r"settings\.boxes\[0\]: expected a number at least 1, got 0"),
         ({"boxes": (300, 400)}, r"400 boxes of size set 'paper2' do not fit a 2.0 x 2.35 x 2.39 m container"),

@@ -29,6 +29,12 @@ def parse_box_range(text: str) -> tuple[int, int]:
         raise UnstackError(f"--boxes: expected COUNT or LOW-HIGH (for example 30-40), got {text!r}")
     low = int(match.group(1))
     high = int(match.group(2)) if match.group(2) is not None else low
+    if low > high:
+        raise UnstackError(f"--boxes: the range {text.strip()} is reversed; expected LOW-HIGH with LOW <= HIGH")
+    if low < 2:
+        raise UnstackError(
+            f"--boxes: expected at least 2 boxes a pile (one box supports nothing), got {text.strip()!r}"
+        )
     return low, high
 
 

@@ -389,7 +389,9 @@ def simulate_dataset(
         raise UnstackError(f"jobs must be from 1 to {MAX_JOBS}, got {jobs}")
     if settings.boxes[0] < 2:
         low, high = settings.boxes
-        raise UnstackError(f"boxes {low}-{high}: a pile of one box supports nothing; a data set needs at least 2")
+        raise UnstackError(
+            f"settings.boxes: {low}-{high}: a pile of one box supports nothing; a data set needs at least 2 a pile"
+        )
     start = time.perf_counter()
     target = Path(folder)
     if target.exists() and not target.is_dir():

@@ -254,7 +254,9 @@ class SimulationSettings:
         _check_pairs(self.pile, self.sensor, "settings", refuse)
         low, high = self.boxes
         if low > high:
-            raise InvalidSettings(f"box range {low}-{high} is reversed; expected LOW-HIGH with LOW <= HIGH")
+            raise InvalidSettings(
+                f"settings.boxes: the range {low}-{high} is reversed; expected LOW-HIGH with LOW <= HIGH"
+            )
         if self.pile.arrangement not in ARRANGEMENTS:
             raise InvalidSettings(
                 f"unknown arrangement {self.pile.arrangement!r}; expected one of {', '.join(ARRANGEMENTS)}"
