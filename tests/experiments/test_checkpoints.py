@@ -44,7 +44,7 @@ def test_a_pile_whose_cloud_changed_is_another_pile(tmp_path: Path, examples: Pa
 
     import numpy as np
 
-    from unstack.experiments.outputs import scene_digest
+    from unstack.dataset_folders import scene_digest
 
     scene = json.loads((examples / "scene3.json").read_text())
     shutil.copy(examples / scene["points_file"], tmp_path / scene["points_file"])

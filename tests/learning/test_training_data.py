@@ -46,6 +46,20 @@ def test_fingerprint_changes_with_the_data(small_dataset: Path, tmp_path: Path) 
     assert dataset_fingerprint(small_dataset) != dataset_fingerprint(tmp_path)
 
 
+def test_fingerprint_changes_with_a_cloud(tmp_path: Path, examples: Path) -> None:
+    """The fingerprint hashed the scene JSONs alone: a model trained on other clouds told the same data."""
+    import json
+    import shutil
+
+    scene = json.loads((examples / "scene3.json").read_text())
+    shutil.copy(examples / scene["points_file"], tmp_path / scene["points_file"])
+    (tmp_path / "config-0000.json").write_text(json.dumps(scene))
+    before = dataset_fingerprint(tmp_path)
+    cloud = np.load(tmp_path / scene["points_file"])
+    np.save(tmp_path / scene["points_file"], cloud + np.array([0.0, 0.0, 0.5]))
+    assert dataset_fingerprint(tmp_path) != before
+
+
 def test_a_folder_without_scenes(tmp_path: Path) -> None:
     with pytest.raises(UnstackError, match=r"expected a data set folder with config-NNNN\.json scene files"):
         dataset_examples(tmp_path)

@@ -272,9 +272,8 @@ def decisions(
     require_configurations(data_dir)  # before any progress bar or output folder
     earlier = read_document(pair_with).data if pair_with is not None else None
     if earlier is not None:
-        from unstack.dataset_folders import list_configurations
+        from unstack.dataset_folders import dataset_digest, list_configurations
         from unstack.experiments.decisions import require_same_draw
-        from unstack.experiments.outputs import dataset_digest
 
         this = {"data": str(data_dir), "r": r, "seed": seed, "draw": draw}
         if "data_sha256" in earlier:

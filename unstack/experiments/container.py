@@ -726,9 +726,9 @@ def container_experiment(
     import json
 
     from unstack.atomic import atomic_write_text
-    from unstack.dataset_folders import first_configurations
+    from unstack.dataset_folders import first_configurations, scene_digest
     from unstack.experiments.decisions import paired_difference
-    from unstack.experiments.outputs import checkpoint_folder, file_digest, model_digest, scene_digest, stored_result
+    from unstack.experiments.outputs import checkpoint_folder, file_digest, model_digest, stored_result
 
     container_policies(model, seed=seed, makers=makers)  # unknown makers fail before any work
     if disturbance is not None and not isinstance(disturbance, str | os.PathLike):

@@ -331,7 +331,7 @@ def evaluate_decisions(
         for maker in DECISION_MAKERS
         if maker != "reasoner"
     }
-    from unstack.experiments.outputs import dataset_digest
+    from unstack.dataset_folders import dataset_digest
 
     return {
         "data": str(data_dir),

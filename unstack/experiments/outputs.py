@@ -135,29 +135,6 @@ def stored_result(path: Path, key: dict[str, Any]) -> dict[str, Any] | None:
     return result
 
 
-def scene_digest(path: Path) -> str:
-    """SHA-256 of a scene file with the files it names (its cloud, its points' box labels): what a
-    pile's stored result rests on, so a changed cloud is run again.
-
-    Examples
-    --------
-    >>> len(scene_digest(Path("examples/pile5.scene.json")))
-    64
-    """
-    digest = hashlib.sha256(path.read_bytes())
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, ValueError):  # no scene: the bytes alone
-        return digest.hexdigest()
-    metadata = data.get("metadata") if isinstance(data, dict) else None
-    named = [data.get("points_file") if isinstance(data, dict) else None]
-    named.append(metadata.get("point_boxes_file") if isinstance(metadata, dict) else None)
-    for name in named:
-        if isinstance(name, str) and (path.parent / name).is_file():
-            digest.update((path.parent / name).read_bytes())
-    return digest.hexdigest()
-
-
 def file_digest(path: Path) -> str:
     """SHA-256 of a file's bytes (a model or a disturbance model a run's results rest on)."""
     return hashlib.sha256(path.read_bytes()).hexdigest()
@@ -171,19 +148,4 @@ def model_digest(model: Any) -> str:
     source = Path(str(model.source)) if getattr(model, "source", "") else None
     if source is not None and source.is_file():
         digest.update(source.read_bytes())
-    return digest.hexdigest()
-
-
-def dataset_digest(files: list[Path]) -> str:
-    """SHA-256 of a data set's configurations (:func:`scene_digest` of each, by name): two runs on
-    one data set agree on it wherever each was started from.
-
-    Examples
-    --------
-    >>> dataset_digest([Path("examples/pile5.scene.json")]) == dataset_digest([Path("./examples/pile5.scene.json")])
-    True
-    """
-    digest = hashlib.sha256()
-    for path in sorted(files, key=lambda file: file.name):
-        digest.update(f"{path.name}:{scene_digest(path)};".encode())
     return digest.hexdigest()

@@ -154,7 +154,8 @@ def _pile_key(
 ) -> dict[str, Any]:
     """What a pile's states depend on: the scene with its cloud, the seed, the picks allowed, the
     behaviour and (for a decision maker) its models."""
-    from unstack.experiments.outputs import file_digest, model_digest, scene_digest
+    from unstack.dataset_folders import scene_digest
+    from unstack.experiments.outputs import file_digest, model_digest
 
     key: dict[str, Any] = {"scene_sha256": scene_digest(path), "seed": seed, "max_picks": max_picks,
                            "behaviour": behaviour}  # fmt: skip

@@ -166,7 +166,8 @@ def unloading_orders(scene: Any, model: Any, settings: DecisionSettings) -> dict
 def _pile_key(path: Path, model: Any, settings: DecisionSettings, closed_loop: bool) -> dict[str, Any]:
     """What a pile's result depends on: the scene file, the model, the decisions' settings and
     the makers."""
-    from unstack.experiments.outputs import model_digest, scene_digest
+    from unstack.dataset_folders import scene_digest
+    from unstack.experiments.outputs import model_digest
 
     return {
         "scene": path.name,

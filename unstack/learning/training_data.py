@@ -234,16 +234,14 @@ def _one_file(
 
 
 def dataset_fingerprint(folder: str | os.PathLike[str]) -> str:
-    """SHA-256 of a data set's manifest and scene files (what a model was trained on)."""
-    from unstack.dataset_folders import list_configurations
+    """SHA-256 of a data set's manifest and scene files with their clouds (what a model was trained on)."""
+    from unstack.dataset_folders import MANIFEST, dataset_digest, list_configurations
 
     digest = hashlib.sha256()
-    manifest = Path(folder) / "manifest.json"
+    manifest = Path(folder) / MANIFEST
     if manifest.is_file():
         digest.update(manifest.read_bytes())
-    for path in list_configurations(folder):
-        digest.update(path.name.encode())
-        digest.update(path.read_bytes())
+    digest.update(dataset_digest(list_configurations(folder)).encode())
     return digest.hexdigest()
 
 
