@@ -48,6 +48,32 @@ def test_an_unknown_maker_is_refused_before_any_work(small_dataset: Path) -> Non
         container_experiment(small_dataset, load_model(default_model_path()), makers=("unstack", "tallest"))
 
 
+@pytest.mark.slow  # physics runs of a decision maker
+@pytest.mark.parametrize(
+    ("given", "message"),
+    [
+        ({"occupancy": 0.5}, r"occupancy 0\.5 is not used: only belief_sampled, belief_sampled_veto read it"),
+        ({"disturbance": "any.skops"}, r"the disturbance model is not used: only moves, moves_veto, "),
+    ],
+    ids=["occupancy", "disturbance"],
+)
+def test_a_setting_no_maker_reads_is_said_unused_and_not_recorded(
+    small_dataset: Path, given: dict[str, object], message: str
+) -> None:
+    """They were accepted silently, recorded among the run's settings and joined its checkpoints' key."""
+    with pytest.warns(UserWarning, match=message):
+        result = container_experiment(
+            small_dataset,
+            load_model(default_model_path()),
+            piles=1,
+            max_picks=1,
+            seed=2,
+            makers=("highest",),
+            **given,  # type: ignore[arg-type]
+        )
+    assert result["occupancy"] is None
+
+
 @pytest.mark.slow  # physics runs of every decision maker
 def test_the_cli_writes_the_results_and_resumes(small_dataset: Path, tmp_path: Path) -> None:
     arguments = ["experiment", "container", str(small_dataset), "--out", str(tmp_path), "--piles", "1",

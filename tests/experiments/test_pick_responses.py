@@ -116,6 +116,18 @@ def test_a_decision_maker_as_behaviour_takes_every_pick(small_dataset: Path, tmp
         assert len(after.box_ids) == len(scene.box_ids) - 1
 
 
+def test_models_given_to_the_drawn_behaviour_are_said_unused(small_dataset: Path, tmp_path: Path) -> None:
+    """A support model given with behaviour 'mixed' was taken silently (the CLI did not even open the file)."""
+    from unstack.learning.model_file import default_model_path, load_model
+
+    with pytest.warns(UserWarning, match=r"the support model is not used: the picks are drawn \(behaviour 'mixed'\)"):
+        collect_pick_responses(
+            [small_dataset], tmp_path, piles=1, seed=1, max_picks=1, model=load_model(default_model_path())
+        )
+    collect_pick_responses([small_dataset], tmp_path / "plain", piles=1, seed=1, max_picks=1)
+    assert len(list(load_states(tmp_path))) == len(list(load_states(tmp_path / "plain")))
+
+
 def test_an_unknown_behaviour_is_refused(small_dataset: Path, tmp_path: Path) -> None:
     with pytest.raises(InvalidArgument, match="unknown behaviour 'tallest'; expected one of mixed, unstack"):
         collect_pick_responses([small_dataset], tmp_path, behaviour="tallest")

@@ -731,16 +731,14 @@ def pick_responses(
     undone). Which candidate is then taken: by default drawn (the probe's best, the highest, a
     random one); with --behaviour, a decision maker's pick.
     """
-    from unstack.cli.main import _warn, load_model_option
+    from unstack.cli.main import load_model_option
     from unstack.sim.dataset import scheduler_client
 
-    if disturbance_path is not None:  # read by a moves maker taking the picks; refused now, or said unused
+    if disturbance_path is not None:  # read by a moves maker taking the picks; refused now (the library says unused)
         from unstack.learning.disturbance import load_disturbance_model
 
         load_disturbance_model(disturbance_path)
-        if behaviour == "mixed":
-            _warn(f"--disturbance {disturbance_path} is not used: the picks are drawn (--behaviour mixed)")
-    model = None if behaviour == "mixed" else load_model_option(model_path)[0]
+    model = None if behaviour == "mixed" and model_path is None else load_model_option(model_path)[0]
     with scheduler_client(scheduler, jobs) as client, progress_bar("piles") as report:
         summaries = collect_pick_responses(
             list(data_dirs), out, piles=piles, seed=seed, max_picks=max_picks, behaviour=behaviour, model=model,

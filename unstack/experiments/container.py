@@ -231,6 +231,8 @@ GATE_MOVES = 0.086
 MOVES_MAKERS = (
     "moves", "moves_veto", "hybrid_moves_free", "hybrid_moves_free_1", "hybrid_faces_free_gated", "hybrid_moves_walk",
 )  # fmt: skip
+#: Makers that read ``occupancy``, the ``sampled`` fill's share of unseen space kept solid.
+OCCUPANCY_MAKERS = ("belief_sampled", "belief_sampled_veto")
 #: Makers whose policy is told what every candidate's removal does in the engine (the true pile).
 PROBING_MAKERS = ("lookahead",)
 #: Recorded sweeps per sampled group in each decision: 512 when a sweep re-inserted every box,
@@ -688,6 +690,26 @@ def _pile_metrics(run: dict[str, Any]) -> dict[str, float]:
     }
 
 
+def _read_by_makers(makers: Sequence[str], occupancy: float | None, disturbance: Any) -> tuple[float | None, Any]:
+    """``occupancy`` and ``disturbance``, each None with a warning where no maker named reads it
+    (it was recorded among the run's settings and joined its checkpoints' key, unused)."""
+    import warnings
+
+    for given, readers, what in (
+        (occupancy, OCCUPANCY_MAKERS, f"occupancy {occupancy}"),
+        (disturbance, MOVES_MAKERS, "the disturbance model"),
+    ):
+        if given is not None and not set(readers) & set(makers):
+            warnings.warn(
+                f"{what} is not used: only {', '.join(readers)} read it, and none of them is among the makers",
+                stacklevel=3,
+            )
+    return (
+        occupancy if set(OCCUPANCY_MAKERS) & set(makers) else None,
+        disturbance if set(MOVES_MAKERS) & set(makers) else None,
+    )
+
+
 @validate_params({
     "piles": COUNT, "detector_noise": DETECTOR_NOISE, "detector_misses": MISSED_SHARE, "reach": OneOf(REACH_RULES),
     "max_picks": OPTIONAL_COUNT, "samples": COUNT, "seed": SEED, "n_jobs": JOBS, "occupancy": OPTIONAL_SHARE,
@@ -731,6 +753,7 @@ def container_experiment(
     from unstack.experiments.outputs import checkpoint_folder, file_digest, model_digest, stored_result
 
     container_policies(model, seed=seed, makers=makers)  # unknown makers fail before any work
+    occupancy, disturbance = _read_by_makers(makers, occupancy, disturbance)
     if disturbance is not None and not isinstance(disturbance, str | os.PathLike):
         disturbance = disturbance.source  # sent to the workers by path
     if set(MOVES_MAKERS) & set(makers):

@@ -292,6 +292,13 @@ def collect_pick_responses(
             f"two data sets are both named {named_twice[0]!r}: their states would share one folder under {out}; "
             "give one of them another folder name (or run them into two collections)"
         )
+    if behaviour == "mixed":
+        import warnings
+
+        for given, what in ((model, "the support model"), (disturbance, "the disturbance model")):
+            if given is not None:
+                warnings.warn(f"{what} is not used: the picks are drawn (behaviour 'mixed')", stacklevel=2)
+        model = disturbance = None
     files: list[Path] = []
     for data_dir in data_dirs:
         files += first_configurations(data_dir, piles)
