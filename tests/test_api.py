@@ -139,6 +139,13 @@ def test_validate_summarises_a_file(examples: Path) -> None:
     assert result.format == "unstack.scene/1" and "5 detected" in result.detail
 
 
+def test_validate_counts_one_box_and_one_point_in_the_singular(tmp_path: Path) -> None:
+    """It said '1 boxes, ..., 1 points'."""
+    scene = unstack.Scene([unstack.Box("only", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2])], [[1.0, 0.0, 0.4]], ["only"])
+    scene.save(tmp_path / "one.json")
+    assert unstack.validate(tmp_path / "one.json").detail == "1 box, 1 detected, 1 point"
+
+
 def test_importing_unstack_and_deciding_on_supports_stays_light(repo: Path) -> None:
     code = (
         "import sys, unstack\n"

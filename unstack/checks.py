@@ -47,6 +47,7 @@ __all__ = [
     "check_probability_matrix",
     "check_quaternion_xyzw",
     "check_vector",
+    "counted",
     "finite_number",
     "heavy_loads",
     "light_boxes",
@@ -102,6 +103,20 @@ def number_text(value: Any) -> str:
     if isinstance(value, int | np.integer) and not isinstance(value, bool) and int(value).bit_length() > 64:
         return f"an integer of about {int(int(value).bit_length() * math.log10(2)) + 1} digits"
     return repr(value)
+
+
+def counted(number: int, noun: str, plural: str | None = None) -> str:
+    """``number`` and ``noun`` for a message, plural unless it is one (``plural``: the plural
+    when it is not ``noun`` + "s").
+
+    Examples
+    --------
+    >>> counted(1, "configuration"), counted(3, "configuration"), counted(1, "box", "boxes")
+    ('1 configuration', '3 configurations', '1 box')
+    >>> counted(2_000, "box", "boxes")
+    '2,000 boxes'
+    """
+    return f"{number:,} {noun if number == 1 else plural or noun + 's'}"
 
 
 def finite_number(value: Any) -> float | None:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 
-from unstack.checks import check_decision_document, check_payoff_document, check_plan_document
+from unstack.checks import check_decision_document, check_payoff_document, check_plan_document, counted
 from unstack.jsonio import read_document, validate_document
 
 __all__ = ["Validated", "validate"]
@@ -90,7 +90,10 @@ def validate(path: str | os.PathLike[str]) -> Validated:
             from unstack.physics_veto import world_settings
 
             world_settings(scene)
-        detail = f"{len(scene.boxes)} boxes, {len(scene.detected)} detected, {len(scene.points):,} points"
+        detail = (
+            f"{counted(len(scene.boxes), 'box', 'boxes')}, {len(scene.detected)} detected, "
+            f"{counted(len(scene.points), 'point')}"
+        )
         return Validated(document.source, tag, detail, tuple(scene_warnings(scene)))
     elif tag == "unstack.plan/1":
         check_plan_document(document)

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import click
 
-from unstack.checks import MAX_BOX_EDGE, MAX_ID_LENGTH, MIN_BOX_EDGE, long_id
+from unstack.checks import MAX_BOX_EDGE, MAX_ID_LENGTH, MIN_BOX_EDGE, counted, long_id
 from unstack.errors import InvalidFile, UnstackError
 from unstack.jsonio import report_text
 
@@ -295,7 +295,8 @@ def scene(
         atomic_write_text(Path(report_file), report_text(built.report()))
     console = Console()
     table = number_table(
-        f"{len(built.scene.boxes)} boxes (gravity tilted {built.frame.tilt_deg:.1f} degrees from the input frame's z)",
+        f"{counted(len(built.scene.boxes), 'box', 'boxes')} "
+        f"(gravity tilted {built.frame.tilt_deg:.1f} degrees from the input frame's z)",
         ("box", "face", "size (m)", "position (m)", "residual (mm)", "face seen"),
     )
     fits = {item.box.id: item for item in built.fitted}

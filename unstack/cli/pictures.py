@@ -11,6 +11,7 @@ from typing import Any
 
 import click
 
+from unstack.checks import counted
 from unstack.cli.main import _warn, model_option
 from unstack.cli.progress import still_working
 from unstack.errors import UnstackError
@@ -119,7 +120,7 @@ def render(
         from unstack.pictures.graph import render_support_graph
 
         render_support_graph(values, output, threshold=threshold, title=title, dpi=dpi)
-        click.echo(f"{output}: support graph of {len(values.objects)} boxes; pick {values.choice}")
+        click.echo(f"{output}: support graph of {counted(len(values.objects), 'box', 'boxes')}; pick {values.choice}")
         return
     scene = loaded
     camera = scene_camera(scene)  # the scene's settings are checked before any decision
@@ -149,7 +150,7 @@ def render(
             dpi=dpi,
         )
     pick = f"; pick {values.choice}" if values is not None else ""
-    click.echo(f"{output}: {len(scene.boxes)} boxes, {len(scene.detected)} detected{pick}")
+    click.echo(f"{output}: {counted(len(scene.boxes), 'box', 'boxes')}, {len(scene.detected)} detected{pick}")
 
 
 @click.command()
@@ -200,4 +201,7 @@ def view(
             loaded, output, values=values, max_points=max_points, seed=seed, title=title or Path(file).name
         )
     pick = f"; pick {values.choice}" if values is not None else ""
-    click.echo(f"{output}: {len(loaded.boxes)} boxes, {len(loaded.detected)} detected{pick}; {size / 1e6:.1f} MB")
+    click.echo(
+        f"{output}: {counted(len(loaded.boxes), 'box', 'boxes')}, {len(loaded.detected)} detected{pick}; "
+        f"{size / 1e6:.1f} MB"
+    )

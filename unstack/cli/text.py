@@ -6,6 +6,8 @@ import re
 from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING
 
+from unstack.checks import counted
+
 if TYPE_CHECKING:
     from rich.table import Table
 
@@ -45,17 +47,6 @@ def shortened(text: str, longest: int = LONGEST_WORD) -> str:
         return f"{text[:head]}…({len(text):,} characters)…{text[-tail:]}"
 
     return re.sub(rf"\S{{{longest + 1},}}", cut, text)
-
-
-def counted(number: int, noun: str) -> str:
-    """``number`` and ``noun``, plural unless it is one.
-
-    Examples
-    --------
-    >>> counted(1, "configuration"), counted(3, "configuration")
-    ('1 configuration', '3 configurations')
-    """
-    return f"{number:,} {noun}{'' if number == 1 else 's'}"
 
 
 def number_table(title: str, columns: Sequence[str], rows: Iterable[Sequence[str]] = ()) -> Table:

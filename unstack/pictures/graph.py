@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from unstack.checks import counted
 from unstack.pictures.labels import LABEL_POINTS, place_labels
 from unstack.pictures.panels import ARROW, HIGHLIGHT, CostColours, arrow_legend, arrow_width, box_label, draw_ranking
 from unstack.pictures.values import DecisionValues, check_threshold
@@ -145,7 +146,8 @@ def draw_support_graph(values: DecisionValues, *, threshold: float = 0.5, title:
     axes.set_aspect("equal", adjustable="box")
     axes.set_axis_off()
     axes.set_title(
-        f"support graph ({len(values.objects)} boxes, {len(arrows)} arrows); supporters below",
+        f"support graph ({counted(len(values.objects), 'box', 'boxes')}, {counted(len(arrows), 'arrow')}); "
+        "supporters below",
         fontsize=LABEL_POINTS + 2,
     )
     arrow_legend(axes, threshold, f"P(X supports Y) ≥ {threshold:g}")

@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from unstack.checks import counted
 from unstack.errors import InvalidArgument
 from unstack.geometry import BOX_FACES, box_corners, convex_hull_2d
 from unstack.pictures.camera import Camera
@@ -323,7 +324,7 @@ def draw_scene(
         draw_ranking(ranking, values, costs or CostColours(values))
         if arrows:
             count = _draw_arrows(sensor, centres, values, threshold)
-            sensor_title += f"; {count} support arrows"
+            sensor_title += f"; {counted(count, 'support arrow')}"
             arrow_legend(sensor, threshold, f"P(X supports Y) ≥ {threshold:g}")
     sensor.set_title(sensor_title, fontsize=LABEL_POINTS + 2)
     if title:
