@@ -339,3 +339,13 @@ def test_real7_rows_of_a_size_the_piles_do_not_hold_are_dashes() -> None:
         ["4", "2", "81.0 %", "50.0 %", "50.0 %", "50.0 %"],
         ["5", "0", "62.0 %", "-", "-", "-"],
     ]
+
+
+def test_the_bins_edges_are_written_as_their_decimals() -> None:
+    """linspace's edges were written with float noise: 0.30000000000000004, 0.09999999999999999."""
+    from unstack.experiments.decisions import BINS, _binned
+
+    empty = {maker: {"squared_regret": np.zeros(0)} for maker in ("reasoner", "random")}
+    binned = _binned([], empty)
+    edges = [edge for rows in binned.values() for row in rows for edge in (row["low"], row["high"])]
+    assert len(binned) == len(BINS) and all(len(repr(edge)) <= 5 for edge in edges), edges

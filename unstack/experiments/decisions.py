@@ -245,7 +245,8 @@ def _binned(isets: list[IsetOutcome], scores: dict[str, dict[str, np.ndarray]]) 
         rows = []
         for k in range(len(edges) - 1):
             members = which == k
-            row: dict[str, Any] = {"low": float(edges[k]), "high": float(edges[k + 1]), "isets": int(members.sum())}
+            low, high = (round(float(edge), 12) for edge in edges[k : k + 2])  # linspace's 0.30000000000000004
+            row: dict[str, Any] = {"low": low, "high": high, "isets": int(members.sum())}
             for maker in ("reasoner", "random"):
                 regret = scores[maker]["squared_regret"][members]
                 row[f"mse_{maker}"] = float(regret.mean()) if members.any() else None
