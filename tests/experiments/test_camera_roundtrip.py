@@ -49,3 +49,24 @@ def test_the_cli_reports_errors_and_decisions(small_dataset: Path, tmp_path: Pat
         assert summary[f"{name}_pick_boxes_moved_mean"] == pytest.approx(np.mean(moved))
         assert summary[f"{name}_pick_moved_nothing_share"] == pytest.approx(np.mean([count == 0 for count in moved]))
     assert "the pick moves nothing in the true pile" in run.stdout
+
+
+def test_a_doubt_of_the_built_scene_names_its_pile(small_dataset: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The camera's doubts were said of a scene the user never saw, naming no pile."""
+    import warnings
+
+    import unstack.camera
+    from unstack.experiments.camera_roundtrip import _roundtrip_pile
+    from unstack.learning.model_file import default_model_path, load_model
+
+    real = unstack.camera.scene_from_depth
+
+    def doubting(*args: object, **kwargs: object) -> object:
+        warnings.warn("cannot tell whether the pose's z is up", stacklevel=2)  # as scene_from_depth says it
+        return real(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(unstack.camera, "scene_from_depth", doubting)
+    path = sorted(small_dataset.glob("config-*.json"))[0]
+    with pytest.warns(UserWarning, match=rf"^{path.name}, built from its camera view: cannot tell whether the pose"):
+        _, result = _roundtrip_pile(path, 0, load_model(default_model_path()), 64)
+    assert result["warnings"] == ["cannot tell whether the pose's z is up"]

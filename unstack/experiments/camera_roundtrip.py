@@ -76,10 +76,14 @@ def _roundtrip_pile(path: Path, number: int, model: Any, samples: int) -> tuple[
     settings = scene_settings(scene) or SimulationSettings()
     view = camera_view(scene)
     ids = sorted(view.masks)
-    built = scene_from_depth(
-        view.depth_m, view.intrinsics, view.camera_to_world, [view.masks[box_id] for box_id in ids], ids=ids,
-        known_sizes=[tuple(size) for size in settings.box_sizes()], door=[-1.0, 0.0, 0.0],
-    )  # fmt: skip
+    with warnings.catch_warnings(record=True) as doubts:  # said again below, naming the pile
+        warnings.simplefilter("always")
+        built = scene_from_depth(
+            view.depth_m, view.intrinsics, view.camera_to_world, [view.masks[box_id] for box_id in ids], ids=ids,
+            known_sizes=[tuple(size) for size in settings.box_sizes()], door=[-1.0, 0.0, 0.0],
+        )  # fmt: skip
+    for doubt in doubts:
+        warnings.warn(f"{path.name}, built from its camera view: {doubt.message}", stacklevel=2)
     boxes = []
     for item in built.fitted:
         truth = scene.box(item.box.id)
@@ -103,7 +107,8 @@ def _roundtrip_pile(path: Path, number: int, model: Any, samples: int) -> tuple[
         moved[name] = list(execute_unloading(scene, [choices[name]]).steps[0].moved)
     return number, {"scene": path.name, "tilt_deg": built.frame.tilt_deg, "boxes": boxes,
                     "duplicates": built.duplicates, "unfitted": built.unfitted,
-                    "masks": len(ids), "choices": choices, "moved": moved}  # fmt: skip
+                    "masks": len(ids), "choices": choices, "moved": moved,
+                    "warnings": [str(doubt.message) for doubt in doubts]}  # fmt: skip
 
 
 @validate_params({"piles": COUNT, "samples": COUNT, "n_jobs": JOBS})
