@@ -163,3 +163,19 @@ def test_a_box_out_of_the_sensors_view_is_labelled_at_the_panels_edge(side_m: fl
     assert label.get_text().endswith("(out of view)")
     x, y = sensor.transData.transform(label.xy)
     assert frame.x0 - 1 <= x <= frame.x1 + 1 and frame.y0 - 1 <= y <= frame.y1 + 1
+
+
+def test_a_long_id_is_drawn_shortened_in_every_panel() -> None:
+    """A 200-character id was one label across all three panels, and the PNG widened to hold it."""
+    from unstack.pictures.panels import LONGEST_DRAWN_ID
+    from unstack.scene import Box
+    from unstack.understanding.clouds import surface_cloud
+
+    long_id = "carton-" + "x" * 180 + "-end"
+    boxes = [Box("b00", [0.4, 0.4, 0.4], [1.5, 0.0, 0.2]), Box(long_id, [0.4, 0.4, 0.4], [1.5, 0.5, 0.2])]
+    scene = Scene(boxes, surface_cloud(boxes, spacing=0.02, seed=0), ["b00", long_id])
+    figure = draw_scene(scene, values=DecisionValues(["b00", long_id], [0.5, 0.0], choice=long_id))
+    figure.canvas.draw()
+    texts = [text.get_text() for axes in figure.axes for text in [*axes.texts, *axes.get_yticklabels()]]
+    assert all(len(text) < LONGEST_DRAWN_ID + 20 for text in texts), max(texts, key=len)
+    assert any(text.startswith("carton-") and text.endswith("…xx-end") for text in texts)

@@ -17,7 +17,16 @@ import numpy as np
 from unstack.pictures.labels import LABEL_POINTS
 from unstack.pictures.values import DecisionValues
 
-__all__ = ["HIGHLIGHT", "CostColours", "arrow_legend", "arrow_width", "box_label", "draw_ranking"]
+__all__ = [
+    "HIGHLIGHT",
+    "LONGEST_DRAWN_ID",
+    "CostColours",
+    "arrow_legend",
+    "arrow_width",
+    "box_label",
+    "draw_ranking",
+    "drawn_id",
+]
 
 #: Edge colour of the chosen box (no colour of the cost map is near it).
 HIGHLIGHT = "#e6007e"
@@ -53,6 +62,27 @@ class CostColours:
         return bar
 
 
+#: Ids longer than this many characters are drawn shortened in pictures (a 200-character id was
+#: one label across every panel, and widened the picture to hold it).
+LONGEST_DRAWN_ID = 24
+
+
+def drawn_id(box: str) -> str:
+    """A box id as a picture draws it: whole up to :data:`LONGEST_DRAWN_ID` characters, else its
+    start and end around an ellipsis.
+
+    Examples
+    --------
+    >>> drawn_id("b04")
+    'b04'
+    >>> drawn_id("carton-" + "x" * 40 + "-17")
+    'carton-xxxxxxxx…xxx-17'
+    """
+    if len(box) <= LONGEST_DRAWN_ID:
+        return box
+    return f"{box[:15]}…{box[-6:]}"
+
+
 def box_label(values: DecisionValues, box: str) -> str:
     """A box's label: its id, with its place in the plan when there is one (``"3. b04"``).
 
@@ -62,7 +92,7 @@ def box_label(values: DecisionValues, box: str) -> str:
     '2. a'
     """
     number = values.plan_number(box)
-    return f"{number}. {box}" if number is not None else box
+    return f"{number}. {drawn_id(box)}" if number is not None else drawn_id(box)
 
 
 def arrow_width(probability: float, threshold: float) -> float:
@@ -117,7 +147,9 @@ def draw_ranking(axes: Any, values: DecisionValues, colours: CostColours) -> Non
         error_kw={"elinewidth": 1.0, "capsize": 2.0, "ecolor": "0.2"},
         height=0.75,
     )
-    axes.set_yticks(rows, ids, fontsize=LABEL_POINTS)  # ids only: the plan's numbers are the 3D panel's
+    axes.set_yticks(
+        rows, [drawn_id(box) for box in ids], fontsize=LABEL_POINTS
+    )  # ids only: the plan's numbers are the 3D panel's
     for tick, box in zip(axes.get_yticklabels(), ids, strict=True):
         if box == values.choice:
             tick.set_color(HIGHLIGHT)

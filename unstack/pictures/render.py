@@ -34,7 +34,16 @@ from unstack.errors import InvalidArgument
 from unstack.geometry import BOX_FACES, box_corners, convex_hull_2d
 from unstack.pictures.camera import Camera
 from unstack.pictures.labels import LABEL_POINTS, place_labels
-from unstack.pictures.panels import ARROW, HIGHLIGHT, CostColours, arrow_legend, arrow_width, box_label, draw_ranking
+from unstack.pictures.panels import (
+    ARROW,
+    HIGHLIGHT,
+    CostColours,
+    arrow_legend,
+    arrow_width,
+    box_label,
+    draw_ranking,
+    drawn_id,
+)
 from unstack.pictures.values import DecisionValues, check_threshold
 from unstack.scene import Scene
 
@@ -102,7 +111,9 @@ def _draw_oblique(axes: Any, scene: Scene, colour: Callable[[int], Colour], valu
     if choice is not None and choice in scene.box_ids:
         box = scene.box(choice)
         top = box.position + np.array([0.0, 0.0, float(box.size.max()) / 2.0 + 0.08])
-        axes.text(*top, f"pick: {choice}", color=HIGHLIGHT, fontsize=LABEL_POINTS + 1, fontweight="bold", zorder=30)
+        axes.text(
+            *top, f"pick: {drawn_id(choice)}", color=HIGHLIGHT, fontsize=LABEL_POINTS + 1, fontweight="bold", zorder=30
+        )
     all_corners = np.concatenate([box_corners(box) for box in scene.boxes])
     low, high = all_corners.min(axis=0), all_corners.max(axis=0)
     low[2] = 0.0
