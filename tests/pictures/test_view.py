@@ -55,6 +55,19 @@ def test_hover_names_the_strongest_relations() -> None:
     assert hover_text(None, "x<y>") == "<b>x&lt;y&gt;</b>"
 
 
+def test_the_sliders_titles_escape_the_heading_and_the_ids_as_the_first_title_does() -> None:
+    """The slider's titles carried the heading and the ids raw ('</title><script>', "a'b")."""
+    from unstack.scene import Box
+
+    boxes = [Box("<b>x</b>", [0.4, 0.4, 0.4], [1.0, 0.0, 0.2]), Box("a'b", [0.4, 0.4, 0.4], [1.0, 0.0, 0.6])]
+    scene = Scene(boxes, np.zeros((0, 3)), ["<b>x</b>", "a'b"])
+    values = DecisionValues(["<b>x</b>", "a'b"], [1.0, 0.0], choice="a'b", order=["a'b", "<b>x</b>"])
+    figure = build_view(scene, values=values, title="</title><script>")
+    titles = [step.args[1]["title.text"] for step in figure.layout.sliders[0].steps]
+    assert titles[0] == figure.layout.title.text == "&lt;/title&gt;&lt;script&gt; — pick a&#x27;b (EC 0.00)"
+    assert titles[2] == "after 2 picks: a&#x27;b, &lt;b&gt;x&lt;/b&gt; taken away"
+
+
 def test_the_page_needs_no_network(tmp_path: Path, wall: Scene, wall_decision: DecisionValues) -> None:
     target = tmp_path / "pile.html"
     size = write_view(wall, target, values=wall_decision)

@@ -268,10 +268,11 @@ def _plan_slider(
             for index in box_traces.get(box, []):
                 visible[index] = False
         if k == 0:
-            label, text = "start", heading
+            label, text = "start", html.escape(heading)
         else:
             label = str(k)  # short: 40 steps fit the page's width; the title names the boxes
-            text = f"after {k} pick{'s' if k > 1 else ''}: {', '.join(values.order[:k])} taken away"
+            taken = ", ".join(html.escape(box) for box in values.order[:k])
+            text = f"after {k} pick{'s' if k > 1 else ''}: {taken} taken away"
         steps.append({"label": label, "method": "update", "args": [{"visible": visible}, {"title.text": text}]})
     return {"active": 0, "currentvalue": {"prefix": "picks taken: "}, "pad": {"t": 10, "b": 10}, "x": 0.05, "len": 0.9,
             "y": 0, "yanchor": "top", "font": {"size": 11}, "steps": steps}  # fmt: skip
