@@ -179,3 +179,15 @@ def test_a_long_id_is_drawn_shortened_in_every_panel() -> None:
     texts = [text.get_text() for axes in figure.axes for text in [*axes.texts, *axes.get_yticklabels()]]
     assert all(len(text) < LONGEST_DRAWN_ID + 20 for text in texts), max(texts, key=len)
     assert any(text.startswith("carton-") and text.endswith("…xx-end") for text in texts)
+
+
+def test_costs_all_zero_get_a_scale_of_one_box() -> None:
+    """The colour bar read 1e-9 and the ranking's axis 1e-6 when every expected cost was 0."""
+    from unstack.scene import Box
+
+    boxes = [Box("a", [0.4, 0.4, 0.4], [1.5, 0.0, 0.2]), Box("b", [0.4, 0.4, 0.4], [1.5, 0.5, 0.2])]
+    scene = Scene(boxes, np.zeros((0, 3)), ["a", "b"])
+    figure = draw_scene(scene, values=DecisionValues(["a", "b"], [0.0, 0.0], choice="a"))
+    limits = [axes.get_xlim()[1] for axes in figure.axes if axes.get_xlabel() == "expected cost"]
+    scales = [image.norm.vmax for axes in figure.axes for image in axes.collections if image.get_array() is not None]
+    assert limits == [1.0] and scales and set(scales) == {1.0}

@@ -44,7 +44,7 @@ class CostColours:
         self.values = values
         self.cmap = colormaps["viridis"]
         top = float(np.max(values.expected_costs + values.expected_cost_errors)) if len(values.objects) else 1.0
-        self.norm = Normalize(0.0, max(top, 1e-9))
+        self.norm = Normalize(0.0, top if top > 0 else 1.0)  # all costs 0: a scale of one box, not of 1e-9
 
     def of(self, box: str) -> tuple[float, float, float, float]:
         """RGBA of ``box``'s EC."""
@@ -155,7 +155,8 @@ def draw_ranking(axes: Any, values: DecisionValues, colours: CostColours) -> Non
             tick.set_color(HIGHLIGHT)
             tick.set_fontweight("bold")
     axes.set_ylim(len(ids) - 0.5, -0.5)
-    axes.set_xlim(0.0, max(float(np.max(costs + errors)) * 1.08, 1e-6) if len(ids) else 1.0)
+    top = float(np.max(costs + errors)) * 1.08 if len(ids) else 0.0
+    axes.set_xlim(0.0, top if top > 0 else 1.0)
     axes.tick_params(axis="x", labelsize=LABEL_POINTS)
     axes.set_xlabel("expected cost", fontsize=LABEL_POINTS + 1)
     title = "ranking (pick on top)" if values.choice is not None else "ranking"

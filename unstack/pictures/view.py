@@ -147,7 +147,7 @@ def build_view(
         values.check_boxes(scene.box_ids, scene.source)
     detected = set(scene.detected) | (set(values.objects) if values is not None else set())
     top = float(np.max(values.expected_costs + values.expected_cost_errors)) if values is not None else 1.0
-    top = max(top, 1e-9)
+    top = top if top > 0 else 1.0  # all costs 0: a scale of one box
     traces: list[Any] = []
     points = scene.points
     if len(points):  # the cloud near the boxes, off the floor and off the detected boxes: context, not clutter
