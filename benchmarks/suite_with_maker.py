@@ -1,6 +1,6 @@
 """The generalisation suite's first picks made by a container maker instead of the decision's.
 
-``unstack experiment generalisation`` checks the decision's own pick (or Eq. 13's minimum, or the
+``unstack experiment generalisation`` checks the decision's own pick (or the minimum EC (Eq. 12), or the
 hybrid's); a maker of :mod:`unstack.experiments.container` such as ``hybrid_faces_free`` (the
 hybrid vetoed by physics on the belief) runs the engine and is not one of its ``--pick`` choices.
 This runs the same canonical scenes (every kind, seeds ``--first-seed`` onwards, both clouds)

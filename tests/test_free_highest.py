@@ -138,7 +138,7 @@ def test_decide_on_a_scene_takes_the_highest_free_box_by_default() -> None:
     free = [box_id for box_id in decision.objects if costs[box_id] < FREE_COST]
     assert decision.free_cost == FREE_COST and decision.choice in free
     assert decision.choice == max(free, key=lambda box_id: (scene.box(box_id).position[2], box_id))
-    assert unstack.decide(scene, seed=0, near_tie_margin=0.0).free_cost == 0.0  # Eq. 13 exactly
+    assert unstack.decide(scene, seed=0, near_tie_margin=0.0).free_cost == 0.0  # Eq. 12 exactly
 
 
 def test_decide_on_support_probabilities_refuses_a_free_cost() -> None:

@@ -338,13 +338,13 @@ def decide(
         Boxes whose expected cost is within this many boxes of the lowest count as tied, and
         the one resting highest is taken (boxes resting on one layer: the lowest cost). Default: 0.05
         (:data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`) for a scene (and for supports
-        that carry heights), Eq. 13's minimum for supports without heights; 0 keeps Eq. 13
+        that carry heights), the minimum EC (Eq. 12) for supports without heights; 0 keeps Eq. 12
         exactly.
     free_cost : float, optional
         For a scene: the highest detected box (its centre) whose expected cost is below this
         is taken -- it holds nothing up (:func:`unstack.height_veto.free_highest`); when none
         is, the reasoner's choice. Default: 0.5 (:data:`~unstack.height_veto.FREE_COST`),
-        0 with ``near_tie_margin=0`` (Eq. 13); 0 leaves the choice to the reasoner. Support
+        0 with ``near_tie_margin=0`` (Eq. 12); 0 leaves the choice to the reasoner. Support
         probabilities (no box centres) and the ``moves`` cost take none.
     statics : bool
         For a scene: raise the probability that a box holds up another that cannot stand

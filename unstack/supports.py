@@ -65,7 +65,7 @@ class Supports:
     heights : array-like, shape (n,), optional
         The height each box rests at: its lowest point above the floor in metres (a scene's
         boxes give it). With it, near ties in expected cost go to the box resting highest
-        (:data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`); without it, Eq. 13's minimum.
+        (:data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`); without it, the minimum EC (Eq. 12).
     metadata : dict, optional
         Free-form provenance, kept when saving.
     source : str, optional

@@ -160,7 +160,7 @@ def test_unstack_gives_near_ties_to_the_box_resting_highest_and_min_cost_keeps_e
     scene = Scene(boxes, surface_cloud(boxes, viewpoint=[-2.0, 0.0, 1.5], seed=0), ["a_low", "base", "b_high"])
     policies = container_policies(load_model(default_model_path()), seed=0, makers=("unstack", "min_cost"))
     assert policies["unstack"](scene) == "b_high"  # two free boxes: the one resting higher
-    assert policies["min_cost"](scene) == "a_low"  # Eq. 13: the lower expected cost (or the smaller id)
+    assert policies["min_cost"](scene) == "a_low"  # Eq. 12: the lower expected cost (or the smaller id)
 
 
 @pytest.mark.slow  # physics runs of every decision maker

@@ -139,7 +139,7 @@ def test_the_choice_rests_highest_within_a_margin_and_never_costs_more_than_it(
     choice, ties = choose(objects, np.array(costs), heights=np.array(heights), margin=margin)
     chosen = objects.index(choice)
     assert costs[chosen] <= min(costs) + margin + 1e-12
-    if margin == 0.0:  # Eq. 13 exactly: exact ties go to the smallest id, whatever the heights
+    if margin == 0.0:  # Eq. 12 exactly: exact ties go to the smallest id, whatever the heights
         assert choice == ties[0]
     else:
         top = max(heights[objects.index(box)] for box in ties)

@@ -532,8 +532,8 @@ def container(
 @click.option("--physics", is_flag=True, help="Also check each scene's labels in the physics engine.")
 @click.option("--pick", type=click.Choice(list(PICKS)), default="default", show_default=True,
               help="default: the highest box of EC below 0.5, else near ties (unstack decide's pick); near-ties: the "
-                   "reasoner's choice (near ties to the box resting highest); min-cost: Eq. 13's minimum; hybrid: the "
-                   "highest box of EC below 0.5, else the minimum.")  # fmt: skip
+                   "reasoner's choice (near ties to the box resting highest); min-cost: the minimum EC (Eq. 12); "
+                   "hybrid: the highest box of EC below 0.5, else the minimum.")  # fmt: skip
 def generalisation(out: str, model_path: str | None, seeds: int, first_seed: int, physics: bool, pick: str) -> None:
     """The generalisation suite: hand-made canonical scenes, two clouds each, the decision checked.
 

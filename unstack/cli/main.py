@@ -298,7 +298,8 @@ def _add_reasoning_options(command: Callable[..., Any], *, plan: bool) -> Callab
             type=MARGIN,
             default=None,
             help="Expected costs within this many boxes of the lowest are tied and the box resting highest is taken; "
-            "on one layer the lowest cost (default 0.05 for a scene or supports with heights; 0: Eq. 13's minimum).",
+            "on one layer the lowest cost (default 0.05 for a scene or supports with heights; 0: the minimum EC, "
+            "Eq. 12).",
         ),
     ]
     for option in reversed(options):

@@ -16,10 +16,10 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
 ``near_ties``
     the reasoner's own choice: near ties alone (the default before 2026-12-06).
 ``min_cost``
-    the same expected costs with Eq. 13's minimum (no near ties; the default before
+    the same expected costs with the minimum EC (Eq. 12; no near ties; the default before
     2026-12-01).
 ``unstack_count``
-    the same probabilities with Eq. 11's cost (detected boxes supported) and Eq. 13's minimum.
+    the same probabilities with Eq. 11's cost (detected boxes supported) and the minimum EC (Eq. 12).
 ``hybrid``
     height vetoed by unstack (:func:`unstack.height_veto.highest_free_box`): the highest
     candidate whose expected cost (the default model and cost) is below

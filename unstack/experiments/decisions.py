@@ -6,7 +6,7 @@ decision maker picks the box to unload first:
 ``reasoner``
     unstack: the classifier's probabilities, the consistent worlds, minimum EC (Eq. 12)
     with the default cost (``load``: every box counted with the undetected load the cloud
-    shows on it); Eq. 13's minimum, as the paper decides.
+    shows on it); the minimum EC (Eq. 12), as the paper decides.
 ``near_ties``
     the reasoner's choice: the same expected costs, near ties (within
     :data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`) to the box resting highest.

@@ -47,7 +47,7 @@ __all__ = [
 CLOUDS = ("sensor", "surface")
 #: How the first box is picked from a decision: the default on a scene (the highest free box,
 #: :func:`unstack.height_veto.free_highest`), the reasoner's own choice (near ties in expected
-#: cost to the box resting highest), Eq. 13's minimum, or the hybrid
+#: cost to the box resting highest), the minimum EC (Eq. 12), or the hybrid
 #: (:func:`unstack.height_veto.highest_free_box`).
 PICKS = ("default", "near-ties", "min-cost", "hybrid")
 #: A box that carries a load of k boxes must cost at least this share of k.

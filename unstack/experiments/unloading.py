@@ -140,7 +140,7 @@ def unloading_orders(scene: Any, model: Any, settings: DecisionSettings) -> dict
 
     supports = scene_support_probabilities(scene, model, statics=settings.statics)
     detected = list(scene.detected)
-    # Eq. 13's minimum at every step (no near ties by height): the open-loop figures of the results page
+    # the minimum EC (Eq. 12) at every step (no near ties by height): the open-loop figures of the results page
     plan = unloading_plan(
         supports, cost=settings.cost, samples=settings.samples, time_limit=settings.time_limit, seed=settings.seed,
         near_tie_margin=0.0,

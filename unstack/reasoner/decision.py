@@ -18,8 +18,8 @@ smallest id), so a box standing on the floor is never preferred to another on th
 for being taller -- a box leaning on it may be what the model missed. Which of several
 boxes that hold up almost nothing comes first is otherwise left to small differences of
 the model; the one resting highest is the one its neighbours press on least. Emptying
-whole containers in the physics engine, near ties moved fewer boxes than Eq. 13's minimum
-(docs/results.md). ``near_tie_margin=0`` keeps Eq. 13 exactly.
+whole containers in the physics engine, near ties moved fewer boxes than the minimum EC (Eq. 12)
+(docs/results.md). ``near_tie_margin=0`` keeps Eq. 12 exactly.
 
 Examples
 --------
@@ -158,7 +158,7 @@ class Decision:
     sampling_seconds : float
         Wall time of the sampled groups (0 when none was sampled).
     near_tie_margin : float
-        The near-tie margin the choice was made with (0: Eq. 13's minimum).
+        The near-tie margin the choice was made with (0: the minimum EC (Eq. 12)).
     free_cost : float
         When the choice is the highest box holding nothing up
         (:func:`unstack.height_veto.free_highest`): the expected cost those boxes lie below
@@ -537,7 +537,7 @@ def decide(
         Expected costs within this many boxes of the lowest count as tied and the box
         resting highest of them is taken (one layer: the lowest EC; needs
         ``supports.heights``). Default: :data:`NEAR_TIE_MARGIN`
-        when the supports carry heights, else 0; 0 keeps Eq. 13's minimum exactly.
+        when the supports carry heights, else 0; 0 keeps the minimum EC (Eq. 12) exactly.
 
     Returns
     -------
