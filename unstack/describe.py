@@ -10,7 +10,7 @@ Examples
 >>> place["height_rank"], place["boxes"]
 (1, 5)
 >>> place_in_words(place)
-'x 1.11 m, y -0.06 m (centre), top at 0.78 m: the highest of 5 detected'
+'x 1.11 m, y -0.06 m (centre), top at 0.78 m: the highest top of 5 detected'
 >>> model_in_words("default:general-mix.skops")
 'general (the default model)'
 """
@@ -30,23 +30,29 @@ __all__ = ["COST_WORDS", "cost_in_words", "model_in_words", "ordinal", "pick_pla
 COST_WORDS = {
     "load": "the boxes that would come down with it (the detected boxes it holds up, directly or through "
     "others, with the undetected load the point cloud shows on them)",
+    "load from the file": "the boxes that would come down with it (the detected boxes it holds up, directly or "
+    "through others, with the undetected load the supports file gives on them, hidden_load)",
     "count": "the detected boxes it is expected to hold up, directly or through others (the paper's Eq. 11)",
     "mass": "the kilograms of detected boxes it is expected to hold up, directly or through others",
     "moves": "the boxes that taking it out is expected to move by more than 2 cm (the learned disturbance model)",
 }
 #: The unit of each cost's expected value, for a column header.
-COST_UNITS = {"load": "boxes held up", "count": "boxes held up", "mass": "kg held up", "moves": "boxes moved"}
+COST_UNITS = {"load": "boxes brought down", "count": "boxes held up", "mass": "kg held up", "moves": "boxes moved"}
 
 
-def cost_in_words(cost: str) -> str:
-    """One sentence saying what ``cost`` counts, ending with which way is safer.
+def cost_in_words(cost: str, *, cloud: bool = True) -> str:
+    """One sentence saying what ``cost`` counts, ending with which way is safer; ``cloud``:
+    whether the undetected load came from a point cloud (a scene) or from a supports file.
 
     Examples
     --------
     >>> cost_in_words("mass")
     "cost 'mass': the kilograms of detected boxes it is expected to hold up, directly or through others; lower is safer"
+    >>> cost_in_words("load", cloud=False).endswith("the supports file gives on them, hidden_load); lower is safer")
+    True
     """
-    return f"cost {cost!r}: {COST_WORDS.get(cost, 'the expected cost of Eq. 13')}; lower is safer"
+    words = COST_WORDS.get(cost if cloud or cost != "load" else "load from the file", "the expected cost of Eq. 13")
+    return f"cost {cost!r}: {words}; lower is safer"
 
 
 def model_in_words(label: str) -> str:
@@ -132,9 +138,11 @@ def place_in_words(place: dict[str, Any]) -> str:
     --------
     >>> place_in_words({"rests_at": 0.3, "height_rank": 2, "boxes": 5})
     'resting at 0.30 m: the 2nd highest of 5'
+    >>> place_in_words({"centre": [1.0, 0.0, 0.5], "top": 0.7, "rests_at": 0.3, "height_rank": 1, "boxes": 5})
+    'x 1.00 m, y 0.00 m (centre), top at 0.70 m: the highest top of 5 detected'
     """
     rank = "the highest" if place["height_rank"] == 1 else f"the {ordinal(place['height_rank'])} highest"
     if "centre" not in place:
         return f"resting at {place['rests_at']:.2f} m: {rank} of {place['boxes']}"
     x, y, _ = place["centre"]
-    return f"x {x:.2f} m, y {y:.2f} m (centre), top at {place['top']:.2f} m: {rank} of {place['boxes']} detected"
+    return f"x {x:.2f} m, y {y:.2f} m (centre), top at {place['top']:.2f} m: {rank} top of {place['boxes']} detected"

@@ -246,10 +246,13 @@ def test_decide_says_why_for_the_pick_and_the_runner_up(tmp_path: Path) -> None:
     )
     result = unstack("decide", str(path))
     assert result.returncode == 0, result.stderr
-    assert "pick top: expected to move 0.10 boxes (top may hold up bottom: P 0.10; held up by bottom: P 0.90)" in (
+    assert "pick top: EC 0.10 boxes brought down (top may hold up bottom: P 0.10; held up by bottom: P 0.90)" in (
         result.stdout.replace("\n", " ").replace("  ", " ")
     )
-    assert "runner-up bottom: expected to move 0.90 boxes (bottom holds up top: P 0.90)" in result.stdout
+    assert "runner-up bottom: EC 0.90 boxes brought down (bottom holds up top: P 0.90)" in result.stdout
+    assert "with the undetected load the supports file gives on them, hidden_load" in (
+        result.stdout.replace("\n", " ").replace("  ", " ")
+    )  # a supports file has no point cloud
 
 
 def test_a_plan_says_up_front_that_its_time_limit_is_per_step() -> None:

@@ -34,9 +34,10 @@ def scene_decision() -> unstack.Decision:
 def test_a_scene_decision_names_its_model_cost_and_where_the_pick_is(scene_decision: unstack.Decision) -> None:
     text = text_of(scene_decision)
     assert "support model: general (the default model)" in text
-    assert "cost 'load': the boxes that would come down with it" in text and "lower is safer" in text
-    assert "where: x " in text and "(centre), top at" in text and "of 5 detected" in text
-    assert "expected boxes held up" in text and "None" not in text
+    assert "EC, the expected cost 'load': the boxes that would come down with it" in text and "lower is safer" in text
+    assert "the undetected load the point cloud shows on them" in text
+    assert "where: x " in text and "(centre), top at" in text and "top of 5 detected" in text
+    assert "EC (boxes brought down)" in text and "None" not in text
 
 
 @pytest.mark.slow  # loads the default model

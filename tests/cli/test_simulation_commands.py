@@ -20,7 +20,7 @@ def dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
     result = unstack("simulate", "--configs", "2", *SMALL, "--seed", "4", "--out", str(folder))
     assert result.returncode == 0, result.stderr
     assert "2 configurations (2 made, 0 already there)" in result.stdout
-    assert "break transitivity in" in result.stdout
+    assert "do not label x supporting z" in result.stdout
     return folder
 
 

@@ -239,7 +239,9 @@ def train(
     best = model.metadata["best_params"]
     params = ", ".join(f"{key.rsplit('__', 1)[-1]} = {value:g}" for key, value in best.items())
     score = model.metadata["cv_score"]
-    console.print(Text.assemble(("chosen: ", "bold"), params, f"  (cross-validated score {score:.3f})"))
+    console.print(
+        Text.assemble(("chosen: ", "bold"), params, f"  (cross-validated balanced accuracy {score:.3f}; 0.5 is chance)")
+    )
     if validation:
         console.print(metrics_view(validation, "hold-out confusion matrix (Fig. 5 layout)"))
         if "by_data_set" in validation:

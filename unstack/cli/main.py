@@ -470,7 +470,8 @@ def plan(file: str, as_json: bool, output: str | None, model: str | None, **reas
     with _first_call(supports), progress_bar("planning: steps") as report:
         report(0, steps)  # the count is known before the first step ends
         result = unstack.plan(supports, model=model, progress=report, **reasoning)
-    _deliver(result.to_dict(), output, as_json, "plan_view", result, warnings=result.warnings)
+    cloud = isinstance(supports, unstack.Scene)  # the undetected load from a point cloud, or from the file
+    _deliver(result.to_dict(), output, as_json, "plan_view", result, cloud, warnings=result.warnings)
 
 
 @cli.command()

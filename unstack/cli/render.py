@@ -13,7 +13,7 @@ from rich.table import Table
 from rich.text import Text
 
 from unstack.cli.text import printable
-from unstack.reasoner.decision import Decision
+from unstack.reasoner.decision import HIGH_RHAT, Decision
 from unstack.reasoner.payoff import PayoffMatrix
 from unstack.reasoner.plan import Plan
 
@@ -40,11 +40,12 @@ def decision_view(decision: Decision) -> Group:
     conditional support matrix, and the model, method and evidence it rests on."""
     from unstack.describe import COST_UNITS, cost_in_words, model_in_words, place_in_words
 
-    order = sorted(range(len(decision.objects)), key=lambda i: (decision.expected_costs[i], decision.objects[i]))
+    index = {box: i for i, box in enumerate(decision.objects)}
+    order = [index[box] for box, _, _ in decision.ranking()]  # the pick first, then by EC
     costs = Table()
     costs.add_column("rank", justify="right")
     costs.add_column("box")
-    costs.add_column(f"expected {COST_UNITS.get(decision.cost, 'cost')}", justify="right")
+    costs.add_column(f"EC ({COST_UNITS.get(decision.cost, 'cost')})", justify="right")
     sampled = decision.sampling is not None and decision.expected_cost_errors is not None
     if sampled:
         costs.add_column("± s.e.", justify="right")
@@ -79,12 +80,13 @@ def decision_view(decision: Decision) -> Group:
         headline.append(f"  (tied with {others}: {rule})")
     if decision.pick is not None:
         headline.append(f"\nwhere: {place_in_words(decision.pick)}")
-    headline.append(f"\n{cost_in_words(decision.cost)}", style="dim")
+    cloud = bool(decision.model)  # a scene's decision names its model; a supports file's none
+    headline.append(f"\nEC, the expected {cost_in_words(decision.cost, cloud=cloud)}", style="dim")
     parts: list[Any] = [headline]
     if decision.physics_veto is not None:
         parts.append(_physics(decision.physics_veto, decision.choice))
     if decision.reasons:
-        parts.append(_why(decision))
+        parts.append(_why(decision, COST_UNITS.get(decision.cost, "boxes"), cloud))
     return Group(*parts, costs, matrix, _footer(decision, model_in_words(decision.model)))
 
 
@@ -111,7 +113,8 @@ def _footer(decision: Decision, model: str) -> Text:
         seeded = f"seed {seed}" if seed is not None else "no seed (a run differs slightly; --seed 0 repeats one)"
         footer.append(
             f"\nsampled: {sum(decision.sampling['samples']):,} sweeps in {decision.sampling['chains']} chains per "
-            f"group, {seeded}, largest R-hat {decision.sampling['rhat_max']}; ± s.e. are standard errors (about "
+            f"group, {seeded}, largest R-hat {decision.sampling['rhat_max']} (near 1 when the chains agree; "
+            f"above {HIGH_RHAT} they have not mixed); ± s.e. are standard errors (about "
             f"95 % of true values lie within 2 of them; --samples {4 * max(decision.sampling['samples'])} halves them)"
         )
     return footer
@@ -143,9 +146,9 @@ def _physics(record: dict[str, Any], choice: str) -> Text:
     return text
 
 
-def _why(decision: Decision) -> Text:
-    """Why the pick and the runner-up cost what they cost: what each is expected to move and
-    the relations that drive it."""
+def _why(decision: Decision, unit: str, cloud: bool) -> Text:
+    """Why the pick and the runner-up cost what they cost: their EC (in ``unit``) and the
+    relations and load that drive it (the load from the point cloud, or from the file)."""
     from unstack.reasoner.reasons import MAY_HOLD_PROBABILITY
 
     by_box = {reason["box"]: reason for reason in decision.reasons}
@@ -159,11 +162,13 @@ def _why(decision: Decision) -> Text:
             among = f", one of {count} at P {MAY_HOLD_PROBABILITY:.2f} or more" if count > 1 else ""
             drivers.append(f"{printable(box)} may hold up {printable(other)}: P {p:.2f}{among}")
         if reason["hidden_load"] >= 0.05:
-            drivers.append(f"the cloud shows {reason['hidden_load']:.2f} undetected boxes on it")
+            shown = "the cloud shows" if cloud else "the file's hidden_load puts"
+            drivers.append(f"{shown} {reason['hidden_load']:.2f} undetected boxes on it")
         if reason["held_by"] is not None and reason["held_by"][1] >= 0.5:
             drivers.append(f"held up by {printable(reason['held_by'][0])}: P {reason['held_by'][1]:.2f}")
-        because = "; ".join(drivers) if drivers else "it holds up no detected box and the cloud shows no load on it"
-        text.append(f"{label} {printable(box)}: expected to move {reason['expected_moves']:.2f} boxes ({because})\n")
+        nothing = "it holds up no detected box and " + ("the cloud shows no load on it" if cloud else "carries no load")
+        because = "; ".join(drivers) if drivers else nothing
+        text.append(f"{label} {printable(box)}: EC {reason['expected_moves']:.2f} {unit} ({because})\n")
     return text
 
 
@@ -200,9 +205,9 @@ def payoff_view(table: PayoffMatrix, limit: int) -> Group:
     return Group(view, note)
 
 
-def plan_view(result: Plan) -> Group:
+def plan_view(result: Plan, cloud: bool = True) -> Group:
     """The unloading order, one row per pick, with errors when steps were sampled, and what
-    the columns mean."""
+    the columns mean (``cloud``: whether the undetected load came from a point cloud)."""
     from unstack.describe import cost_in_words
 
     table = Table(title="Unloading plan (each step decided on the boxes still in place)", title_justify="left")
@@ -215,7 +220,8 @@ def plan_view(result: Plan) -> Group:
         table.add_row(str(number), _id(step.choice), _number(step.expected_cost), *errors, str(len(step.remaining)))
     if not result.steps:
         return Group(table)
-    note = f"EC: the expected cost of the pick among the boxes in place, {cost_in_words(result.steps[0].decision.cost)}"
+    cost = cost_in_words(result.steps[0].decision.cost, cloud=cloud)
+    note = f"EC: the expected cost of the pick among the boxes in place, {cost}"
     if sampled:
         note += (
             "; ± s.e.: its standard error (the step was sampled); P(minimum): the probability that the pick "

@@ -140,7 +140,7 @@ def simulate(
         f"{summary.folder}: {counted(summary.finished, 'configuration')} "
         f"({summary.made} made, {summary.skipped} already there{asked}) "
         f"in {summary.seconds:.1f} s; {statistics.get('support_relations', 0)} support relations among "
-        f"{statistics.get('ordered_pairs', 0)} ordered pairs; removal labels break transitivity in "
-        f"{100 * statistics.get('transitivity_violated_share', 0.0):.1f} % of "
-        f"{statistics.get('transitivity_premises', 0)} premise triples"
+        f"{statistics.get('ordered_pairs', 0)} ordered pairs; of {statistics.get('transitivity_premises', 0)} "
+        f"chains x supports y supports z, {100 * statistics.get('transitivity_violated_share', 0.0):.1f} % do not "
+        "label x supporting z (removal labels are not transitive: a box on two others survives either's removal)"
     )
