@@ -102,16 +102,16 @@ DEPENDENCIES_ENVIRONMENT = {"KMP_DUPLICATE_LIB_OK", "KMP_INIT_AT_FORK"}
 @pytest.mark.slow  # a fresh interpreter that imports scikit-learn
 def test_a_decision_changes_no_process_state_but_what_its_dependencies_set_on_import(repo: Path) -> None:
     code = (
-        "import json, logging, os, signal, sys, warnings\n"
+        "import json, logging, os, random, signal, sys, warnings\n"
         "import numpy as np\n"
         "def state():\n"
         "    return {'environment': dict(os.environ), 'filters': [repr(f) for f in warnings.filters],\n"
         "            'print': repr(np.get_printoptions()), 'random': repr(np.random.get_state()[1][:4]),\n"
         "            'errors': repr(np.geterr()), 'cwd': os.getcwd(), 'root': repr(logging.getLogger().handlers),\n"
         "            'level': logging.getLogger().level, 'sigint': repr(signal.getsignal(signal.SIGINT)),\n"
-        "            'recursion': sys.getrecursionlimit()}\n"
+        "            'recursion': sys.getrecursionlimit(), 'python_random': repr(random.getstate()[1][:4])}\n"
         "before = state()\n"
-        "import sklearn, scipy.stats  # what unstack imports lazily, imported alone\n"
+        "import sklearn, sklearn.tree, scipy.stats  # what unstack imports lazily, imported alone\n"
         "dependencies = state()\n"
         "import unstack\n"
         "scene = unstack.load('examples/pile5.scene.json')\n"
@@ -131,3 +131,5 @@ def test_a_decision_changes_no_process_state_but_what_its_dependencies_set_on_im
     assert after["filters"] == dependencies["filters"]
     for key in ("print", "random", "errors", "cwd", "root", "level", "sigint", "recursion"):
         assert after[key] == before[key], key
+    # scikit-learn's tree module draws from Python's random at import: that draw, and none of unstack's
+    assert after["python_random"] == dependencies["python_random"]

@@ -67,9 +67,11 @@ KERNELS: tuple[tuple[str, Callable[[], None]], ...] = (
     ("wide sampler", _wide_sampler),
     ("feature kernels", _features),
 )
-#: Seconds each group took to compile on an empty cache, one after the other (2026-12-01, 2-core
-#: machine; the README): processes start the longest first.
-_COMPILE_SECONDS = {"exact engine": 35.4, "sampler": 37.5, "wide sampler": 53.6, "feature kernels": 10.2}
+#: Seconds each group takes to compile on an empty cache, one process after the other on a
+#: 2-core machine with a core busy elsewhere (``NUMBA_CACHE_DIR=$(mktemp -d) python -c "from
+#: unstack.warmup import KERNELS; dict(KERNELS)['sampler']()"``, timed): what the first call's
+#: note says; processes start the longest first.
+_COMPILE_SECONDS = {"exact engine": 13.6, "sampler": 11.4, "wide sampler": 12.6, "feature kernels": 2.0}
 
 
 #: The module each kernel group's compiled functions live in (the sampler's module compiles both

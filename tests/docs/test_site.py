@@ -53,3 +53,20 @@ def test_reference_page_renders_the_docstrings(site: Path) -> None:
     html = (site / "reference" / "index.html").read_text()
     assert "Choose the box to unload first" in html
     assert "NoConsistentWorld" in html
+
+
+@pytest.mark.parametrize("name", ["decide"])
+def test_the_reference_tables_signature_is_the_functions(name: str) -> None:
+    """The table's decide listed 8 of its 12 parameters, and 'cost=...' for its default."""
+    import inspect
+    import re
+
+    import unstack
+
+    page = (REPO / "docs" / "reference.md").read_text()
+    row = next(line for line in page.splitlines() if line.startswith(f"| `unstack.{name}("))
+    listed = row.split("(", 1)[1].split(")`", 1)[0]
+    written = dict(re.findall(r"(\w+)=([^,]+)", listed))
+    parameters = inspect.signature(getattr(unstack, name)).parameters
+    assert list(written) == [key for key in parameters if parameters[key].kind is inspect.Parameter.KEYWORD_ONLY]
+    assert {key: repr(parameters[key].default).replace("'", '"') for key in written} == written
