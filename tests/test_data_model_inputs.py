@@ -145,10 +145,56 @@ def test_an_empty_file_name_is_said_to_be_empty_not_a_folder() -> None:
         unstack.load("")
 
 
-def test_a_box_changed_in_place_to_a_value_that_is_not_finite_is_refused_where_it_is(examples: Path) -> None:
+@pytest.mark.parametrize(
+    ("field", "index", "value", "message"),
+    [
+        ("position", slice(None), np.nan, r"\$\.boxes\[13\]\.position\[0\]: expected a finite number, got nan"),
+        ("orientation_xyzw", slice(None), 0.0, r"\$\.boxes\[13\]\.orientation_xyzw: expected a unit quaternion"),
+        ("position", 0, 1e9, r"\$\.boxes\[13\]\.position\[0\]: expected a coordinate within 100 m"),
+        ("size", 0, -0.4, r"\$\.boxes\[13\]\.size\[0\]: expected a positive number, got -0\.4"),
+    ],
+    ids=["not-finite", "zero-quaternion", "far-away", "negative-size"],
+)
+def test_a_box_changed_in_place_to_a_pose_the_scene_refuses_is_refused_where_it_is(
+    examples: Path, field: str, index: Any, value: float, message: str
+) -> None:
+    """A box's arrays stay writeable (scipy's Rotation.apply refuses read-only ones); a zero
+    quaternion, 1e9 m or a negative size put into them was decided on unchecked."""
     scene = unstack.load(examples / "pile5.scene.json")
-    scene.boxes[13].position[:] = np.nan  # a box's arrays stay writeable: scipy's rotations refuse read-only ones
-    with pytest.raises(
-        InvalidArgument, match=r"\$\.boxes\[13\]\.position: expected finite numbers, got \[nan, nan, nan\]"
-    ):
+    getattr(scene.boxes[13], field)[index] = value
+    with pytest.raises(InvalidArgument, match=message + r".*\(changed in place after the scene was made\)"):
         unstack.decide(scene)
+
+
+def test_a_box_resting_below_the_floor_is_named_by_its_position_not_by_the_supports_heights() -> None:
+    """It was refused as '$.heights[0]', a field of the supports the caller never gave."""
+    boxes = [unstack.Box("a", [0.4, 0.4, 0.4], [1.0, 0.0, -5.0]), unstack.Box("b", [0.4, 0.4, 0.4], [1.0, 0.5, 0.2])]
+    with pytest.raises(InvalidScene, match=r"\$\.boxes\[0\]\.position: box 'a' rests at -5\.20 m: expected its bottom"):
+        unstack.decide(unstack.Scene(boxes, np.zeros((0, 3)), ["a", "b"]))
+
+
+@pytest.mark.parametrize(
+    "build",
+    [
+        lambda masked: unstack.Supports(IDS, masked(PROBABILITIES)),
+        lambda masked: unstack.Supports(IDS, PROBABILITIES, masses=masked([1.0, 2.0, 3.0])),
+        lambda masked: _scene(masked([[1.0, 0.0, 0.4]])),
+        lambda masked: unstack.Box("a", masked([0.4, 0.4, 0.4]), [1.0, 0.0, 0.2]),
+    ],
+    ids=["probabilities", "masses", "points", "size"],
+)
+def test_a_masked_array_is_refused_not_read_under_its_mask(build: Any) -> None:
+    """numpy read the values under the mask: a masked P(b supports a) of 0.9 was decided on as 0.9."""
+
+    def masked(values: Any) -> np.ndarray:
+        array = np.asarray(values, dtype=float)
+        return np.ma.masked_array(array, mask=np.eye(*array.shape, dtype=bool) if array.ndim == 2 else array < 0.5)
+
+    with pytest.raises((InvalidSupports, InvalidScene), match="expected a plain array, got a masked array"):
+        build(masked)
+
+
+def test_a_boolean_matrix_is_refused_as_true_and_false_cells_are() -> None:
+    """A bool array was read as 0 and 1, while [[0, np.True_], ...] was refused."""
+    with pytest.raises(InvalidSupports, match=r"\$\.probabilities: expected real numbers, got dtype bool"):
+        unstack.Supports(["a", "b"], np.array([[False, True], [False, False]]))

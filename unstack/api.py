@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, Any, Union
 from unstack.errors import InvalidArgument, ModelRequired
 from unstack.reasoner.decision import DEFAULT_COST, Decision
 from unstack.reasoner.plan import Plan
-from unstack.scene import Scene
+from unstack.scene import Box, Scene
 from unstack.supports import Supports
 
 if TYPE_CHECKING:
@@ -230,18 +230,18 @@ def support_probabilities(scene: Scene, model: ModelArgument = None, *, statics:
 
 def _refuse_changed_poses(scene: Scene) -> None:
     """A box whose arrays were changed in place after the scene was made (they stay writeable:
-    scipy's rotations refuse read-only arrays) to a value that is not finite: one line, not
-    numbers that no check of the scene's file saw."""
-    import numpy as np
+    scipy's ``Rotation.apply`` refuses read-only arrays, and a planner hands a box's position to
+    it) to a pose the scene's checks refuse -- not finite, a quaternion far from unit length, a
+    size no carton has, a coordinate beyond :data:`~unstack.checks.MAX_COORDINATE`: one line
+    naming it, not numbers that no check saw."""
+    from unstack.errors import InvalidScene
 
     for index, box in enumerate(scene.boxes):
-        for name in ("size", "position", "orientation_xyzw"):
-            values = getattr(box, name)
-            if not np.all(np.isfinite(values)):
-                raise InvalidArgument(
-                    f"{scene.source}: $.boxes[{index}].{name}: expected finite numbers, got {values.tolist()} "
-                    "(changed in place after the scene was made)"
-                )
+        try:
+            Box(box.id, box.size, box.position, box.orientation_xyzw, box.mass, source=scene.source,
+                path=f"$.boxes[{index}]")  # fmt: skip
+        except InvalidScene as error:
+            raise InvalidArgument(f"{error} (changed in place after the scene was made)") from None
 
 
 def _supports(scene_or_supports: Any, model: Any, statics: bool = True) -> Supports:

@@ -158,11 +158,18 @@ def float_array(
     ...
     unstack.errors.InvalidScene: <array>: $.points[0][1]: expected a finite number, got an integer of about 401 digits
     """
+    _refuse_masked(value, source, path, error)
     try:
         return np.asarray(value, dtype=np.float64)
     except OverflowError:
         where, number = _first_huge_integer(value, path)
         raise error(source, where, f"expected a finite number, got {number_text(number)}") from None
+
+
+def _refuse_masked(value: Any, source: str, path: str, error: type[InvalidFile]) -> None:
+    """Refuse a masked array: numpy reads the values under its mask, which nobody meant to give."""
+    if np.ma.isMaskedArray(value):
+        raise error(source, path, "expected a plain array, got a masked array: fill its masked cells first")
 
 
 def _first_huge_integer(value: Any, path: str) -> tuple[str, Any]:
@@ -224,7 +231,8 @@ def _matrix(value: Any, n_objects: int, source: str, path: str, error: type[Inva
     if isinstance(value, np.ndarray):
         if value.ndim != 2 or value.shape != (n_objects, n_objects):
             raise error(source, path, f"expected a {n_objects} x {n_objects} matrix, got shape {value.shape}")
-        if (not np.issubdtype(value.dtype, np.number) and value.dtype != np.bool_) or np.iscomplexobj(value):
+        _refuse_masked(value, source, path, error)
+        if not np.issubdtype(value.dtype, np.number) or np.iscomplexobj(value):  # booleans, as true/false cells
             raise error(source, path, f"expected real numbers, got dtype {value.dtype}")
         return np.ascontiguousarray(value, dtype=np.float64)
     if not isinstance(value, Sequence) or isinstance(value, str):
@@ -411,6 +419,7 @@ def check_vector(
     >>> check_vector([0.6, 0.4, 0.4], 3, positive=True)
     array([0.6, 0.4, 0.4])
     """
+    _refuse_masked(value, source, path, error)
     array = np.asarray(value, dtype=object if not isinstance(value, np.ndarray) else None)
     if array.shape != (length,):
         raise error(source, path, f"expected {length} numbers, got shape {array.shape}")
@@ -470,6 +479,7 @@ def check_points(
     >>> check_points([]).shape
     (0, 3)
     """
+    _refuse_masked(value, source, path, error)
     if isinstance(value, np.ndarray):
         array = value
     else:

@@ -26,6 +26,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from unstack.errors import InvalidScene
 from unstack.geometry import bounding_boxes
 from unstack.learning.features import pair_features
 from unstack.learning.model_file import SupportModel
@@ -101,6 +102,8 @@ def scene_support_probabilities(
     index = {box_id: k for k, box_id in enumerate(scene.box_ids)}
     objects = list(scene.detected if boxes is None else boxes)
     detected = [index[box_id] for box_id in objects]
+    heights = bounding_boxes([scene.boxes[k] for k in detected])[:, 2] if detected else np.zeros(0)
+    _refuse_heights(scene, detected, heights)
     n = len(detected)
     pairs = [(detected[i], detected[j]) for i in range(n) for j in range(n) if i != j]
     probabilities = np.zeros((n, n))
@@ -149,5 +152,22 @@ def scene_support_probabilities(
         metadata=metadata,
         source=scene.source,
         hidden_load=hidden_load(scene, objects, columns=binned),
-        heights=bounding_boxes([scene.boxes[k] for k in detected])[:, 2],  # the heights the boxes rest at
+        heights=heights,  # the heights the boxes rest at
     )
+
+
+def _refuse_heights(scene: Scene, detected: Sequence[int], heights: np.ndarray) -> None:
+    """A detected box resting outside the heights support probabilities hold, named by its
+    position (the supports' ``$.heights``, a field the caller never gave, was blamed)."""
+    from unstack.checks import HEIGHT_RANGE
+
+    low, high = HEIGHT_RANGE
+    for k, height in zip(detected, heights, strict=True):
+        if not low <= height <= high:
+            box = scene.boxes[k]
+            raise InvalidScene(
+                scene.source,
+                f"$.boxes[{k}].position",
+                f"box {box.id!r} rests at {height:.2f} m: expected its bottom from {low:g} to {high:g} m above "
+                "the floor (z = 0); is the scene in the floor's frame?",
+            )

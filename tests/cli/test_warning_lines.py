@@ -44,3 +44,22 @@ def test_a_word_of_thousands_of_characters_is_cut_in_the_middle_with_its_length(
         and line.endswith("d/x.json: cannot write there")
     )
     assert f"…({len(path) + 1:,} characters)…" in line
+
+
+@pytest.mark.parametrize(
+    ("library", "command"),
+    [
+        ("they have not mixed; sample longer (samples=1024)", "they have not mixed; sample longer (--samples 1024)"),
+        ("(samples=4096) and compare two seeds", "(--samples 4096) and compare two seeds"),
+        ("give time_limit=2, seed=0", "give --time-limit 2, --seed 0"),
+        ("the samples are 1024", "the samples are 1024"),
+    ],
+)
+def test_a_library_warning_names_the_commands_options(
+    library: str, command: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The library's warnings name its arguments (they named --samples to Python callers)."""
+    from unstack.cli.main import _print_warnings
+
+    _print_warnings((library,))
+    assert capsys.readouterr().err == f"unstack: warning: {command}\n"

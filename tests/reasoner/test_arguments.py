@@ -11,6 +11,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import unstack
+from tests.conftest import EXAMPLES
+from unstack.api import payoff
 from unstack.errors import InvalidArgument, UnstackError
 from unstack.reasoner.decision import choose, decide
 from unstack.reasoner.marginals import exact_marginals
@@ -107,3 +110,42 @@ def test_a_budget_is_used_exactly_when_positive_finite_and_at_most_a_day(budget:
     else:
         with pytest.raises(InvalidArgument, match="time_limit must be a positive, finite number"):
             decide(PAIR, time_limit=budget)
+
+
+@pytest.mark.parametrize(
+    ("keyword", "value", "said"),
+    [("time_limit", 1e300, r"got 1e\+300"), ("samples", 10**400, "got an integer of about 401 digits")],
+    ids=["time_limit", "samples"],
+)
+def test_a_huge_budget_is_refused_in_a_short_line(keyword: str, value: Any, said: str) -> None:
+    """1e300 seconds and 10**400 samples were printed whole: lines of 456 and 664 characters."""
+    with pytest.raises(InvalidArgument, match=said) as refused:
+        unstack.decide(unstack.load_supports(EXAMPLES / "stack5.supports.json"), **{keyword: value})
+    assert len(str(refused.value)) < 200
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda supports: payoff(supports, cost="bad"), r"unknown cost 'bad'"),
+        (lambda supports: unstack.decide(supports, cost="mass", method="exact"), "masses"),
+    ],
+    ids=["unknown-cost", "mass-without-masses"],
+)
+def test_cost_errors_are_argument_errors(call: Callable[[Any], Any], message: str) -> None:
+    """They were bare UnstackErrors, not InvalidArgument (a ValueError) as every other argument error."""
+    supports = unstack.Supports(["a", "b"], [[0.0, 0.2], [0.7, 0.0]])
+    with pytest.raises(InvalidArgument, match=message):
+        call(supports)
+
+
+def _generator_progress(done: int, total: int) -> Any:
+    yield done, total
+
+
+@pytest.mark.parametrize(("progress", "kind"), [(int, "the class int"), (_generator_progress, "a generator function")])
+def test_progress_callables_that_would_never_report_are_refused_before_any_work(progress: Any, kind: str) -> None:
+    """A class passed the check and failed after the first step; a generator function never ran."""
+    supports = unstack.Supports(["a", "b"], [[0.0, 0.2], [0.7, 0.0]])
+    with pytest.raises(InvalidArgument, match=f"progress must be a callable progress\\(done, total\\), got {kind}"):
+        unstack.plan(supports, progress=progress)

@@ -362,9 +362,14 @@ def _duration(seconds: float) -> str:
     return f"{seconds:.0f} s"
 
 
+#: A library warning's argument, as the command's option says it (``samples=4096`` -> ``--samples 4096``).
+_ARGUMENT = re.compile(r"\b(samples|seed|time_limit)=(\S+?)(?=[);,]|$)")
+
+
 def _print_warnings(warnings: tuple[str, ...]) -> None:
+    """The library's warnings as the command's lines, its arguments named as the options are."""
     for warning in warnings:
-        _warn(warning)
+        _warn(_ARGUMENT.sub(lambda found: f"--{found[1].replace('_', '-')} {found[2]}", warning))
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})

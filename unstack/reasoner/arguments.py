@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from unstack.checks import number_text
 from unstack.errors import InvalidArgument, InvalidFile
 from unstack.parameters import Interval, OneOf
 
@@ -79,7 +80,8 @@ def check_budget(value: Any, name: str) -> float:
     if not (math.isfinite(seconds) and seconds > 0):
         raise InvalidArgument(f"{name} must be a positive, finite number of seconds, got {seconds}")
     if seconds > MAX_SECONDS:
-        raise InvalidArgument(f"{name} must be at most {MAX_SECONDS:,.0f} seconds (a day), got {seconds:,.0f}")
+        said = f"{seconds:,.0f}" if seconds < 1e15 else f"{seconds:.3g}"  # 1e300 is no 300-digit line
+        raise InvalidArgument(f"{name} must be at most {MAX_SECONDS:,.0f} seconds (a day), got {said}")
     return seconds
 
 
@@ -93,9 +95,10 @@ def check_samples(value: Any) -> int:
     """
     samples = check_count(value, "samples")
     if samples > MAX_SAMPLES:
+        said = f"{samples:,}" if samples < 10**15 else number_text(samples)  # 10**400 is no 400-digit line
         raise InvalidArgument(
             f"samples must be at most {MAX_SAMPLES:,} (about a quarter of an hour for 40 boxes on 2 cores), "
-            f"got {samples:,}; give a time limit for a longer run"
+            f"got {said}; give a time limit for a longer run"
         )
     return samples
 

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from unstack.errors import UnstackError
+from unstack.errors import InvalidArgument
 from unstack.supports import Supports
 
 __all__ = [
@@ -55,12 +55,12 @@ def cost_weights(supports: Supports, cost: str) -> np.ndarray:
         return weights
     if cost == "mass":
         if supports.masses is None:
-            raise UnstackError(
+            raise InvalidArgument(
                 f"{supports.source}: $.masses: the mass-weighted cost needs box masses; "
                 'add "masses" (kg, aligned with objects) or use the count cost'
             )
         return np.asarray(supports.masses, dtype=np.float64)
-    raise UnstackError(f"unknown cost {cost!r}; expected one of {', '.join(COSTS)}")
+    raise InvalidArgument(f"unknown cost {cost!r}; expected one of {', '.join(COSTS)}")
 
 
 def own_costs(supports: Supports, cost: str) -> np.ndarray:

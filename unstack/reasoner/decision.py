@@ -477,12 +477,12 @@ def _sampling_summary(results: list[_GroupResult], seed: int | None) -> dict[str
     if slowest < LOW_ACCEPTANCE:
         summary["warning"] = (
             f"re-insertion moves were accepted in only {100 * slowest:.1f} % of the tries: the chains mix slowly "
-            f"and the standard errors may be too small; sample longer (--samples {longer}) and compare two seeds"
+            f"and the standard errors may be too small; sample longer (samples={longer}) and compare two seeds"
         )
     elif not worst_rhat <= HIGH_RHAT:
         summary["warning"] = (
             f"the chains disagree (R-hat of an EC {worst_rhat:.2f} > {HIGH_RHAT}): they have not mixed and the "
-            f"standard errors are too small; sample longer (--samples {longer})"
+            f"standard errors are too small; sample longer (samples={longer})"
         )
     return summary
 

@@ -127,9 +127,14 @@ def _check_progress(progress: Any) -> None:
     """Raise before any work when ``progress`` cannot be called as ``progress(done, total)``."""
     if progress is None:
         return
-    if not callable(progress):
-        raise InvalidArgument(f"progress must be a callable progress(done, total), got {type(progress).__name__}")
     import inspect
+
+    if not callable(progress) or isinstance(progress, type) or inspect.isgeneratorfunction(progress):
+        kind = (  # a class is called to make an object, a generator function's body runs only when iterated
+            f"the class {progress.__name__}" if isinstance(progress, type)
+            else "a generator function" if callable(progress) else type(progress).__name__
+        )  # fmt: skip
+        raise InvalidArgument(f"progress must be a callable progress(done, total), got {kind}")
 
     try:
         signature = inspect.signature(progress)

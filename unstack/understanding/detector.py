@@ -43,6 +43,6 @@ def detector_poses(boxes: Sequence[Box], noise: float, rng: np.random.Generator)
     for box in boxes:
         shift = rng.normal(0.0, noise, size=3) * [1.0, 1.0, 0.5]
         yaw = Rotation.from_euler("z", rng.normal(0.0, YAW_PER_METRE * noise), degrees=True)
-        orientation = (yaw * Rotation.from_quat(box.orientation_xyzw)).as_quat()
+        orientation = (yaw * Rotation.from_quat(np.array(box.orientation_xyzw))).as_quat()  # a writeable copy
         result.append(Box(box.id, box.size, box.position + shift, orientation, box.mass))
     return result
