@@ -108,6 +108,39 @@ print("ok")
     assert result.stdout.strip() == "ok"
 
 
+@pytest.mark.slow  # loads shipped models in fresh interpreters
+@pytest.mark.parametrize(
+    ("program", "expected"),
+    [
+        (  # four threads asking for a model no thread has loaded yet
+            "from concurrent.futures import ThreadPoolExecutor\n"
+            "with ThreadPoolExecutor(4) as pool:\n"
+            "    models = list(pool.map(lambda _: unstack.load_model('paper'), range(4)))\n"
+            "print(len({id(model) for model in models}))",
+            "1",
+        ),
+        (  # the default model asked for by its name first, then decided with as the default
+            "unstack.load_model('general')\n"
+            "print(unstack.decide(unstack.load_scene(EXAMPLE), seed=1).to_dict()['model'])",
+            "default:general-mix.skops",
+        ),
+    ],
+    ids=["one-load-for-four-threads", "label-whatever-came-first"],
+)
+def test_a_shipped_model_is_loaded_once_and_named_the_same_whoever_asked_first(
+    examples: Path, program: str, expected: str
+) -> None:
+    """Four threads' first loads read four copies; the default model asked for by name first was
+    recorded as 'shipped:' in every later decision of the process (another to_dict for one call)."""
+    import subprocess
+    import sys
+
+    code = f"import unstack\nEXAMPLE = {str(examples / 'pile5.scene.json')!r}\n{program}\n"
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert result.stdout.strip() == expected
+
+
 def test_even_ranges_cover_every_item_once() -> None:
     for items in range(0, 12):
         for parts in range(1, 6):

@@ -49,6 +49,8 @@ _LOCK = threading.Lock()
 _SHIPPED: dict[str, tuple[tuple[int, int], SupportModel]] = {}
 #: What each loaded model is called in provenance metadata (by ``id``; dropped with the model).
 _LABELS: dict[int, str] = {}
+#: A lock per shipped model file, held while it is read: concurrent first loads read it once.
+_LOADING: dict[str, threading.Lock] = {}
 
 
 def model_names() -> tuple[str, ...]:
@@ -78,8 +80,12 @@ def _remember(model: SupportModel, label: str) -> SupportModel:
     return model
 
 
-def _shipped(path: Path, label: str) -> SupportModel:
-    """A shipped model, loaded once per process (reloaded if the file changes)."""
+def _shipped(path: Path) -> SupportModel:
+    """A shipped model, loaded once per process however many threads ask for it first (reloaded
+    if the file changes); named ``default:`` when it is the default model, however it was asked
+    for (by ``None`` or by its name), so a decision's provenance does not depend on which
+    came first."""
+    from unstack.learning.model_file import default_model_path
     from unstack.learning.model_file import load_model as read_model
 
     try:
@@ -90,13 +96,17 @@ def _shipped(path: Path, label: str) -> SupportModel:
         ) from None
     stamp = (status.st_size, status.st_mtime_ns)
     with _LOCK:
-        cached = _SHIPPED.get(str(path))
-    if cached is not None and cached[0] == stamp:
-        return cached[1]
-    model = read_model(path)  # outside the lock: another thread may load it too; either copy is fine
-    with _LOCK:
-        _SHIPPED[str(path)] = (stamp, model)
-    return _remember(model, label)
+        loading = _LOADING.setdefault(str(path), threading.Lock())
+    with loading:  # one thread reads the file; the others wait for its model
+        with _LOCK:
+            cached = _SHIPPED.get(str(path))
+        if cached is not None and cached[0] == stamp:
+            return cached[1]
+        model = read_model(path)
+        with _LOCK:
+            _SHIPPED[str(path)] = (stamp, model)
+    kind = "default" if path == default_model_path() else "shipped"
+    return _remember(model, f"{kind}:{path.name}")
 
 
 def load_model(name_or_path: str | os.PathLike[str] | None = None) -> SupportModel:
@@ -136,14 +146,12 @@ def load_model(name_or_path: str | os.PathLike[str] | None = None) -> SupportMod
     from unstack.learning import model_file
 
     if name_or_path is None:
-        path = model_file.default_model_path()
-        return _shipped(path, f"default:{path.name}")
+        return _shipped(model_file.default_model_path())
     if not isinstance(name_or_path, str | os.PathLike):
         raise InvalidArgument(f"expected a model name or a model file path, got {type(name_or_path).__name__}")
     name = os.fspath(name_or_path)
     if isinstance(name_or_path, str) and name in model_file.BUNDLED_MODELS:
-        path = model_file.bundled_model_path(name)
-        return _shipped(path, f"shipped:{path.name}")
+        return _shipped(model_file.bundled_model_path(name))
     if isinstance(name_or_path, str) and not os.path.exists(name) and os.sep not in name and "." not in name:
         shipped = ", ".join(model_names())
         raise model_file.InvalidModel(name, "$", f"no shipped model and no file of that name (shipped: {shipped})")
