@@ -17,6 +17,7 @@ from unstack.reasoner import sampling
 from unstack.reasoner.marginals import exact_marginals
 from unstack.reasoner.pruning import propagate_evidence
 from unstack.reasoner.sampling import sample_worlds, sampled_marginals
+from unstack.supports import Supports
 
 
 def random_probabilities(rng: np.random.Generator, n: int, kind: str) -> np.ndarray:
@@ -159,3 +160,35 @@ def test_a_short_run_on_a_real_pile_warns_that_chains_disagree(repo: Path) -> No
     longer = decide(supports, samples=8_000, seed=0)
     assert longer.sampling is not None and "warning" not in longer.sampling
     assert not any("chains disagree" in warning for warning in longer.warnings)
+
+
+def _sparse_pile(n: int, seed: int = 0) -> Supports:
+    """``n`` boxes, 4 n random relations (``P`` uniform), zeros elsewhere: one linked group."""
+    rng = np.random.default_rng(seed)
+    probabilities = np.zeros((n, n))
+    rows, columns = rng.integers(n, size=(2, 4 * n))
+    probabilities[rows, columns] = rng.random(4 * n)
+    np.fill_diagonal(probabilities, 0.0)
+    return Supports([f"b{i:04d}" for i in range(n)], probabilities)
+
+
+@pytest.mark.slow  # a scattering sweep over 1,000 linked boxes
+def test_a_time_limit_the_least_sampling_cannot_come_near_is_refused_after_one_sweep() -> None:
+    """1,000 linked boxes with a limit of 0.2 s ran 20 s (3,000 with 2 s: over 400 s) before warning."""
+    import time
+
+    from unstack.errors import TooLarge
+    from unstack.reasoner.decision import decide
+
+    started = time.perf_counter()
+    with pytest.raises(TooLarge, match=r"a group of \d{3,4} linked boxes needs about \d+ s of sampling at the least"):
+        decide(_sparse_pile(1000), time_limit=0.2, seed=1)
+    assert time.perf_counter() - started < 60  # refused after its first sweep, not after the whole run
+
+
+@pytest.mark.parametrize("time_limit", [0.01, 0.3])
+def test_a_container_sized_group_is_never_refused_for_its_time_limit(time_limit: float) -> None:
+    from unstack.reasoner.decision import decide
+
+    decision = decide(_sparse_pile(60), time_limit=time_limit, seed=1)
+    assert decision.sampling is not None and decision.choice in decision.objects
