@@ -173,7 +173,7 @@ def _sparse_pile(n: int, seed: int = 0) -> Supports:
 
 
 @pytest.mark.slow  # a scattering sweep over 1,000 linked boxes
-def test_a_time_limit_the_least_sampling_cannot_come_near_is_refused_after_one_sweep() -> None:
+def test_a_time_limit_the_least_sampling_cannot_come_near_is_refused_after_a_few_sweeps() -> None:
     """1,000 linked boxes with a limit of 0.2 s ran 20 s (3,000 with 2 s: over 400 s) before warning."""
     import time
 
@@ -181,9 +181,11 @@ def test_a_time_limit_the_least_sampling_cannot_come_near_is_refused_after_one_s
     from unstack.reasoner.decision import decide
 
     started = time.perf_counter()
-    with pytest.raises(TooLarge, match=r"a group of \d{3,4} linked boxes needs about \d+ s of sampling at the least"):
+    with pytest.raises(
+        TooLarge, match=r"a group of \d{3,4} linked boxes needs about \d+ s more of sampling at the least"
+    ):
         decide(_sparse_pile(1000), time_limit=0.2, seed=1)
-    assert time.perf_counter() - started < 60  # refused after its first sweep, not after the whole run
+    assert time.perf_counter() - started < 60  # refused after a few sweeps, not after the whole run
 
 
 @pytest.mark.parametrize("time_limit", [0.01, 0.3])

@@ -363,37 +363,39 @@ def _chain_seeds(seed: int | None, chains: int) -> np.ndarray:
 
 #: A recorded sweep takes about this many times an unrecorded one (its conditionals are added up).
 _RECORDING_COST = 1.6
-#: A time limit is refused as unmeetable when the least sampling of a group, estimated from its
-#: scattering sweep, would take more than this many times the limit ...
+#: Under a time limit, the burn-in's first sweeps are timed on their own (the scattering sweep
+#: before them also compiles or loads the kernel): they tell what a sweep of the group costs.
+_PROBE_SWEEPS = 4
+#: A time limit is refused as unmeetable when the rest of a group's least sampling, estimated
+#: from the probe, would take more than this many times the time left for it ...
 _UNMEETABLE_FACTOR = 4.0
-#: ... plus this many seconds (groups of the sizes of a container's detected boxes never are).
+#: ... plus this many seconds (groups of the sizes of a container's detected boxes never do).
 _UNMEETABLE_SLACK = 2.0
 
 
-def _refuse_unmeetable_limit(n: int, scatter_seconds: float, burn_in: int, moves: int, time_limit: float) -> None:
-    """Raise :class:`~unstack.errors.TooLarge` when the least sampling of a group of ``n`` boxes
-    (the scattering sweep of ``n`` re-insertions, the burn-in and two recorded rounds), estimated
-    from the scattering sweep's ``scatter_seconds``, cannot come near ``time_limit``: a planner
-    with a budget gets an error it can act on after one sweep, not a decision minutes late
-    (3,000 linked boxes with a limit of 2 s ran for over 400 s).
+def _refuse_unmeetable_limit(n: int, sweep_seconds: float, burn_in_left: int, time_limit: float) -> None:
+    """Raise :class:`~unstack.errors.TooLarge` when the rest of the least sampling of a group of
+    ``n`` boxes (``burn_in_left`` sweeps and two recorded rounds, at ``sweep_seconds`` a sweep)
+    cannot come near ``time_limit``: a planner with a budget gets an error it can act on after a
+    few sweeps, not a decision minutes late (3,000 linked boxes with a limit of 2 s ran for over
+    400 s).
 
     Examples
     --------
-    >>> _refuse_unmeetable_limit(40, 0.001, 64, 8, 1.0)  # a container's group: nothing to say
-    >>> _refuse_unmeetable_limit(3000, 30.0, 64, 16, 2.0)
+    >>> _refuse_unmeetable_limit(40, 0.0002, 60, 1.0)  # a container's group: nothing to say
+    >>> _refuse_unmeetable_limit(1000, 0.06, 60, 0.2)
     Traceback (most recent call last):
     ...
-    unstack.errors.TooLarge: a group of 3000 linked boxes needs about 48 s of sampling at the least ...
+    unstack.errors.TooLarge: a group of 1000 linked boxes needs about 7 s more of sampling at the least ...
     """
     from unstack.errors import TooLarge
 
-    per_move = scatter_seconds / n
-    least = scatter_seconds + per_move * moves * (burn_in + 2 * _ROUND_SWEEPS * _RECORDING_COST)
-    if least > _UNMEETABLE_FACTOR * time_limit + _UNMEETABLE_SLACK:
+    least = sweep_seconds * (burn_in_left + 2 * _ROUND_SWEEPS * _RECORDING_COST)
+    if least > _UNMEETABLE_FACTOR * max(time_limit, 0.0) + _UNMEETABLE_SLACK:
         raise TooLarge(
-            f"a group of {n} linked boxes needs about {least:.0f} s of sampling at the least (its first sweep took "
-            f"{scatter_seconds:.1f} s), with {time_limit:.2g} s of the time limit left for it: the limit cannot be "
-            "met; give a longer one, or decide on fewer boxes"
+            f"a group of {n} linked boxes needs about {least:.0f} s more of sampling at the least (a sweep takes "
+            f"{sweep_seconds:.2f} s), with {max(time_limit, 0.0):.2g} s of the time limit left for it: the limit "
+            "cannot be met; give a longer one, or decide on fewer boxes"
         )
 
 
@@ -417,7 +419,7 @@ class _Chains:
         blocks: bool = True,
         start: np.ndarray | None = None,
         wide: bool | None = None,
-        time_limit: float | None = None,
+        deadline: float | None = None,
     ) -> None:
         from unstack.reasoner._sampler_kernels import run_chains
         from unstack.reasoner.block_gibbs import block_tables, strong_blocks
@@ -445,14 +447,18 @@ class _Chains:
         self._pool: ThreadPoolExecutor | None = None
         try:
             if start is None:
-                scattered = time.perf_counter()
                 self.advance(1, scatter=True)
-                if time_limit is not None:
-                    _refuse_unmeetable_limit(n, time.perf_counter() - scattered, burn_in, self.moves, time_limit)
             else:
                 self.successors[:] = start
                 self.predecessors[:] = _transposed(start, n, wide=self.wide)
-            self.advance(burn_in)
+            if deadline is not None and start is None and burn_in > _PROBE_SWEEPS:  # seeded runs: one call
+                probed = time.perf_counter()
+                self.advance(_PROBE_SWEEPS)
+                now = time.perf_counter()
+                _refuse_unmeetable_limit(n, (now - probed) / _PROBE_SWEEPS, burn_in - _PROBE_SWEEPS, deadline - now)
+                self.advance(burn_in - _PROBE_SWEEPS)
+            else:
+                self.advance(burn_in)
         except BaseException:  # an error or Ctrl-C in the burn-in: no threads left behind
             self.close()
             raise
@@ -669,7 +675,7 @@ def _sampled_marginals(
         watch.start(n, None if per_chain is None else chains * -(-per_chain // _ROUND_SWEEPS) * _ROUND_SWEEPS)
     with _Chains(
         p, chains=chains, seed=seed, burn_in=burn_in, tries=tries, blocks=blocks, start=warm, wide=wide,
-        time_limit=time_limit,
+        deadline=deadline,
     ) as state:  # fmt: skip
         choosing = revisits and n > MOVES  # the pilot: the first part of the run
         pilot_sweeps = None if per_chain is None else max(2 * _ROUND_SWEEPS, per_chain // PILOT_SHARE)
