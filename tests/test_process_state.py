@@ -109,7 +109,7 @@ def test_a_decision_changes_no_process_state_but_what_its_dependencies_set_on_im
         "            'print': repr(np.get_printoptions()), 'random': repr(np.random.get_state()[1][:4]),\n"
         "            'errors': repr(np.geterr()), 'cwd': os.getcwd(), 'root': repr(logging.getLogger().handlers),\n"
         "            'level': logging.getLogger().level, 'sigint': repr(signal.getsignal(signal.SIGINT)),\n"
-        "            'recursion': sys.getrecursionlimit(), 'python_random': repr(random.getstate()[1][:4])}\n"
+        "            'recursion': sys.getrecursionlimit(), 'python_random': repr(random.getstate())}\n"
         "before = state()\n"
         "import sklearn, sklearn.tree, scipy.stats  # what unstack imports lazily, imported alone\n"
         "dependencies = state()\n"

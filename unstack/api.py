@@ -97,16 +97,16 @@ def _shipped(path: Path) -> SupportModel:
     stamp = (status.st_size, status.st_mtime_ns)
     with _LOCK:
         loading = _LOADING.setdefault(str(path), threading.Lock())
-    with loading:  # one thread reads the file; the others wait for its model
+    with loading:  # one thread reads the file; the others wait for its model, named before it is shared
         with _LOCK:
             cached = _SHIPPED.get(str(path))
         if cached is not None and cached[0] == stamp:
             return cached[1]
-        model = read_model(path)
+        kind = "default" if path == default_model_path() else "shipped"
+        model = _remember(read_model(path), f"{kind}:{path.name}")
         with _LOCK:
             _SHIPPED[str(path)] = (stamp, model)
-    kind = "default" if path == default_model_path() else "shipped"
-    return _remember(model, f"{kind}:{path.name}")
+    return model
 
 
 def load_model(name_or_path: str | os.PathLike[str] | None = None) -> SupportModel:
@@ -379,6 +379,10 @@ def decide(
         A wrong type or an argument out of its domain (also a :class:`ValueError`).
     NoConsistentWorld
         Hard evidence contradicts transitivity.
+    TooLarge
+        ``method`` cannot do the scene, or with ``time_limit`` a linked group's least sampling
+        cannot come near the time left for it (hundreds of linked boxes with a limit of a
+        second: the first sweeps tell, and the message says what the group needs).
 
     Examples
     --------
@@ -576,6 +580,8 @@ def plan(
     ------
     InvalidArgument
         A wrong type or an argument out of its domain.
+    TooLarge
+        As in :func:`decide`, at a step.
 
     Examples
     --------

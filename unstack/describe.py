@@ -24,18 +24,29 @@ import numpy as np
 from unstack.scene import Scene
 from unstack.supports import Supports
 
-__all__ = ["COST_WORDS", "cost_in_words", "model_in_words", "ordinal", "pick_place", "place_in_words"]
+__all__ = [
+    "COST_WORDS",
+    "LOAD_FROM_FILE_WORDS",
+    "cost_in_words",
+    "model_in_words",
+    "ordinal",
+    "pick_place",
+    "place_in_words",
+]
 
 #: What each cost counts, in one sentence.
 COST_WORDS = {
     "load": "the boxes that would come down with it (the detected boxes it holds up, directly or through "
     "others, with the undetected load the point cloud shows on them)",
-    "load from the file": "the boxes that would come down with it (the detected boxes it holds up, directly or "
-    "through others, with the undetected load the supports file gives on them, hidden_load)",
     "count": "the detected boxes it is expected to hold up, directly or through others (the paper's Eq. 11)",
     "mass": "the kilograms of detected boxes it is expected to hold up, directly or through others",
     "moves": "the boxes that taking it out is expected to move by more than 2 cm (the learned disturbance model)",
 }
+#: What the ``load`` cost counts when the undetected load came from a supports file, not a cloud.
+LOAD_FROM_FILE_WORDS = (
+    "the boxes that would come down with it (the detected boxes it holds up, directly or through others, with "
+    "the undetected load the supports file gives on them, hidden_load)"
+)
 #: The unit of each cost's expected value, for a column header.
 COST_UNITS = {"load": "boxes brought down", "count": "boxes held up", "mass": "kg held up", "moves": "boxes moved"}
 
@@ -51,7 +62,9 @@ def cost_in_words(cost: str, *, cloud: bool = True) -> str:
     >>> cost_in_words("load", cloud=False).endswith("the supports file gives on them, hidden_load); lower is safer")
     True
     """
-    words = COST_WORDS.get(cost if cloud or cost != "load" else "load from the file", "the expected cost of Eq. 13")
+    words = (
+        LOAD_FROM_FILE_WORDS if cost == "load" and not cloud else COST_WORDS.get(cost, "the expected cost of Eq. 13")
+    )
     return f"cost {cost!r}: {words}; lower is safer"
 
 

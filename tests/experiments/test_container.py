@@ -58,7 +58,7 @@ def test_an_unknown_maker_is_refused_before_any_work(small_dataset: Path) -> Non
     ids=["occupancy", "disturbance"],
 )
 def test_a_setting_no_maker_reads_is_said_unused_and_not_recorded(
-    small_dataset: Path, given: dict[str, object], message: str
+    small_dataset: Path, tmp_path: Path, given: dict[str, object], message: str
 ) -> None:
     """They were accepted silently, recorded among the run's settings and joined its checkpoints' key."""
     with pytest.warns(UserWarning, match=message):
@@ -69,9 +69,12 @@ def test_a_setting_no_maker_reads_is_said_unused_and_not_recorded(
             max_picks=1,
             seed=2,
             makers=("highest",),
+            checkpoints=tmp_path,
             **given,  # type: ignore[arg-type]
         )
-    assert result["occupancy"] is None
+    [checkpoint] = tmp_path.glob("config-*.json")
+    key = json.loads(checkpoint.read_text())["key"]
+    assert result["occupancy"] is None and "occupancy" not in key and "disturbance_sha256" not in key
 
 
 @pytest.mark.slow  # physics runs of every decision maker

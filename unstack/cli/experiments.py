@@ -518,10 +518,13 @@ def container(
         )
         for maker in result["makers"]
     )
+    from unstack.sim.settings import DISPLACEMENT_THRESHOLD, ROTATION_THRESHOLD_DEG
+
     header = ("decision maker", "picks", "boxes moved", "minus unstack's", "fallen", "minus unstack's", "calm")
     title = f"Emptying {result['piles']} piles of {data_dir}, detecting again before every pick"
     legend = (
-        "per pile: picks, boxes moved (2 cm or 5 degrees and more) and fallen over all picks; minus unstack's: the "
+        f"per pile: picks, boxes moved (more than {100 * DISPLACEMENT_THRESHOLD:g} cm or {ROTATION_THRESHOLD_DEG:g} "
+        "degrees) and fallen over all picks; minus unstack's: the "
         "difference from unstack's on the same piles, ± its standard error over piles; calm: the share of "
         "picks that moved no other box"
     )

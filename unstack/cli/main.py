@@ -363,7 +363,7 @@ def _duration(seconds: float) -> str:
 
 
 #: A library warning's argument, as the command's option says it (``samples=4096`` -> ``--samples 4096``).
-_ARGUMENT = re.compile(r"\b(samples|seed|time_limit)=(\S+?)(?=[);,]|$)")
+_ARGUMENT = re.compile(r"\b(samples|seed|time_limit)=([^\s);,]+)")
 
 
 def _print_warnings(warnings: tuple[str, ...]) -> None:
@@ -411,7 +411,10 @@ def decide(file: str, as_json: bool, output: str | None, timing: bool, model: st
 
     with _first_call(loaded), still_working("deciding"):
         decision = unstack.decide(loaded, model=model, **reasoning)
-    _deliver(decision.to_dict(timing=timing), output, as_json, "decision_view", decision, warnings=decision.warnings)
+    cloud = isinstance(loaded, unstack.Scene)  # the undetected load from a point cloud, or from the file
+    _deliver(
+        decision.to_dict(timing=timing), output, as_json, "decision_view", decision, cloud, warnings=decision.warnings
+    )
 
 
 @cli.command()

@@ -35,9 +35,10 @@ def _number(value: float) -> str:
 MATRIX_MAX_BOXES = 12
 
 
-def decision_view(decision: Decision) -> Group:
+def decision_view(decision: Decision, cloud: bool = True) -> Group:
     """The choice and where it is, what the cost counts, every box's expected cost, the
-    conditional support matrix, and the model, method and evidence it rests on."""
+    conditional support matrix, and the model, method and evidence it rests on (``cloud``:
+    whether the undetected load came from a point cloud, a scene's, or from a supports file)."""
     from unstack.describe import COST_UNITS, cost_in_words, model_in_words, place_in_words
 
     index = {box: i for i, box in enumerate(decision.objects)}
@@ -80,7 +81,6 @@ def decision_view(decision: Decision) -> Group:
         headline.append(f"  (tied with {others}: {rule})")
     if decision.pick is not None:
         headline.append(f"\nwhere: {place_in_words(decision.pick)}")
-    cloud = bool(decision.model)  # a scene's decision names its model; a supports file's none
     headline.append(f"\nEC, the expected {cost_in_words(decision.cost, cloud=cloud)}", style="dim")
     parts: list[Any] = [headline]
     if decision.physics_veto is not None:

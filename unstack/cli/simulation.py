@@ -9,7 +9,7 @@ import click
 from unstack.cli.options import scheduler_option, setting
 from unstack.errors import InvalidArgument, UnstackError
 from unstack.parameters import MAX_CONFIGS, MAX_JOBS
-from unstack.sim.settings import FAMILIES, SIZE_SETS, check_setting
+from unstack.sim.settings import FAMILIES, MIN_PILE_BOXES, SIZE_SETS, check_setting
 
 __all__ = ["parse_box_range", "simulate"]
 
@@ -31,9 +31,9 @@ def parse_box_range(text: str) -> tuple[int, int]:
     high = int(match.group(2)) if match.group(2) is not None else low
     if low > high:
         raise UnstackError(f"--boxes: the range {text.strip()} is reversed; expected LOW-HIGH with LOW <= HIGH")
-    if low < 2:
+    if low < MIN_PILE_BOXES:
         raise UnstackError(
-            f"--boxes: expected at least 2 boxes a pile (one box supports nothing), got {text.strip()!r}"
+            f"--boxes: expected at least {MIN_PILE_BOXES} boxes a pile (one box supports nothing), got {text.strip()!r}"
         )
     return low, high
 

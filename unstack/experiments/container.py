@@ -14,10 +14,9 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     the default with a box counted as holding nothing up below an expected cost of
     :data:`STRICT_FREE_COST` instead of :data:`~unstack.height_veto.FREE_COST`.
 ``near_ties``
-    the reasoner's own choice: near ties alone (the default before 2026-12-06).
+    the reasoner's own choice: near ties alone (without the free-box rule above them).
 ``min_cost``
-    the same expected costs with the minimum EC (Eq. 12; no near ties; the default before
-    2026-12-01).
+    the same expected costs with the minimum EC (Eq. 12; no near ties).
 ``unstack_count``
     the same probabilities with Eq. 11's cost (detected boxes supported) and the minimum EC (Eq. 12).
 ``hybrid``

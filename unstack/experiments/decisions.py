@@ -4,9 +4,9 @@ For every test ISet (``r`` detected boxes drawn from a test scene's complete set
 decision maker picks the box to unload first:
 
 ``reasoner``
-    unstack: the classifier's probabilities, the consistent worlds, minimum EC (Eq. 12)
-    with the default cost (``load``: every box counted with the undetected load the cloud
-    shows on it); the minimum EC (Eq. 12), as the paper decides.
+    unstack: the classifier's probabilities, the consistent worlds and the minimum EC
+    (Eq. 12, as the paper decides) with the default cost (``load``: every box counted with
+    the undetected load the cloud shows on it).
 ``near_ties``
     the reasoner's choice: the same expected costs, near ties (within
     :data:`~unstack.reasoner.decision.NEAR_TIE_MARGIN`) to the box resting highest.

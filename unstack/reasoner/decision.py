@@ -13,7 +13,7 @@ Near ties. When the supports carry the heights the boxes rest at (their lowest p
 scene's supports do), boxes whose EC lies within :data:`NEAR_TIE_MARGIN` expected boxes
 moved of the minimum count as tied, and the tied box resting highest is taken: a box on
 top of others before the boxes under it. Tied boxes resting on one layer (within
-:data:`LAYER_TOLERANCE` of the highest) are decided by their EC as in Eq. 13 (then the
+:data:`LAYER_TOLERANCE` of the highest) are decided by their EC as in Eq. 12 (then the
 smallest id), so a box standing on the floor is never preferred to another on the floor
 for being taller -- a box leaning on it may be what the model missed. Which of several
 boxes that hold up almost nothing comes first is otherwise left to small differences of
@@ -551,7 +551,8 @@ def decide(
     NoConsistentWorld
         Hard evidence contradicts transitivity (the message names the file and the relations).
     TooLarge
-        The scene is beyond the method's limit.
+        The scene is beyond the method's limit, or with ``time_limit`` a sampled group's least
+        sampling cannot come near the time left for it (:func:`~unstack.reasoner.sampling.sampled_marginals`).
 
     Examples
     --------

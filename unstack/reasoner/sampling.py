@@ -394,7 +394,7 @@ def _refuse_unmeetable_limit(n: int, sweep_seconds: float, burn_in_left: int, ti
     if least > _UNMEETABLE_FACTOR * max(time_limit, 0.0) + _UNMEETABLE_SLACK:
         raise TooLarge(
             f"a group of {n} linked boxes needs about {least:.0f} s more of sampling at the least (a sweep takes "
-            f"{sweep_seconds:.2f} s), with {max(time_limit, 0.0):.2g} s of the time limit left for it: the limit "
+            f"{sweep_seconds:.2g} s), with {max(time_limit, 0.0):.2g} s of the time limit left for it: the limit "
             "cannot be met; give a longer one, or decide on fewer boxes"
         )
 
@@ -451,7 +451,7 @@ class _Chains:
             else:
                 self.successors[:] = start
                 self.predecessors[:] = _transposed(start, n, wide=self.wide)
-            if deadline is not None and start is None and burn_in > _PROBE_SWEEPS:  # seeded runs: one call
+            if deadline is not None and start is None and burn_in > _PROBE_SWEEPS:  # no limit: one call, as ever
                 probed = time.perf_counter()
                 self.advance(_PROBE_SWEEPS)
                 now = time.perf_counter()
@@ -579,6 +579,10 @@ def sampled_marginals(
     ------
     InvalidArgument
         Not a square probability matrix, or a budget, seed or count out of its domain.
+    TooLarge
+        With ``time_limit``: the burn-in's first sweeps show that the rest of the least
+        sampling (burn-in and two recorded rounds) would take more than 4 times the time left
+        plus 2 s.
     """
     start = time.perf_counter()  # loading the compiled kernels counts against the time limit
     if insertion_sums:

@@ -52,7 +52,7 @@ from unstack.dataset_folders import DATASET_FORMAT, MANIFEST, TIMINGS, config_na
 from unstack.errors import InvalidArgument, UnstackError
 from unstack.parameters import MAX_CONFIGS, MAX_JOBS
 from unstack.sim.configuration import SimulatedConfiguration, simulate_configuration
-from unstack.sim.settings import SimulationSettings, json_ready
+from unstack.sim.settings import MIN_PILE_BOXES, SimulationSettings, json_ready
 
 __all__ = [
     "DatasetConflict",
@@ -387,10 +387,11 @@ def simulate_dataset(
         raise UnstackError(f"configs must be from 1 to {MAX_CONFIGS:,}, got {configs}")
     if not 1 <= jobs <= MAX_JOBS:
         raise UnstackError(f"jobs must be from 1 to {MAX_JOBS}, got {jobs}")
-    if settings.boxes[0] < 2:
+    if settings.boxes[0] < MIN_PILE_BOXES:
         low, high = settings.boxes
         raise UnstackError(
-            f"settings.boxes: {low}-{high}: a pile of one box supports nothing; a data set needs at least 2 a pile"
+            f"settings.boxes: {low}-{high}: a pile of one box supports nothing; a data set needs at least "
+            f"{MIN_PILE_BOXES} a pile"
         )
     start = time.perf_counter()
     target = Path(folder)

@@ -34,6 +34,7 @@ __all__ = [
     "ARRANGEMENTS",
     "DISPLACEMENT_THRESHOLD",
     "FAMILIES",
+    "MIN_PILE_BOXES",
     "ROTATION_THRESHOLD_DEG",
     "SIZE_SETS",
     "Container",
@@ -149,6 +150,8 @@ class PileSettings:
 #: A box that moved more than this (metres) was disturbed: by a removal (ground truth,
 #: Section V) or by a pick (unloading, decisions). The one home of the 2 cm threshold.
 DISPLACEMENT_THRESHOLD = 0.02
+#: A data set's piles hold at least this many boxes: a pile of one box supports nothing.
+MIN_PILE_BOXES = 2
 #: ... or turned more than this (degrees).
 ROTATION_THRESHOLD_DEG = 5.0
 
