@@ -782,3 +782,100 @@ def test_boxes_on_a_pallet_deck_land_on_the_deck() -> None:
     fitted = {item.box.id: item.box for item in built.fitted}
     for box in boxes:
         assert fitted[box.id].position[2] == pytest.approx(0.3, abs=0.005), box.id
+
+
+def _ramp_scene() -> tuple[np.ndarray, list[np.ndarray], np.ndarray, list]:
+    """Cartons on a level floor seen from above, beside a ramp rising 20 degrees that fills more
+    of the view than the floor: the planes take the ramp for level."""
+    from tests.camera.conftest import FLOOR, looking_down, render_boxes
+    from unstack.scene import Box
+
+    rise = np.radians(20.0)
+    ramp = (np.array([np.sin(rise), 0.0, np.cos(rise)]), 0.0)  # level with the floor at x = 0, rising for x < 0
+    boxes = [
+        Box("a", [0.6, 0.4, 0.4], [0.7, 0.3, 0.2]),
+        Box("b", [0.4, 0.3, 0.3], [0.5, -0.4, 0.15]),
+        Box("c", [0.4, 0.3, 0.3], [0.7, 0.3, 0.55]),
+    ]
+    depth, masks = render_boxes(boxes, looking_down(), planes=(FLOOR, ramp))
+    return depth, masks, looking_down(), boxes
+
+
+@pytest.mark.parametrize("route", ["depth", "cloud"])
+def test_gravity_from_the_pose_is_not_turned_by_a_ramp_in_view(route: str) -> None:
+    from unstack.camera import depth_points, scene_from_cloud
+
+    depth, masks, pose, truth = _ramp_scene()
+    if route == "depth":
+        build = lambda gravity: scene_from_depth(  # noqa: E731
+            depth, INTRINSICS, pose, masks, ids=[box.id for box in truth], known_sizes=SIZES, gravity=gravity
+        )
+    else:
+        detections = [{"id": box.id, "center": box.position.tolist(), "size": box.size.tolist()} for box in truth]
+        cloud = depth_points(depth, INTRINSICS, pose)
+        build = lambda gravity: scene_from_cloud(cloud, detections, gravity=gravity)  # noqa: E731
+    assert build("planes").frame.tilt_deg == pytest.approx(20.0, abs=0.5)  # what the option is for
+    built = build("pose")
+    assert built.frame.tilt_deg == 0.0 and built.frame.gravity == "pose"
+    assert built.frame.planes_tilt_deg == pytest.approx(20.0, abs=0.5)
+    assert built.scene.metadata["camera"]["gravity"] == "pose" and built.report()["gravity"] == "pose"
+    for box, true in zip(built.scene.boxes, truth, strict=True):
+        assert box.position == pytest.approx(true.position, abs=0.01) and sorted(box.size) == sorted(true.size)
+    assert any("level planes lean 20.0 degrees" in doubt for doubt in built.doubts())
+
+
+def test_gravity_from_the_pose_on_a_level_pile_gives_the_planes_boxes_without_a_doubt(three_cartons) -> None:
+    depth, masks, pose = render_tops(three_cartons)
+    by_planes = scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES)
+    by_pose = scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES, gravity="pose")
+    assert by_pose.frame.planes_tilt_deg == pytest.approx(0.0, abs=0.1) and by_pose.doubts() == []
+    for box, other in zip(by_pose.scene.boxes, by_planes.scene.boxes, strict=True):
+        assert box.position == pytest.approx(other.position, abs=0.002)
+
+
+@pytest.mark.parametrize(("tilt_deg", "doubted"), [(1.0, False), (2.0, True), (9.0, True)])
+def test_a_pose_tilted_against_level_planes_is_taken_as_asked_and_doubted_past_1_5_degrees(
+    three_cartons, tilt_deg: float, doubted: bool
+) -> None:
+    depth, masks, pose = render_tops(three_cartons, tilt_deg)
+    built = scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES, gravity="pose")
+    assert built.frame.tilt_deg == 0.0 and built.frame.planes_tilt_deg == pytest.approx(tilt_deg, abs=0.1)
+    assert any(f"lean {tilt_deg:.1f} degrees" in doubt for doubt in built.doubts()) == doubted
+
+
+@pytest.mark.parametrize("lean_deg", [5.0, 12.0, 20.0])
+def test_a_floor_leaning_against_the_pose_s_z_is_refused_or_taken_saying_how_far_it_leans(lean_deg: float) -> None:
+    # a leaning floor has no level along the pose's z, but its slab at an edge of the view can stand
+    # out as one: either way the lean is said, never a level floor silently
+    from unstack.camera.planes import gravity_frame
+
+    rng = np.random.default_rng(0)
+    floor = np.column_stack([rng.uniform(-1, 1, 4000), rng.uniform(-1, 1, 4000), np.zeros(4000)])
+    lean = np.radians(lean_deg)
+    turned = floor @ np.array([[1, 0, 0], [0, np.cos(lean), -np.sin(lean)], [0, np.sin(lean), np.cos(lean)]]).T
+    try:
+        frame = gravity_frame(turned, gravity="pose")
+    except UnstackError as error:
+        assert "no level plane along the frame's z (gravity from the pose)" in str(error)
+        assert f"the cloud's planes lean {lean_deg:.1f} degrees from it" in str(error)
+    else:
+        assert frame.planes_tilt_deg == pytest.approx(lean_deg, abs=0.1)
+
+
+def test_a_wall_with_no_level_plane_is_refused_with_gravity_from_the_pose() -> None:
+    from unstack.camera.planes import gravity_frame
+
+    rng = np.random.default_rng(0)
+    wall = np.column_stack([np.ones(4000), rng.uniform(-1, 1, 4000), rng.uniform(0, 1.5, 4000)])
+    with pytest.raises(
+        UnstackError, match=r"^no level plane along the frame's z \(gravity from the pose\) holds 2 % of the points: is"
+    ):
+        gravity_frame(wall, gravity="pose")
+
+
+def test_gravity_is_from_the_planes_or_the_pose() -> None:
+    from unstack.camera.planes import gravity_frame
+    from unstack.errors import InvalidArgument
+
+    with pytest.raises(InvalidArgument, match=r"gravity: expected one of 'planes', 'pose', got 'imu'"):
+        gravity_frame(np.zeros((200, 3)), gravity="imu")

@@ -187,3 +187,24 @@ def test_a_label_image_of_another_size_than_the_depth_is_refused_before_the_ids_
     run = unstack("scene", *arguments, "--labels", "--ids", "a,b,c", "--out", str(tmp_path / "scene.json"))
     assert run.returncode == 2 and run.stderr.count("\n") == 1, run.stderr
     assert "labels.png: $: expected a label image of " in run.stderr and "like the depth image, got " in run.stderr
+
+
+def test_gravity_from_the_pose_is_said_in_the_table_the_warnings_and_the_report(
+    camera_files: list[str], tmp_path: Path
+) -> None:
+    # the fixture's pose frame is tilted 9 degrees against gravity: taken as asked, and said
+    run = unstack("scene", *camera_files, "--sizes", "0.6x0.4x0.4,0.4x0.3x0.3", "--gravity", "pose",
+                  "--out", str(tmp_path / "scene.json"), "--report", str(tmp_path / "report.json"))  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert "gravity along the pose's z" in run.stdout
+    assert "level planes lean 9.0 degrees" in run.stderr
+    report = json.loads((tmp_path / "report.json").read_text())
+    assert report["gravity"] == "pose" and report["tilt_deg"] == 0.0
+    assert report["planes_tilt_deg"] == pytest.approx(9.0, abs=0.3)
+
+
+def test_an_unknown_gravity_source_is_one_line(camera_files: list[str], tmp_path: Path) -> None:
+    run = unstack("scene", *camera_files, "--gravity", "imu", "--out", str(tmp_path / "scene.json"))
+    assert run.returncode == 2 and run.stderr.count("\n") == 1
+    assert "--gravity" in run.stderr and "'imu' is not one of 'planes', 'pose'" in run.stderr
+    assert not (tmp_path / "scene.json").exists()

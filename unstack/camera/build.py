@@ -176,6 +176,10 @@ LARGE_FIT_M = 1.0
 #: from the door: the door's direction was given the wrong way (a camera looking down from above
 #: the pile stands about level with it).
 DOOR_DOUBT_M = 0.3
+#: With gravity from the pose, level planes of the cloud leaning more than this (degrees) from
+#: the pose's z are said: a pose not calibrated to gravity, or a ramp or leaning layer in view
+#: (the planes find gravity within 0.5 degrees under Kinect-like noise: docs page "Your own camera").
+POSE_DOUBT_DEG = 1.5
 
 
 @dataclass(frozen=True)
@@ -227,6 +231,13 @@ class CameraScene:
                 f"the fitted boxes are larger than cartons (their longest edges' median is {longest:.2f} m): are the "
                 "depth image's units right (--depth-units)?"
             )
+        lean = self.frame.planes_tilt_deg
+        if lean is not None and lean > POSE_DOUBT_DEG:
+            doubts.append(
+                f"gravity is the pose's z, as asked, but the cloud's level planes lean {lean:.1f} degrees from it: "
+                "check the pose's calibration; where the pile's tops and the floor are level, let the planes "
+                "correct it (gravity from the planes)"
+            )
         if self.frame.floor_inliers == 0:
             doubts.append(
                 "no floor plane was seen (hidden by the boxes, or out of the view): z = 0 is put at the lowest "
@@ -249,7 +260,9 @@ class CameraScene:
         """JSON-ready: gravity (tilt, planes, floor, whether the depth's noise filled the planes' band),
         every fitted box with its residual, duplicates."""
         return {
+            "gravity": self.frame.gravity,
             "tilt_deg": self.frame.tilt_deg,
+            "planes_tilt_deg": self.frame.planes_tilt_deg,
             "horizontal_planes": self.frame.planes,
             "floor_points": self.frame.floor_inliers,
             "noisy_depth": self.frame.noisy,
@@ -442,6 +455,7 @@ def scene_from_depth(
     known_sizes: Sequence[Sequence[float]] | None = None,
     door: Sequence[float] | None = None,
     seed: int = 0,
+    gravity: str = "planes",
 ) -> CameraScene:
     """Build an ``unstack.scene/1`` scene: gravity frame, one fitted box per mask, the cloud.
 
@@ -463,6 +477,10 @@ def scene_from_depth(
         (the pose frame's -x when the camera looks down from above the pile).
     seed : int
         Seeds RANSAC and the subsets.
+    gravity : {"planes", "pose"}
+        Up from the cloud's level planes, or the pose frame's z taken as up (a calibrated robot
+        frame: a ramp or a leaning layer in view cannot turn it); see
+        :func:`~unstack.camera.planes.gravity_frame`.
     """
     rng = np.random.default_rng(seed)
     names = [f"b{k:02d}" for k in range(len(masks))] if ids is None else list(ids)
@@ -487,7 +505,7 @@ def scene_from_depth(
         toward_camera = pose[:3, 3] - np.median(cloud, axis=0)
         horizontal = np.linalg.norm(toward_camera[:2])
         door = list(toward_camera if horizontal > 0.3 * np.linalg.norm(toward_camera) else [-1.0, 0.0, 0.0])
-    frame = gravity_frame(cloud, door=np.asarray(door, dtype=np.float64), seed=seed)
+    frame = gravity_frame(cloud, door=np.asarray(door, dtype=np.float64), seed=seed, gravity=gravity)
     masks = [_without_specks(mask, name) for mask, name in zip(masks, names, strict=True)]
     duplicates = duplicate_masks(masks)
     merged = merged_masks(masks)
@@ -552,6 +570,7 @@ def scene_from_depth(
     boxes: list[Box] = [item.box for item in fitted]
     metadata = {
         "camera": {
+            "gravity": frame.gravity,
             "tilt_deg": frame.tilt_deg,
             "gravity_rotation": frame.rotation.tolist(),
             "gravity_translation": frame.translation.tolist(),

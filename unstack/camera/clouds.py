@@ -274,9 +274,18 @@ def _heading(rotation: np.ndarray, size: np.ndarray) -> tuple[float, np.ndarray]
 
 
 def scene_from_cloud(
-    points: np.ndarray, detections: Sequence[dict[str, Any]], *, door: Sequence[float] | None = None, seed: int = 0
+    points: np.ndarray,
+    detections: Sequence[dict[str, Any]],
+    *,
+    door: Sequence[float] | None = None,
+    seed: int = 0,
+    gravity: str = "planes",
 ) -> CameraScene:
-    """Build a scene from a cloud and box detections in the same frame (z roughly up)."""
+    """Build a scene from a cloud and box detections in the same frame (z roughly up).
+
+    ``gravity="pose"`` takes the frame's z as up (see
+    :func:`~unstack.camera.planes.gravity_frame`); the cloud's planes give the floor.
+    """
     from scipy.spatial.transform import Rotation
 
     from unstack.camera.boxes import TILT_MIN_DEG
@@ -288,7 +297,8 @@ def scene_from_cloud(
     cloud = check_points(finite_points(points, "<cloud>"), source="<cloud>", path="$")  # NaN left out, with a warning
     if len(cloud) < 100:
         raise UnstackError(f"the cloud holds {len(cloud)} points; at least 100 are needed for gravity and the floor")
-    frame = gravity_frame(cloud, door=None if door is None else np.asarray(door, dtype=np.float64), seed=seed)
+    direction = None if door is None else np.asarray(door, dtype=np.float64)
+    frame = gravity_frame(cloud, door=direction, seed=seed, gravity=gravity)
     boxes = []
     for item in detections:
         if "orientation_xyzw" in item:
@@ -312,7 +322,8 @@ def scene_from_cloud(
                 f"detection {item['id']!r}, moved into the gravity frame the cloud gives: {error.json_path[2:]}: "
                 f"{error.message}; are the cloud and the detections in one frame?"
             ) from None
-    metadata = {"camera": {"tilt_deg": frame.tilt_deg, "gravity_rotation": frame.rotation.tolist(),
+    metadata = {"camera": {"gravity": frame.gravity, "tilt_deg": frame.tilt_deg,
+                           "gravity_rotation": frame.rotation.tolist(),
                            "gravity_translation": frame.translation.tolist()}}  # fmt: skip
     scene = Scene(boxes, frame.apply(cloud), [box.id for box in boxes], metadata=metadata, source="<cloud>")
     return CameraScene(scene, frame, (), door_given=door is not None)

@@ -78,6 +78,9 @@ LEAN_EVIDENCE = 1.2
 LEVEL_PEAK = 2.0
 #: Points used for the plane search (a random subset of larger clouds; the fit is refined on all).
 PLANE_SAMPLE = 60_000
+#: Where gravity comes from: the cloud's level planes (correcting a pose frame tilted against
+#: gravity), or the pose frame's z taken as up (a robot cell's calibrated frame).
+GRAVITY_SOURCES = ("planes", "pose")
 
 
 def depth_points(
@@ -231,6 +234,25 @@ def _level_within_noise(points: np.ndarray, normal: np.ndarray) -> tuple[float, 
     noise fills it (up to :data:`NOISE_BAND`), and the points within that band."""
     heights = points @ normal
     return _widened(heights, _fullest_slab(heights, 4 * PLANE_THRESHOLD)[0], PLANE_THRESHOLD)
+
+
+def _level_along(points: np.ndarray, up: np.ndarray) -> tuple[float, np.ndarray]:
+    """The fullest level of the points along ``up``: the median height of the fullest 4 cm slab
+    (:func:`_fullest_slab`; exact depth puts a plane at the slab's lower edge, not its middle),
+    refitted in a band doubled while the noise fills it (up to :data:`NOISE_BAND`), and the
+    points within that band.
+
+    Examples
+    --------
+    >>> heights = np.r_[np.zeros(500), np.full(200, 0.3)]
+    >>> offset, inside = _level_along(np.column_stack([np.zeros(700), np.zeros(700), heights]), np.array([0, 0, 1.0]))
+    >>> offset, int(inside.sum())
+    (0.0, 500)
+    """
+    heights = points @ up
+    centre = _fullest_slab(heights, 4 * PLANE_THRESHOLD)[0]
+    slab = heights[np.abs(heights - centre) <= 2 * PLANE_THRESHOLD + 1e-9]  # its lower edge, past rounding
+    return _widened(heights, float(np.median(slab)), PLANE_THRESHOLD)
 
 
 def _widened(heights: np.ndarray, offset: float, band: float) -> tuple[float, np.ndarray]:
@@ -443,6 +465,11 @@ class GravityFrame:
         The depth's noise filled the lead plane's band (:data:`PLANE_THRESHOLD`; the plane with
         the most points): it was found by the points' heights and refitted in a band as
         wide as the noise (:func:`plane_by_heights`, :func:`plane_within_noise`).
+    gravity : {"planes", "pose"}
+        Where up came from: the level planes, or the input frame's z.
+    planes_tilt_deg : float or None
+        With ``gravity="pose"``: how far the level planes would have turned up from the frame's z
+        (``None`` where they find no plane); ``None`` with ``"planes"``.
     """
 
     rotation: np.ndarray
@@ -452,6 +479,8 @@ class GravityFrame:
     floor_inliers: int
     plane_heights: tuple[tuple[float, int], ...] = ()
     noisy: bool = False
+    gravity: str = "planes"
+    planes_tilt_deg: float | None = None
 
     def apply(self, points: np.ndarray) -> np.ndarray:
         """The points in the gravity frame."""
@@ -470,7 +499,9 @@ def _rotation_onto_z(up: np.ndarray, heading: np.ndarray) -> np.ndarray:
     return np.vstack([x, y, z])
 
 
-def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: int = 0) -> GravityFrame:
+def gravity_frame(
+    points: np.ndarray, *, door: np.ndarray | None = None, seed: int = 0, gravity: str = "planes"
+) -> GravityFrame:
     """Gravity and floor from a cloud's horizontal planes; the door towards -x.
 
     Parameters
@@ -483,6 +514,19 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
         (towards where the robot stands); it becomes -x. Default: the input frame's -x.
     seed : int
         Seeds RANSAC.
+    gravity : {"planes", "pose"}
+        ``"planes"``: up is the level planes' normal (the input frame's z corrected by up to
+        :data:`HORIZONTAL_TOLERANCE_DEG`). ``"pose"``: up is the input frame's z, as a calibrated
+        robot frame gives it; the planes give only the levels, the floor among them (a ramp or
+        a leaning layer of tops that would turn the planes' up is not followed), and
+        ``planes_tilt_deg`` says how far the planes would have turned it.
+
+    Raises
+    ------
+    InvalidArgument
+        ``gravity`` is neither ``"planes"`` nor ``"pose"``.
+    UnstackError
+        No level plane, or a door direction within 15 degrees of the vertical.
 
     Examples
     --------
@@ -493,10 +537,24 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
     >>> frame = gravity_frame(flat @ turn.T + [0, 0, 0.7])
     >>> round(frame.tilt_deg, 1), round(float(np.abs(frame.apply(flat @ turn.T + [0, 0, 0.7])[:, 2]).max()), 3)
     (9.0, 0.0)
+
+    A floor 1 degree off the frame's z, with that z taken as up: not corrected (the floor's
+    level is its height along z), and how far the planes would have turned up is said:
+
+    >>> tilt = np.radians(1.0)
+    >>> turn = np.array([[1, 0, 0], [0, np.cos(tilt), -np.sin(tilt)], [0, np.sin(tilt), np.cos(tilt)]])
+    >>> frame = gravity_frame(flat @ turn.T + [0, 0, 0.7], gravity="pose")
+    >>> frame.tilt_deg, round(frame.planes_tilt_deg, 1), round(float(frame.translation[2]), 2)
+    (0.0, 1.0, -0.7)
     """
+    if gravity not in GRAVITY_SOURCES:
+        from unstack.errors import InvalidArgument
+
+        raise InvalidArgument(f"gravity: expected one of {', '.join(map(repr, GRAVITY_SOURCES))}, got {gravity!r}")
     points = np.asarray(points, dtype=np.float64)
     rng = np.random.default_rng(seed)
     up_guess = np.array([0.0, 0.0, 1.0])
+    from_pose = gravity == "pose"
     remaining = points
     found: list[tuple[np.ndarray, float, int]] = []
     noisy_planes: list[bool] = []
@@ -504,29 +562,12 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
     for _ in range(MAX_PLANES):
         if len(remaining) < max(3, MIN_PLANE_SHARE * len(points)):
             break
-        normal, offset, inliers = fit_plane(remaining, rng=rng, near_normal=up_guess, in_cone=True)
-        # depth noise grows with distance: each plane tells whether noise fills its band
-        noisy = bool(inliers.sum() >= 3 and _fills_band(remaining, normal, offset))
-        if noisy and first_up is not None:
-            # a noisy plane after the first -- a far floor, noisier with distance, tops among noisy
-            # sides, or in exact depth a few tops among the sides crossing them -- keeps the first's
-            # direction and gives only its height, in a band as wide as its noise (searched over the
-            # cone, such a plane turned gravity 25 degrees; searched within 2 degrees of a noisy
-            # ceiling, slabs cutting through a dropped pile's faces turned it 2-3 degrees)
-            normal = first_up
-            offset, inliers = _level_within_noise(remaining, first_up)
+        if from_pose:  # up is the frame's z: each plane is the fullest level along it
+            normal = up_guess
+            offset, inliers = _level_along(remaining, up_guess)
+            noisy = bool(inliers.sum() >= 3 and _fills_band(remaining, normal, offset))
         else:
-            if noisy:  # the first plane, over the whole cone, by its heights
-                normal, offset = plane_by_heights(remaining, up_guess, rng=rng)
-                inliers = np.abs(remaining @ normal - offset) < PLANE_THRESHOLD
-            if inliers.sum() >= 3:
-                normal, offset, inliers = plane_within_noise(
-                    remaining, normal, offset, inliers, max_turn_deg=LEVEL_TURN_DEG, level=True
-                )
-            if not noisy and inliers.sum() >= 3:  # RANSAC's plane leans only on evidence
-                normal, offset, inliers = _level_unless_leaning(
-                    remaining, normal, offset, inliers, up_guess if first_up is None else first_up
-                )
+            normal, offset, inliers, noisy = _plane_in_cone(remaining, rng, up_guess, first_up)
         if inliers.sum() < MIN_PLANE_SHARE * len(points):
             break
         band = max(float(np.max(np.abs(remaining[inliers] @ normal - offset))), PLANE_THRESHOLD)
@@ -538,6 +579,14 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
         if first_up is None:
             first_up = normal
         remaining = remaining[~inliers]
+    if not found and from_pose:
+        planes_tilt = _planes_tilt_deg(points, door, seed)
+        lean = "" if planes_tilt is None else f"; the cloud's planes lean {planes_tilt:.1f} degrees from it"
+        raise UnstackError(
+            f"no level plane along the frame's z (gravity from the pose) holds 2 % of the points{lean}: "
+            "is the pose's z up? Without gravity from the pose, the planes correct a tilt of up to "
+            f"{HORIZONTAL_TOLERANCE_DEG:g} degrees"
+        )
     if not found:
         raise UnstackError(
             f"no horizontal plane in the cloud (none within {HORIZONTAL_TOLERANCE_DEG:g} degrees of the frame's z "
@@ -582,6 +631,55 @@ def gravity_frame(points: np.ndarray, *, door: np.ndarray | None = None, seed: i
     plane_heights = tuple(
         (float(height - floor_level), count) for height, (*_, count) in zip(floor_heights, found, strict=True)
     )
+    planes_tilt = _planes_tilt_deg(points, door, seed) if from_pose else None
     return GravityFrame(
-        rotation, np.array([0.0, 0.0, -floor_level]), tilt, len(found), floor_inliers, plane_heights, bool(noisy)
+        rotation,
+        np.array([0.0, 0.0, -floor_level]),
+        tilt,
+        len(found),
+        floor_inliers,
+        plane_heights,
+        bool(noisy),
+        gravity,
+        planes_tilt,
     )
+
+
+def _plane_in_cone(
+    points: np.ndarray, rng: np.random.Generator, up_guess: np.ndarray, first_up: np.ndarray | None
+) -> tuple[np.ndarray, float, np.ndarray, bool]:
+    """The next level plane of ``points`` within :data:`HORIZONTAL_TOLERANCE_DEG` of ``up_guess``
+    (the first plane's normal ``first_up`` once there is one): its normal, offset, inliers and
+    whether the depth's noise filled its band."""
+    normal, offset, inliers = fit_plane(points, rng=rng, near_normal=up_guess, in_cone=True)
+    # depth noise grows with distance: each plane tells whether noise fills its band
+    noisy = bool(inliers.sum() >= 3 and _fills_band(points, normal, offset))
+    if noisy and first_up is not None:
+        # a noisy plane after the first -- a far floor, noisier with distance, tops among noisy
+        # sides, or in exact depth a few tops among the sides crossing them -- keeps the first's
+        # direction and gives only its height, in a band as wide as its noise (searched over the
+        # cone, such a plane turned gravity 25 degrees; searched within 2 degrees of a noisy
+        # ceiling, slabs cutting through a dropped pile's faces turned it 2-3 degrees)
+        normal = first_up
+        offset, inliers = _level_within_noise(points, first_up)
+    else:
+        if noisy:  # the first plane, over the whole cone, by its heights
+            normal, offset = plane_by_heights(points, up_guess, rng=rng)
+            inliers = np.abs(points @ normal - offset) < PLANE_THRESHOLD
+        if inliers.sum() >= 3:
+            normal, offset, inliers = plane_within_noise(
+                points, normal, offset, inliers, max_turn_deg=LEVEL_TURN_DEG, level=True
+            )
+        if not noisy and inliers.sum() >= 3:  # RANSAC's plane leans only on evidence
+            normal, offset, inliers = _level_unless_leaning(
+                points, normal, offset, inliers, up_guess if first_up is None else first_up
+            )
+    return normal, offset, inliers, noisy
+
+
+def _planes_tilt_deg(points: np.ndarray, door: np.ndarray | None, seed: int) -> float | None:
+    """How far the level planes turn up from the frame's z (``None`` where they find no plane)."""
+    try:
+        return gravity_frame(points, door=door, seed=seed).tilt_deg
+    except UnstackError:
+        return None

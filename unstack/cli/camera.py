@@ -14,11 +14,15 @@ import os
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 
 from unstack.checks import MAX_BOX_EDGE, MAX_ID_LENGTH, MIN_BOX_EDGE, counted, long_id
 from unstack.errors import InvalidFile, UnstackError
+
+if TYPE_CHECKING:
+    from unstack.camera.planes import GravityFrame
 from unstack.jsonio import report_text
 
 __all__ = ["scene"]
@@ -127,6 +131,13 @@ def _depth_units(context: click.Context, parameter: click.Parameter, value: str 
     return value
 
 
+def _gravity_said(frame: GravityFrame) -> str:
+    """Where gravity came from, for the table's title."""
+    if frame.gravity == "pose":
+        return "gravity along the pose's z, as --gravity pose asks"
+    return f"gravity tilted {frame.tilt_deg:.1f} degrees from the input frame's z"
+
+
 def _holds_labels(path: str) -> bool:
     """Whether a mask file holds two non-zero values or more, as a label image does."""
     from unstack.camera import load_label_masks
@@ -162,6 +173,10 @@ def _holds_labels(path: str) -> bool:
 @click.option("--sizes", default=None, help="Known carton sizes, e.g. 0.255x0.155x0.1,0.34x0.25x0.095 (metres).")
 @click.option("--door", default=None,
               help="Direction x,y,z (pose frame) out through the door; default: towards the camera.")  # fmt: skip
+@click.option("--gravity", type=click.Choice(["planes", "pose"]), default="planes", show_default=True,
+              help="planes: up from the cloud's level planes (corrects a pose tilted up to 25 degrees); pose: the "
+              "pose's z is up, as a calibrated robot frame gives it (a ramp or leaning layer in view cannot turn "
+              "it; the planes give the floor).")  # fmt: skip
 @click.option("--out", required=True, type=click.Path(dir_okay=False), help="The scene file to write (.json).")
 @click.option("--report", "report_file", default=None, type=click.Path(dir_okay=False),
               help="Also write the fit report (tilt, residuals, duplicates) as JSON.")  # fmt: skip
@@ -169,15 +184,16 @@ def _holds_labels(path: str) -> bool:
 def scene(
     mask_files: tuple[str, ...], depth_file: str | None, depth_units: str | None, intrinsics_file: str | None,
     pose_file: str | None, cloud_file: str | None, detections_file: str | None, ids: str | None, labels: bool,
-    sizes: str | None, door: str | None, out: str, report_file: str | None, seed: int,
+    sizes: str | None, door: str | None, gravity: str, out: str, report_file: str | None, seed: int,
 ) -> None:  # fmt: skip
     """Build a scene from a depth camera's files and one mask per detected box (MASK_FILES: PNG or
     .npy, non-zero where the box is; or one label image with --labels), or from a point cloud and
     box detections.
 
-    Gravity and the floor come from the cloud's horizontal planes; each box from its mask's top
-    face (or front face) matched to the known sizes, or from its detection levelled in the
-    gravity frame. Decide on the result with ``unstack decide OUT``.
+    Gravity and the floor come from the cloud's horizontal planes (gravity from the pose's z with
+    --gravity pose); each box from its mask's top face (or front face) matched to the known
+    sizes, or from its detection levelled in the gravity frame. Decide on the result with
+    ``unstack decide OUT``.
     """
     from rich.console import Console
 
@@ -225,7 +241,9 @@ def scene(
             cloud = depth_points(load_depth(depth_file, units=depth_units), load_intrinsics(intrinsics_file),
                                  load_pose(pose_file))  # fmt: skip
         with _naming(f"{cloud_file or f'{depth_file} seen from {pose_file}'} with {detections_file}"):
-            built = scene_from_cloud(cloud, load_detections(detections_file), door=direction, seed=seed)
+            built = scene_from_cloud(
+                cloud, load_detections(detections_file), door=direction, seed=seed, gravity=gravity
+            )
     elif cloud_file is not None:
         raise UnstackError("--cloud needs --detections: the boxes a 3-D detector found in the cloud")
     else:
@@ -278,7 +296,15 @@ def scene(
         with _naming(f"{depth_file} seen from {pose_file}"):
             try:
                 built = scene_from_depth(
-                    depth, intrinsics, pose, masks, ids=names, known_sizes=known, door=direction, seed=seed
+                    depth,
+                    intrinsics,
+                    pose,
+                    masks,
+                    ids=names,
+                    known_sizes=known,
+                    door=direction,
+                    seed=seed,
+                    gravity=gravity,
                 )
             except UnstackError as error:
                 if (
@@ -295,8 +321,7 @@ def scene(
         atomic_write_text(Path(report_file), report_text(built.report()))
     console = Console()
     table = number_table(
-        f"{counted(len(built.scene.boxes), 'box', 'boxes')} "
-        f"(gravity tilted {built.frame.tilt_deg:.1f} degrees from the input frame's z)",
+        f"{counted(len(built.scene.boxes), 'box', 'boxes')} ({_gravity_said(built.frame)})",
         ("box", "face", "size (m)", "position (m)", "residual (mm)", "face seen"),
     )
     fits = {item.box.id: item for item in built.fitted}
