@@ -19,6 +19,8 @@ HEAVY = ("sklearn", "pybullet", "matplotlib", "dask", "torch")
 PROBE = """
 import json, sys
 sys.argv = ["unstack", "decide", {file!r}, "--json", "--method", {method!r}]
+if {text!r}:
+    sys.argv.remove("--json")
 from unstack.cli.main import main
 try:
     main()
@@ -28,14 +30,20 @@ sys.stderr.write(json.dumps(sorted(sys.modules)))
 """
 
 
+@pytest.mark.parametrize("text", [False, True], ids=["json", "text"])
 @pytest.mark.parametrize("method", ["exact", "sat"])
-def test_decide_on_a_supports_file_imports_nothing_heavy(repo: Path, method: str) -> None:
-    probe = PROBE.format(file=str(repo / "examples" / "stack5.supports.json"), method=method)
+def test_decide_on_a_supports_file_imports_nothing_heavy(repo: Path, method: str, text: bool) -> None:
+    # the text output says "support model: none": saying it must not load the model table's module
+    probe = PROBE.format(file=str(repo / "examples" / "stack5.supports.json"), method=method, text=text)
     result = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300, check=True)
-    modules = json.loads(result.stderr)
-    assert json.loads(result.stdout)["choice"] == "top_left"
+    modules = json.loads(result.stderr.splitlines()[-1])
+    if text:
+        assert "Unload first: top_left" in result.stdout
+    else:
+        assert json.loads(result.stdout)["choice"] == "top_left"
     loaded = {name.split(".")[0] for name in modules}
     assert not loaded & set(HEAVY), sorted(loaded & set(HEAVY))
+    assert "unstack.learning" not in modules
 
 
 def test_importing_the_reasoner_loads_no_learning_or_simulation(repo: Path) -> None:
@@ -49,7 +57,7 @@ def test_importing_the_reasoner_loads_no_learning_or_simulation(repo: Path) -> N
 
 def test_a_small_decision_loads_only_what_it_needs(repo: Path) -> None:
     """``unstack decide FILE --json`` on five boxes: no compiled engine, SAT solver, schema library or tables."""
-    probe = PROBE.format(file=str(repo / "examples" / "stack5.supports.json"), method="auto")
+    probe = PROBE.format(file=str(repo / "examples" / "stack5.supports.json"), method="auto", text=False)
     result = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300, check=True)
     loaded = {name.split(".")[0] for name in json.loads(result.stderr)}
     lean = {"numba", "pysat", "networkx", "jsonschema", "rich", "scipy", *HEAVY}
@@ -62,7 +70,7 @@ def test_help_lists_the_commands_without_loading_heavy_parts(arguments: list[str
     """Listing the commands imports each lazy command's module; none of them may load scikit-learn."""
     probe = PROBE.replace(
         '["unstack", "decide", {file!r}, "--json", "--method", {method!r}]', repr(["unstack", *arguments])
-    )
+    ).replace("{text!r}", "False")
     result = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300, check=True)
     loaded = {name.split(".")[0] for name in json.loads(result.stderr)}
     assert "Usage: unstack" in result.stdout

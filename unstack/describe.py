@@ -78,6 +78,8 @@ def model_in_words(label: str) -> str:
     >>> model_in_words("")
     'none (the probabilities were given)'
     """
+    if not label:  # before the model table's import: a supports file's decision loads no learning
+        return "none (the probabilities were given)"
     from unstack.learning.model_file import BUNDLED_MODELS
 
     names = {file: name for name, file in BUNDLED_MODELS.items()}
@@ -86,8 +88,6 @@ def model_in_words(label: str) -> str:
         return f"{names[file]} (the default model)"
     if kind == "shipped" and file in names:
         return f"{names[file]} (a shipped model)"
-    if not label:
-        return "none (the probabilities were given)"
     return f"the model file {label}"
 
 
