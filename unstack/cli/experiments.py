@@ -415,7 +415,7 @@ def unload(
         )
         for maker in result["makers"]
     )
-    header = ("decision maker", "boxes moved > 2 cm per pile", "minus unstack's (± s.e.)", "per pick",
+    header = ("decision maker", "boxes moved (> 2 cm or 5°) per pile", "minus unstack's (± s.e.)", "per pick",
               "picks moving nothing", "displacement (m)")  # fmt: skip
     title = f"Unloading every detected box of {result['configs']} piles ({data_dir}) in the simulator"
     _print_results(number_table(title, header, figures), written)

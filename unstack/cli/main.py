@@ -246,7 +246,8 @@ def _default_samples_text() -> str:
 def _add_reasoning_options(command: Callable[..., Any], *, plan: bool) -> Callable[..., Any]:
     from unstack.reasoner.costs import COSTS, DEFAULT_COST
     from unstack.reasoner.decision import METHODS
-    from unstack.reasoner.plan import PLAN_SAMPLES
+    from unstack.reasoner.marginals import EXACT_MAX_BOXES
+    from unstack.reasoner.plan import PLAN_EXACT_MAX_BOXES, PLAN_SAMPLES
 
     moves = (
         ""
@@ -268,7 +269,8 @@ def _add_reasoning_options(command: Callable[..., Any], *, plan: bool) -> Callab
             default="auto",
             show_default=True,
             help="exact: weighted preorder counting (<= 8 boxes per group); sat: list worlds with CaDiCaL "
-            "(<= 6); approx: sampling with standard errors (any size); auto: per group, exact up to 8, else approx.",
+            "(<= 6); approx: sampling with standard errors (any size); auto: per group, exact up to "
+            f"{PLAN_EXACT_MAX_BOXES if plan else EXACT_MAX_BOXES}, else approx.",
         ),
         click.option(
             "--cost",
