@@ -8,12 +8,12 @@ script prints medians and the ratio moves / load.
 
 Usage::
 
-    python benchmarks/moves_speed.py test-dropped --piles 5 --repeat 5 --sizes 5,40 \\
+    python benchmarks/moves_speed.py fresh30-dropped --piles 5 --repeat 5 --sizes 5,40 \\
         --json benchmarks/results/moves-speed.json
 
-``test-dropped`` is made by::
+``fresh30-dropped`` (the results page's set) is made by::
 
-    unstack simulate --family dropped --configs 30 --seed 9001 --viewpoint-jitter 0.3 --out test-dropped
+    unstack simulate --family dropped --configs 30 --seed 9001 --viewpoint-jitter 0.3 --out fresh30-dropped
 """
 
 from __future__ import annotations
