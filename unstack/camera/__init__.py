@@ -28,7 +28,15 @@ Examples
 from unstack.camera.boxes import FittedBox, boxes_from_masks
 from unstack.camera.build import CameraScene, scene_from_depth
 from unstack.camera.clouds import load_cloud, load_detections, scene_from_cloud
-from unstack.camera.files import Intrinsics, load_depth, load_intrinsics, load_label_masks, load_mask, load_pose
+from unstack.camera.files import (
+    Intrinsics,
+    check_pose,
+    load_depth,
+    load_intrinsics,
+    load_label_masks,
+    load_mask,
+    load_pose,
+)
 from unstack.camera.planes import GravityFrame, depth_points, fit_plane, gravity_frame
 
 __all__ = [
@@ -37,6 +45,7 @@ __all__ = [
     "GravityFrame",
     "Intrinsics",
     "boxes_from_masks",
+    "check_pose",
     "depth_points",
     "fit_plane",
     "gravity_frame",

@@ -23,8 +23,14 @@ from typing import Any
 import numpy as np
 
 from unstack.camera.boxes import FittedBox, boxes_from_masks, content_rng, duplicate_masks, merged_masks
-from unstack.camera.files import Intrinsics
-from unstack.camera.planes import GravityFrame, depth_points, gravity_frame
+from unstack.camera.files import Intrinsics, check_pose
+from unstack.camera.planes import (
+    HORIZONTAL_TOLERANCE_DEG,
+    GravityFrame,
+    check_gravity,
+    depth_points,
+    gravity_frame,
+)
 from unstack.errors import UnstackError
 from unstack.geometry import points_in_box
 from unstack.scene import Box, Scene
@@ -180,6 +186,11 @@ DOOR_DOUBT_M = 0.3
 #: the pose's z are said: a pose not calibrated to gravity, or a ramp or leaning layer in view
 #: (the planes find gravity within 0.5 degrees under Kinect-like noise: docs page "Your own camera").
 POSE_DOUBT_DEG = 1.5
+#: Without a floor plane, a level plane this far (metres) above the lowest readings, the largest
+#: one, is named: it may be the floor, and the lowest readings a ramp or pit going down from it.
+FLOOR_ABOVE_DOUBT_M = 0.05
+#: A tilt this close (degrees) to what the planes correct is said: the fit may have stopped there.
+CONE_EDGE_DEG = 1.0
 
 
 @dataclass(frozen=True)
@@ -231,6 +242,12 @@ class CameraScene:
                 f"the fitted boxes are larger than cartons (their longest edges' median is {longest:.2f} m): are the "
                 "depth image's units right (--depth-units)?"
             )
+        if self.frame.gravity == "planes" and self.frame.tilt_deg >= HORIZONTAL_TOLERANCE_DEG - CONE_EDGE_DEG:
+            doubts.append(
+                f"gravity is tilted {self.frame.tilt_deg:.1f} degrees from the pose's z, at the edge of the "
+                f"{HORIZONTAL_TOLERANCE_DEG:g} degrees the planes correct: a pose further off is fitted short of "
+                "gravity, or to a wall; check the pose"
+            )
         lean = self.frame.planes_tilt_deg
         if lean is not None and lean > POSE_DOUBT_DEG:
             doubts.append(
@@ -239,9 +256,16 @@ class CameraScene:
                 "correct it (gravity from the planes)"
             )
         if self.frame.floor_inliers == 0:
+            largest = max(self.frame.plane_heights, key=lambda plane: plane[1], default=(0.0, 0))
+            above = (
+                f"; the largest level plane ({largest[1]:,} points) lies {largest[0]:.2f} m above it: if that is the "
+                "floor (a ramp or a pit going down from it seen past it), every box stands that much too high"
+                if largest[0] > FLOOR_ABOVE_DOUBT_M
+                else ""
+            )
             doubts.append(
                 "no floor plane was seen (hidden by the boxes, or out of the view): z = 0 is put at the lowest "
-                "readings; if the floor lies lower, every box stands that much too low"
+                f"readings; if the floor lies lower, every box stands that much too low{above}"
             )
         pile_x = float(np.median([box.position[0] for box in self.scene.boxes]))
         if self.camera is None and self.door_given and pile_x < 0:
@@ -482,6 +506,8 @@ def scene_from_depth(
         frame: a ramp or a leaning layer in view cannot turn it); see
         :func:`~unstack.camera.planes.gravity_frame`.
     """
+    gravity = check_gravity(gravity)
+    pose = check_pose(camera_to_world)
     rng = np.random.default_rng(seed)
     names = [f"b{k:02d}" for k in range(len(masks))] if ids is None else list(ids)
     if len(names) != len(masks) or len(set(names)) != len(names):
@@ -495,17 +521,16 @@ def scene_from_depth(
             "with 0 or NaN where there is no reading"
         )
     masks = [_mask_array(mask, name, depth_m.shape) for mask, name in zip(masks, names, strict=True)]
-    pose = np.asarray(camera_to_world, dtype=np.float64)
     cloud = depth_points(depth_m, intrinsics, pose)
     if len(cloud) < 100:
         raise UnstackError(f"the depth image holds {len(cloud)} readings; at least 100 are needed")
     if len(cloud) > MAX_SCENE_POINTS:
         cloud = cloud[np.sort(rng.choice(len(cloud), MAX_SCENE_POINTS, replace=False))]
-    if door is None:  # towards the camera; a camera above the pile says nothing: the pose frame's -x
-        toward_camera = pose[:3, 3] - np.median(cloud, axis=0)
-        horizontal = np.linalg.norm(toward_camera[:2])
-        door = list(toward_camera if horizontal > 0.3 * np.linalg.norm(toward_camera) else [-1.0, 0.0, 0.0])
-    frame = gravity_frame(cloud, door=np.asarray(door, dtype=np.float64), seed=seed, gravity=gravity)
+    # without a door, towards the camera where that is horizontal enough against gravity (a camera
+    # above the pile says nothing of the door: the pose frame's -x)
+    given = None if door is None else np.asarray(door, dtype=np.float64)
+    toward_camera = pose[:3, 3] - np.median(cloud, axis=0)
+    frame = gravity_frame(cloud, door=given, seed=seed, gravity=gravity, default_door=toward_camera)
     masks = [_without_specks(mask, name) for mask, name in zip(masks, names, strict=True)]
     duplicates = duplicate_masks(masks)
     merged = merged_masks(masks)

@@ -34,7 +34,7 @@ import numpy as np
 
 from unstack.camera.build import CameraScene
 from unstack.camera.files import read_json_file
-from unstack.camera.planes import gravity_frame
+from unstack.camera.planes import check_gravity, gravity_frame
 from unstack.checks import check_quaternion_xyzw, check_vector, finite_number, number_text
 from unstack.errors import InvalidFile, UnstackError
 from unstack.jsonio import refuse_special_file
@@ -293,6 +293,7 @@ def scene_from_cloud(
     from unstack.geometry import rotation_matrix, rotation_tilt_deg
     from unstack.scene import finite_points
 
+    gravity = check_gravity(gravity)
     check_detections(detections)
     cloud = check_points(finite_points(points, "<cloud>"), source="<cloud>", path="$")  # NaN left out, with a warning
     if len(cloud) < 100:

@@ -36,6 +36,7 @@ __all__ = [
     "DEPTH_UNITS",
     "MAX_DEPTH_M",
     "Intrinsics",
+    "check_pose",
     "depth_scale",
     "load_depth",
     "load_intrinsics",
@@ -260,12 +261,54 @@ def _refuse_distortion(data: dict[str, Any], source: str) -> None:
             )  # fmt: skip
 
 
-def load_pose(path: str | os.PathLike[str]) -> np.ndarray:
-    """Read a 4 x 4 camera-to-world transform: a JSON matrix, or an object holding one matrix.
+def check_pose(matrix: Any, *, source: str = "<camera_to_world>", json_path: str = "$") -> np.ndarray:
+    """Check a 4 x 4 camera-to-world transform and return it as float64.
 
-    The rotation part must be a rotation (orthonormal, determinant 1, within 1e-3) and the
-    last row ``0 0 0 1``.
+    The rotation part must be a rotation (orthonormal, determinant 1, within 1e-3), the
+    translation within :data:`~unstack.checks.MAX_COORDINATE` metres and the last row ``0 0 0 1``;
+    anything else raises :class:`~unstack.errors.InvalidFile` naming ``source`` and the entry.
+
+    Examples
+    --------
+    >>> check_pose(np.eye(4)).dtype
+    dtype('float64')
+    >>> check_pose(np.diag([2.0, 2.0, 2.0, 1.0]))
+    Traceback (most recent call last):
+    ...
+    unstack.errors.InvalidFile: <camera_to_world>: $: expected a rotation in the upper 3 x 3 block (orthonormal, det 1)
     """
+    try:
+        pose = np.array(matrix, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InvalidFile(
+            source, json_path, f"expected a 4 x 4 matrix of finite numbers, got {type(matrix).__name__}"
+        ) from None
+    if pose.shape != (4, 4):
+        raise InvalidFile(source, json_path, f"expected a 4 x 4 matrix of finite numbers, got {pose.shape}")
+    bad = np.argwhere(~np.isfinite(pose))
+    if len(bad):
+        row, column = (int(index) for index in bad[0])
+        raise InvalidFile(source, f"{json_path}[{row}][{column}]", f"expected a finite number, got {pose[row, column]}")
+    rotation = pose[:3, :3]
+    far = np.flatnonzero(np.abs(pose[:3, 3]) > MAX_COORDINATE)
+    if far.size:
+        row = int(far[0])
+        raise InvalidFile(
+            source, f"{json_path}[{row}][3]", f"expected a translation within {MAX_COORDINATE:g} m (metres?), "
+            f"got {pose[row, 3]:g}"
+        )  # fmt: skip
+    if not np.allclose(pose[3], [0.0, 0.0, 0.0, 1.0]):
+        raise InvalidFile(source, f"{json_path}[3]", "expected the last row 0 0 0 1")
+    if not np.allclose(rotation.T @ rotation, np.eye(3), atol=1e-3) or not np.isclose(
+        np.linalg.det(rotation), 1.0, atol=1e-3
+    ):
+        raise InvalidFile(source, json_path, "expected a rotation in the upper 3 x 3 block (orthonormal, det 1)")
+    return pose
+
+
+def load_pose(path: str | os.PathLike[str]) -> np.ndarray:
+    """Read a 4 x 4 camera-to-world transform: a JSON matrix, or an object holding one matrix,
+    checked by :func:`check_pose`."""
     data, source = read_json_file(path)
     json_path = "$"
     if isinstance(data, dict):
@@ -285,21 +328,7 @@ def load_pose(path: str | os.PathLike[str]) -> np.ndarray:
                     source, f"{json_path}[{row}][{column}]", f"expected a finite number, got {number_text(entry)}"
                 )
     pose = np.array([[finite_number(entry) for entry in entries] for entries in rows], dtype=np.float64)
-    rotation = pose[:3, :3]
-    far = np.flatnonzero(np.abs(pose[:3, 3]) > MAX_COORDINATE)
-    if far.size:
-        row = int(far[0])
-        raise InvalidFile(
-            source, f"{json_path}[{row}][3]", f"expected a translation within {MAX_COORDINATE:g} m (metres?), "
-            f"got {pose[row, 3]:g}"
-        )  # fmt: skip
-    if not np.allclose(pose[3], [0.0, 0.0, 0.0, 1.0]):
-        raise InvalidFile(source, f"{json_path}[3]", "expected the last row 0 0 0 1")
-    if not np.allclose(rotation.T @ rotation, np.eye(3), atol=1e-3) or not np.isclose(
-        np.linalg.det(rotation), 1.0, atol=1e-3
-    ):
-        raise InvalidFile(source, json_path, "expected a rotation in the upper 3 x 3 block (orthonormal, det 1)")
-    return pose
+    return check_pose(pose, source=source, json_path=json_path)
 
 
 def _load_npy(file: Path, source: str, what: str) -> np.ndarray:

@@ -19,6 +19,7 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -27,6 +28,7 @@ from unstack.errors import UnstackError
 
 __all__ = [
     "GravityFrame",
+    "check_gravity",
     "depth_points",
     "fit_plane",
     "gravity_frame",
@@ -81,6 +83,9 @@ PLANE_SAMPLE = 60_000
 #: Where gravity comes from: the cloud's level planes (correcting a pose frame tilted against
 #: gravity), or the pose frame's z taken as up (a robot cell's calibrated frame).
 GRAVITY_SOURCES = ("planes", "pose")
+#: A default door (towards the camera) is taken when its horizontal part, against the gravity
+#: found, is over this share of it: a camera above the pile says nothing of the door.
+DEFAULT_DOOR_SHARE = 0.3
 
 
 def depth_points(
@@ -296,11 +301,14 @@ def _level_unless_leaning(
     return normal, offset, inliers
 
 
-def _stands_out(heights: np.ndarray, offset: float, band: float) -> bool:
+def _stands_out(heights: np.ndarray, offset: float, band: float, *, per_side: bool = False) -> bool:
     """Whether a level plane's points stand out of the cloud's heights around it: the band
     (``offset`` +- ``band``) holds :data:`LEVEL_PEAK` times the points of the two bands as wide
     beside it. A plane does; a slab of the heights of a wall (box fronts seen from the door, with
-    no floor or top in it) holds as many as the slabs above and below it.
+    no floor or top in it) holds as many as the slabs above and below it. ``per_side``: each of
+    the two bands counts as both (the fuller one, doubled): the lowest or highest slab of a
+    surface leaning against the direction has nothing beyond it, and only its one side to
+    compare with (gravity from the pose, where every slab is a level along the pose's z).
 
     Examples
     --------
@@ -309,10 +317,16 @@ def _stands_out(heights: np.ndarray, offset: float, band: float) -> bool:
     >>> floor = np.r_[wall, rng.normal(0.0, 0.005, 3000)]
     >>> _stands_out(floor, 0.0, 0.02), _stands_out(wall, 0.7, 0.02)
     (True, False)
+    >>> _stands_out(wall, 0.02, 0.02), _stands_out(wall, 0.02, 0.02, per_side=True)
+    (True, False)
     """
     distances = np.abs(heights - offset)
     inside = int(np.sum(distances < band))
-    return inside >= LEVEL_PEAK * int(np.sum((distances >= band) & (distances < 2.0 * band)))
+    beside = (distances >= band) & (distances < 2.0 * band)
+    if per_side:
+        above = int(np.sum(beside & (heights > offset)))
+        return inside >= LEVEL_PEAK * 2 * max(above, int(np.sum(beside)) - above)
+    return inside >= LEVEL_PEAK * int(np.sum(beside))
 
 
 def _surfaces(points: np.ndarray, under: np.ndarray, rng: np.random.Generator) -> bool:
@@ -500,7 +514,12 @@ def _rotation_onto_z(up: np.ndarray, heading: np.ndarray) -> np.ndarray:
 
 
 def gravity_frame(
-    points: np.ndarray, *, door: np.ndarray | None = None, seed: int = 0, gravity: str = "planes"
+    points: np.ndarray,
+    *,
+    door: np.ndarray | None = None,
+    seed: int = 0,
+    gravity: str = "planes",
+    default_door: np.ndarray | None = None,
 ) -> GravityFrame:
     """Gravity and floor from a cloud's horizontal planes; the door towards -x.
 
@@ -520,13 +539,17 @@ def gravity_frame(
         robot frame gives it; the planes give only the levels, the floor among them (a ramp or
         a leaning layer of tops that would turn the planes' up is not followed), and
         ``planes_tilt_deg`` says how far the planes would have turned it.
+    default_door : numpy.ndarray, shape (3,), optional
+        Without ``door``: a direction out through the door to take where it is horizontal
+        enough against the gravity found (its horizontal part over :data:`DEFAULT_DOOR_SHARE`
+        of it; else the input frame's -x), never refused: the direction towards the camera.
 
     Raises
     ------
     InvalidArgument
         ``gravity`` is neither ``"planes"`` nor ``"pose"``.
     UnstackError
-        No level plane, or a door direction within 15 degrees of the vertical.
+        No level plane, or a door given within 15 degrees of the vertical.
 
     Examples
     --------
@@ -547,11 +570,10 @@ def gravity_frame(
     >>> frame.tilt_deg, round(frame.planes_tilt_deg, 1), round(float(frame.translation[2]), 2)
     (0.0, 1.0, -0.7)
     """
-    if gravity not in GRAVITY_SOURCES:
-        from unstack.errors import InvalidArgument
+    from unstack.checks import check_points
 
-        raise InvalidArgument(f"gravity: expected one of {', '.join(map(repr, GRAVITY_SOURCES))}, got {gravity!r}")
-    points = np.asarray(points, dtype=np.float64)
+    gravity = check_gravity(gravity)
+    points = check_points(points, source="<points>", path="$")
     rng = np.random.default_rng(seed)
     up_guess = np.array([0.0, 0.0, 1.0])
     from_pose = gravity == "pose"
@@ -571,7 +593,7 @@ def gravity_frame(
         if inliers.sum() < MIN_PLANE_SHARE * len(points):
             break
         band = max(float(np.max(np.abs(remaining[inliers] @ normal - offset))), PLANE_THRESHOLD)
-        if not _stands_out(points @ normal, offset, band):  # a slice of a wall, not a plane
+        if not _stands_out(points @ normal, offset, band, per_side=from_pose):  # a slice of a wall, not a plane
             remaining = remaining[~inliers]
             continue
         found.append((normal, offset, int(inliers.sum())))
@@ -580,7 +602,7 @@ def gravity_frame(
             first_up = normal
         remaining = remaining[~inliers]
     if not found and from_pose:
-        planes_tilt = _planes_tilt_deg(points, door, seed)
+        planes_tilt = _planes_tilt_deg(points, seed)
         lean = "" if planes_tilt is None else f"; the cloud's planes lean {planes_tilt:.1f} degrees from it"
         raise UnstackError(
             f"no level plane along the frame's z (gravity from the pose) holds 2 % of the points{lean}: "
@@ -601,6 +623,10 @@ def gravity_frame(
     up /= np.linalg.norm(up)
     found = parallel
     heading = np.array([-1.0, 0.0, 0.0]) if door is None else np.asarray(door, dtype=np.float64)
+    if door is None and default_door is not None:
+        toward = np.asarray(default_door, dtype=np.float64)
+        if np.linalg.norm(toward - (toward @ up) * up) > DEFAULT_DOOR_SHARE * np.linalg.norm(toward):
+            heading = toward
     if door is not None and abs(heading @ up) > np.sin(np.radians(MAX_DOOR_RISE_DEG)) * np.linalg.norm(heading):
         raise UnstackError(
             f"the door's direction {heading.tolist()} is within {90 - MAX_DOOR_RISE_DEG:g} degrees of the vertical "
@@ -631,7 +657,7 @@ def gravity_frame(
     plane_heights = tuple(
         (float(height - floor_level), count) for height, (*_, count) in zip(floor_heights, found, strict=True)
     )
-    planes_tilt = _planes_tilt_deg(points, door, seed) if from_pose else None
+    planes_tilt = _planes_tilt_deg(points, seed) if from_pose else None
     return GravityFrame(
         rotation,
         np.array([0.0, 0.0, -floor_level]),
@@ -643,6 +669,21 @@ def gravity_frame(
         gravity,
         planes_tilt,
     )
+
+
+def check_gravity(gravity: Any) -> str:
+    """Check where gravity is to come from: one of :data:`GRAVITY_SOURCES`, as a plain ``str``.
+
+    Examples
+    --------
+    >>> check_gravity("pose")
+    'pose'
+    """
+    if not isinstance(gravity, str) or str(gravity) not in GRAVITY_SOURCES:
+        from unstack.errors import InvalidArgument
+
+        raise InvalidArgument(f"gravity: expected one of {', '.join(map(repr, GRAVITY_SOURCES))}, got {gravity!r}")
+    return str(gravity)
 
 
 def _plane_in_cone(
@@ -677,9 +718,10 @@ def _plane_in_cone(
     return normal, offset, inliers, noisy
 
 
-def _planes_tilt_deg(points: np.ndarray, door: np.ndarray | None, seed: int) -> float | None:
-    """How far the level planes turn up from the frame's z (``None`` where they find no plane)."""
+def _planes_tilt_deg(points: np.ndarray, seed: int) -> float | None:
+    """How far the level planes turn up from the frame's z (``None`` where they find no plane;
+    the door is left out: it turns the frame about up, not up)."""
     try:
-        return gravity_frame(points, door=door, seed=seed).tilt_deg
+        return gravity_frame(points, seed=seed).tilt_deg
     except UnstackError:
         return None
