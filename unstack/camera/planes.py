@@ -603,12 +603,13 @@ def gravity_frame(
         remaining = remaining[~inliers]
     if not found and from_pose:
         planes_tilt = _planes_tilt_deg(points, seed)
-        lean = "" if planes_tilt is None else f"; the cloud's planes lean {planes_tilt:.1f} degrees from it"
-        raise UnstackError(
-            f"no level plane along the frame's z (gravity from the pose) holds 2 % of the points{lean}: "
-            "is the pose's z up? Without gravity from the pose, the planes correct a tilt of up to "
-            f"{HORIZONTAL_TOLERANCE_DEG:g} degrees"
+        lean = (
+            f"; the cloud's planes lean {planes_tilt:.1f} degrees from it: is the pose's z up? Gravity from the "
+            "planes corrects that lean"
+            if planes_tilt is not None
+            else f", nor does a plane within {HORIZONTAL_TOLERANCE_DEG:g} degrees of it: is the pose's z up?"
         )
+        raise UnstackError(f"no level plane along the frame's z (gravity from the pose) holds 2 % of the points{lean}")
     if not found:
         raise UnstackError(
             f"no horizontal plane in the cloud (none within {HORIZONTAL_TOLERANCE_DEG:g} degrees of the frame's z "

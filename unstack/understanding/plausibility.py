@@ -71,6 +71,10 @@ SMALL_BOX = 0.08
 FAR_CLOUD = 0.5
 #: ... when less than this share of its points is nearer.
 NEAR_CLOUD_SHARE = 0.05
+#: ... and fewer than half the boxes have this many points within :data:`FACE_GAP` of their
+#: bounds (a box fitted to the cloud, one alone in a container's view, shows its faces in it).
+FACE_POINTS = 10
+FACE_GAP = 0.05
 
 
 def _share_within(points: np.ndarray, low: np.ndarray, high: np.ndarray, enough: float) -> float:
@@ -91,6 +95,23 @@ def _share_within(points: np.ndarray, low: np.ndarray, high: np.ndarray, enough:
         if inside >= enough * len(points):
             break
     return inside / len(points)
+
+
+def _boxes_in_cloud(points: np.ndarray, bounds: np.ndarray) -> float:
+    """Share of the boxes (their axis-aligned ``bounds``, rows ``low, high``) with
+    :data:`FACE_POINTS` points or more within :data:`FACE_GAP` of them.
+
+    Examples
+    --------
+    >>> points = np.array([[0.0, 0.0, 0.21]] * 10)
+    >>> _boxes_in_cloud(points, np.array([[-0.2, -0.2, 0.0, 0.2, 0.2, 0.2], [5.0, 5.0, 0.0, 5.4, 5.4, 0.4]]))
+    0.5
+    """
+    shown = [
+        np.count_nonzero(np.all((points >= low - FACE_GAP) & (points <= high + FACE_GAP), axis=1)) >= FACE_POINTS
+        for low, high in zip(bounds[:, :3], bounds[:, 3:], strict=True)
+    ]
+    return float(np.mean(shown)) if shown else 0.0
 
 
 def _floating(scene: Scene, bounds: np.ndarray, index: int) -> float | None:
@@ -164,7 +185,7 @@ def scene_warnings(scene: Scene) -> list[str]:
     else:
         low, high = poses.bounds[:, :3].min(axis=0) - FAR_CLOUD, poses.bounds[:, 3:].max(axis=0) + FAR_CLOUD
         near = _share_within(scene.points, low, high, NEAR_CLOUD_SHARE)
-        if near < NEAR_CLOUD_SHARE:
+        if near < NEAR_CLOUD_SHARE and _boxes_in_cloud(scene.points, poses.bounds) < 0.5:
             warnings.append(
                 f"{source}: only {100 * near:.1f} % of the cloud's points lie within {FAR_CLOUD} m of the boxes; "
                 "is the cloud in the same frame and unit (metres) as the boxes?"
