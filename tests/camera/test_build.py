@@ -854,7 +854,7 @@ def test_a_floor_leaning_against_the_pose_s_z_is_refused_saying_how_far_it_leans
     lean = np.radians(lean_deg)
     turned = floor @ np.array([[1, 0, 0], [0, np.cos(lean), -np.sin(lean)], [0, np.sin(lean), np.cos(lean)]]).T
     measured = (
-        rf"; the cloud's planes lean {lean_deg:.1f} degrees from it: is the pose's z up\? Gravity from the planes"
+        rf"; the cloud's planes lean {lean_deg:.1f} degrees from it: is the pose's z up\? \(gravity from the planes"
         if lean_deg < 25
         else r", nor does a plane within 25 degrees of it: is the pose's z up\?$"
     )
@@ -930,8 +930,31 @@ def test_a_default_door_steep_only_in_the_pose_frame_is_replaced_not_refused() -
     depth, masks, pose = _oblique(truth, "y", -6.0)
     built = scene_from_depth(depth, INTRINSICS, pose, masks, ids=[box.id for box in truth], known_sizes=SIZES)
     assert built.frame.tilt_deg == pytest.approx(6.0, abs=0.2)
-    for box, true in zip(built.scene.boxes, truth, strict=True):
-        assert box.position[2] == pytest.approx(true.position[2], abs=0.01)
+    for box, true in zip(built.scene.boxes, truth, strict=True):  # the pose frame's -x is the door: x, y kept
+        assert box.position == pytest.approx(true.position, abs=0.01)
+
+
+@pytest.mark.parametrize(("axis", "tilt_deg"), [("x", 4.0), ("y", -4.0)])
+def test_a_door_camera_s_default_door_is_towards_the_camera_on_a_tilted_pose(axis: str, tilt_deg: float) -> None:
+    # the default door is the direction towards the camera where that is no steep door: the same
+    # scene as with that direction given
+    from scipy.spatial.transform import Rotation
+
+    from tests.camera.conftest import looking_in, render_boxes
+    from unstack.camera import depth_points
+    from unstack.scene import Box
+
+    truth = [Box(box.id, box.size, np.add(box.position, [1.5, 0.0, 0.0])) for box in _pile()]
+    depth, masks = render_boxes(truth, looking_in(1.2, 30.0))
+    tilt = np.eye(4)
+    tilt[:3, :3] = Rotation.from_euler(axis, tilt_deg, degrees=True).as_matrix()
+    pose = tilt @ looking_in(1.2, 30.0)
+    toward = pose[:3, 3] - np.median(depth_points(depth, INTRINSICS, pose), axis=0)
+    by_default = scene_from_depth(depth, INTRINSICS, pose, masks, ids=["a", "b", "c"], known_sizes=SIZES)
+    given = scene_from_depth(depth, INTRINSICS, pose, masks, ids=["a", "b", "c"], known_sizes=SIZES, door=toward)
+    np.testing.assert_array_equal(by_default.frame.rotation, given.frame.rotation)
+    for box, true in zip(by_default.scene.boxes, truth, strict=True):
+        assert box.position == pytest.approx(true.position, abs=0.02)
 
 
 @pytest.mark.parametrize(
@@ -970,7 +993,7 @@ def test_a_floor_fitted_at_the_edge_of_what_the_planes_correct_is_doubted() -> N
     tilt[:3, :3] = Rotation.from_euler("x", 30.0, degrees=True).as_matrix()
     built = scene_from_depth(depth, INTRINSICS, tilt @ looking_in(1.2, 30.0), masks, ids=["a", "b", "c", "d"])
     assert built.frame.tilt_deg == pytest.approx(25.0, abs=0.1)
-    assert any("at the edge of the 25 degrees the planes correct" in doubt for doubt in built.doubts())
+    assert any("at or past the edge of the 25 degrees the planes search" in doubt for doubt in built.doubts())
 
 
 def test_without_a_floor_plane_the_largest_level_above_the_lowest_readings_is_named() -> None:

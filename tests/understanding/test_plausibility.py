@@ -167,3 +167,12 @@ def test_boxes_the_cloud_does_not_show_are_said_to_be_in_another_frame(shift: li
         re.search(r"of the cloud's points lie within 0\.5 m of the boxes; is the cloud in the same frame", w)
         for w in warnings
     )
+
+
+def test_a_box_the_cloud_shows_only_the_floor_under_is_said_to_be_in_another_frame() -> None:
+    # the floor under a box's footprint is no face of it: a detection where nothing stands is doubted
+    rng = np.random.default_rng(0)
+    warnings = scene_warnings(
+        Scene([Box("a", [0.4, 0.3, 0.3], [3.0, 0.0, 0.15])], _container_cloud(rng, 40_000), ["a"])
+    )
+    assert any("is the cloud in the same frame" in warning for warning in warnings)

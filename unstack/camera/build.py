@@ -26,6 +26,7 @@ from unstack.camera.boxes import FittedBox, boxes_from_masks, content_rng, dupli
 from unstack.camera.files import Intrinsics, check_pose
 from unstack.camera.planes import (
     HORIZONTAL_TOLERANCE_DEG,
+    PLANE_THRESHOLD,
     GravityFrame,
     check_gravity,
     depth_points,
@@ -182,6 +183,9 @@ LARGE_FIT_M = 1.0
 #: from the door: the door's direction was given the wrong way (a camera looking down from above
 #: the pile stands about level with it).
 DOOR_DOUBT_M = 0.3
+#: The direction towards the camera is the default door when its horizontal part (in the pose's
+#: frame) is over this share of it: a camera above the pile says nothing of the door.
+DEFAULT_DOOR_SHARE = 0.3
 #: With gravity from the pose, level planes of the cloud leaning more than this (degrees) from
 #: the pose's z are said: a pose not calibrated to gravity, or a ramp or leaning layer in view
 #: (the planes find gravity within 0.5 degrees under Kinect-like noise: docs page "Your own camera").
@@ -189,6 +193,8 @@ POSE_DOUBT_DEG = 1.5
 #: Without a floor plane, a level plane this far (metres) above the lowest readings, the largest
 #: one, is named: it may be the floor, and the lowest readings a ramp or pit going down from it.
 FLOOR_ABOVE_DOUBT_M = 0.05
+#: ... whose points lie mostly this far (metres) beyond every box's footprint.
+FOOTPRINT_MARGIN_M = 0.05
 #: A tilt this close (degrees) to what the planes correct is said: the fit may have stopped there.
 CONE_EDGE_DEG = 1.0
 
@@ -244,9 +250,9 @@ class CameraScene:
             )
         if self.frame.gravity == "planes" and self.frame.tilt_deg >= HORIZONTAL_TOLERANCE_DEG - CONE_EDGE_DEG:
             doubts.append(
-                f"gravity is tilted {self.frame.tilt_deg:.1f} degrees from the pose's z, at the edge of the "
-                f"{HORIZONTAL_TOLERANCE_DEG:g} degrees the planes correct: a pose further off is fitted short of "
-                "gravity, or to a wall; check the pose"
+                f"gravity is tilted {self.frame.tilt_deg:.1f} degrees from the input frame's z, at or past the edge "
+                f"of the {HORIZONTAL_TOLERANCE_DEG:g} degrees the planes search: a frame further off is fitted short "
+                "of gravity, or to a wall; check the pose"
             )
         lean = self.frame.planes_tilt_deg
         if lean is not None and lean > POSE_DOUBT_DEG:
@@ -256,11 +262,12 @@ class CameraScene:
                 "correct it (gravity from the planes)"
             )
         if self.frame.floor_inliers == 0:
-            largest = max(self.frame.plane_heights, key=lambda plane: plane[1], default=(0.0, 0))
+            floor = _floor_above(self.scene, self.frame.plane_heights)
             above = (
-                f"; the largest level plane ({largest[1]:,} points) lies {largest[0]:.2f} m above it: if that is the "
-                "floor (a ramp or a pit going down from it seen past it), every box stands that much too high"
-                if largest[0] > FLOOR_ABOVE_DOUBT_M
+                f"; a level plane ({floor[1]:,} points, most of them beside the boxes) lies {floor[0]:.2f} m above "
+                "it: if that is the floor (a ramp or a pit going down from it seen past it), every box stands that "
+                "much too high"
+                if floor is not None
                 else ""
             )
             doubts.append(
@@ -294,6 +301,24 @@ class CameraScene:
             "duplicates": dict(self.duplicates),
             "unfitted": dict(self.unfitted),
         }
+
+
+def _floor_above(scene: Scene, plane_heights: Sequence[tuple[float, int]]) -> tuple[float, int] | None:
+    """The largest level plane over :data:`FLOOR_ABOVE_DOUBT_M` above z = 0 whose points lie mostly
+    beside the boxes' footprints, as a floor's do (a layer of tops lies on them), or ``None``."""
+    from unstack.geometry import bounding_boxes
+
+    bounds = bounding_boxes(scene.boxes)
+    for height, count in sorted(plane_heights, key=lambda plane: -plane[1]):
+        if height <= FLOOR_ABOVE_DOUBT_M:
+            continue
+        level = scene.points[np.abs(scene.points[:, 2] - height) < PLANE_THRESHOLD, :2]
+        over = np.zeros(len(level), dtype=bool)
+        for low, high in zip(bounds[:, :2] - FOOTPRINT_MARGIN_M, bounds[:, 3:5] + FOOTPRINT_MARGIN_M, strict=True):
+            over |= np.all((level >= low) & (level <= high), axis=1)
+        if len(level) and float(np.mean(~over)) > 0.5:
+            return height, count
+    return None
 
 
 def _without_overlaps(fitted: list[FittedBox], unfitted: dict[str, str]) -> list[FittedBox]:
@@ -526,11 +551,15 @@ def scene_from_depth(
         raise UnstackError(f"the depth image holds {len(cloud)} readings; at least 100 are needed")
     if len(cloud) > MAX_SCENE_POINTS:
         cloud = cloud[np.sort(rng.choice(len(cloud), MAX_SCENE_POINTS, replace=False))]
-    # without a door, towards the camera where that is horizontal enough against gravity (a camera
-    # above the pile says nothing of the door: the pose frame's -x)
+    # without a door, towards the camera; a camera above the pile says nothing: the pose frame's -x,
+    # as it is where the gravity found makes the direction towards the camera steep
     given = None if door is None else np.asarray(door, dtype=np.float64)
     toward_camera = pose[:3, 3] - np.median(cloud, axis=0)
-    frame = gravity_frame(cloud, door=given, seed=seed, gravity=gravity, default_door=toward_camera)
+    horizontal = np.linalg.norm(toward_camera[:2])
+    guess = toward_camera if horizontal > DEFAULT_DOOR_SHARE * np.linalg.norm(toward_camera) else [-1.0, 0.0, 0.0]
+    frame = gravity_frame(
+        cloud, door=given, seed=seed, gravity=gravity, default_door=np.asarray(guess, dtype=np.float64)
+    )
     masks = [_without_specks(mask, name) for mask, name in zip(masks, names, strict=True)]
     duplicates = duplicate_masks(masks)
     merged = merged_masks(masks)

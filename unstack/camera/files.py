@@ -277,14 +277,25 @@ def check_pose(matrix: Any, *, source: str = "<camera_to_world>", json_path: str
     ...
     unstack.errors.InvalidFile: <camera_to_world>: $: expected a rotation in the upper 3 x 3 block (orthonormal, det 1)
     """
+    from unstack.checks import float_array
+
+    if np.ma.isMaskedArray(matrix):
+        raise InvalidFile(source, json_path, "expected a plain array, got a masked array: fill its masked cells first")
+    expected = "expected a 4 x 4 matrix of finite numbers"
     try:
-        pose = np.array(matrix, dtype=np.float64)
+        raw = np.asarray(matrix)
+        if raw.dtype == object:  # integers too large for a float, or anything mixed in
+            raw = float_array(matrix, source=source, path=json_path, error=InvalidFile)
     except (TypeError, ValueError):
-        raise InvalidFile(
-            source, json_path, f"expected a 4 x 4 matrix of finite numbers, got {type(matrix).__name__}"
-        ) from None
+        raise InvalidFile(source, json_path, f"{expected}, got {type(matrix).__name__}") from None
+    if raw.dtype.kind not in "iuf":
+        kind = {"U": "text", "S": "text", "b": "true or false", "c": "complex numbers"}.get(
+            raw.dtype.kind, str(raw.dtype)
+        )
+        raise InvalidFile(source, json_path, f"{expected}, got {kind}")
+    pose = raw.astype(np.float64)
     if pose.shape != (4, 4):
-        raise InvalidFile(source, json_path, f"expected a 4 x 4 matrix of finite numbers, got {pose.shape}")
+        raise InvalidFile(source, json_path, f"{expected}, got {pose.shape}")
     bad = np.argwhere(~np.isfinite(pose))
     if len(bad):
         row, column = (int(index) for index in bad[0])

@@ -83,9 +83,6 @@ PLANE_SAMPLE = 60_000
 #: Where gravity comes from: the cloud's level planes (correcting a pose frame tilted against
 #: gravity), or the pose frame's z taken as up (a robot cell's calibrated frame).
 GRAVITY_SOURCES = ("planes", "pose")
-#: A default door (towards the camera) is taken when its horizontal part, against the gravity
-#: found, is over this share of it: a camera above the pile says nothing of the door.
-DEFAULT_DOOR_SHARE = 0.3
 
 
 def depth_points(
@@ -540,14 +537,17 @@ def gravity_frame(
         a leaning layer of tops that would turn the planes' up is not followed), and
         ``planes_tilt_deg`` says how far the planes would have turned it.
     default_door : numpy.ndarray, shape (3,), optional
-        Without ``door``: a direction out through the door to take where it is horizontal
-        enough against the gravity found (its horizontal part over :data:`DEFAULT_DOOR_SHARE`
-        of it; else the input frame's -x), never refused: the direction towards the camera.
+        Without ``door``: a direction out through the door guessed by the caller (towards the
+        camera), taken unless the gravity found makes it as steep as a refused door (within
+        :data:`MAX_DOOR_RISE_DEG` of the horizontal, or more): then the input frame's -x, never
+        an error -- the caller gave no door.
 
     Raises
     ------
     InvalidArgument
         ``gravity`` is neither ``"planes"`` nor ``"pose"``.
+    InvalidScene
+        ``points`` is no N x 3 array of finite numbers.
     UnstackError
         No level plane, or a door given within 15 degrees of the vertical.
 
@@ -604,8 +604,8 @@ def gravity_frame(
     if not found and from_pose:
         planes_tilt = _planes_tilt_deg(points, seed)
         lean = (
-            f"; the cloud's planes lean {planes_tilt:.1f} degrees from it: is the pose's z up? Gravity from the "
-            "planes corrects that lean"
+            f"; the cloud's planes lean {planes_tilt:.1f} degrees from it: is the pose's z up? (gravity from the "
+            "planes would follow them: check the tilt it prints)"
             if planes_tilt is not None
             else f", nor does a plane within {HORIZONTAL_TOLERANCE_DEG:g} degrees of it: is the pose's z up?"
         )
@@ -624,11 +624,9 @@ def gravity_frame(
     up /= np.linalg.norm(up)
     found = parallel
     heading = np.array([-1.0, 0.0, 0.0]) if door is None else np.asarray(door, dtype=np.float64)
-    if door is None and default_door is not None:
-        toward = np.asarray(default_door, dtype=np.float64)
-        if np.linalg.norm(toward - (toward @ up) * up) > DEFAULT_DOOR_SHARE * np.linalg.norm(toward):
-            heading = toward
-    if door is not None and abs(heading @ up) > np.sin(np.radians(MAX_DOOR_RISE_DEG)) * np.linalg.norm(heading):
+    if door is None and default_door is not None and not _steep(np.asarray(default_door, dtype=np.float64), up):
+        heading = np.asarray(default_door, dtype=np.float64)
+    if door is not None and _steep(heading, up):
         raise UnstackError(
             f"the door's direction {heading.tolist()} is within {90 - MAX_DOOR_RISE_DEG:g} degrees of the vertical "
             "the cloud shows: expected a roughly horizontal direction out through the door"
@@ -717,6 +715,14 @@ def _plane_in_cone(
                 points, normal, offset, inliers, up_guess if first_up is None else first_up
             )
     return normal, offset, inliers, noisy
+
+
+def _steep(direction: np.ndarray, up: np.ndarray) -> bool:
+    """Whether a door's ``direction`` rises or falls more than :data:`MAX_DOOR_RISE_DEG` against ``up``
+    (a zero vector is steep: it points nowhere)."""
+    return bool(abs(direction @ up) > np.sin(np.radians(MAX_DOOR_RISE_DEG)) * np.linalg.norm(direction)) or not bool(
+        np.linalg.norm(direction) > 0
+    )
 
 
 def _planes_tilt_deg(points: np.ndarray, seed: int) -> float | None:

@@ -20,10 +20,10 @@ import click
 
 from unstack.checks import MAX_BOX_EDGE, MAX_ID_LENGTH, MIN_BOX_EDGE, counted, long_id
 from unstack.errors import InvalidFile, UnstackError
+from unstack.jsonio import report_text
 
 if TYPE_CHECKING:
     from unstack.camera.planes import GravityFrame
-from unstack.jsonio import report_text
 
 __all__ = ["scene"]
 

@@ -415,7 +415,10 @@ def unload(
         )
         for maker in result["makers"]
     )
-    header = ("decision maker", "boxes moved (> 2 cm or 5°) per pile", "minus unstack's (± s.e.)", "per pick",
+    from unstack.sim.settings import DISPLACEMENT_THRESHOLD, ROTATION_THRESHOLD_DEG
+
+    moved = f"boxes moved (> {100 * DISPLACEMENT_THRESHOLD:g} cm or {ROTATION_THRESHOLD_DEG:g}°) per pile"
+    header = ("decision maker", moved, "minus unstack's (± s.e.)", "per pick",
               "picks moving nothing", "displacement (m)")  # fmt: skip
     title = f"Unloading every detected box of {result['configs']} piles ({data_dir}) in the simulator"
     _print_results(number_table(title, header, figures), written)

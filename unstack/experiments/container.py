@@ -150,9 +150,9 @@ candidates, and the policy picks one. Decision makers (:data:`CONTAINER_MAKERS`)
     ``hybrid_faces_free`` with each belief world's masses drawn from the settings' range
     (``draw_masses=True``), not the typical mass in every world.
 
-Metrics per pile and per maker: boxes moved more than 2 cm, boxes fallen (dropped more than
-0.2 m or tipped more than 45 degrees), the share of picks that move nothing, and paired
-differences from ``unstack`` with standard errors. Seeded and reproducible (sample budgets,
+Metrics per pile and per maker: boxes moved more than 2 cm or turned more than 5 degrees, boxes
+fallen (dropped more than 0.2 m or tipped more than 45 degrees), the share of picks that move
+nothing, and paired differences from ``unstack`` with standard errors. Seeded and reproducible (sample budgets,
 not time limits); resumable per pile; piles in parallel processes.
 
 Examples

@@ -333,7 +333,11 @@ def plot_unloading(result: dict[str, Any], output: str | os.PathLike[str]) -> No
             markerfacecolor="none" if hidden else None, label=label,
         )  # fmt: skip
     axis.set_xlabel("% of the detected boxes unloaded")
-    axis.set_ylabel("boxes moved > 2 cm so far (mean over piles)")
+    from unstack.sim.settings import DISPLACEMENT_THRESHOLD, ROTATION_THRESHOLD_DEG
+
+    axis.set_ylabel(
+        f"boxes moved > {100 * DISPLACEMENT_THRESHOLD:g} cm or {ROTATION_THRESHOLD_DEG:g}° so far (mean over piles)"
+    )
     axis.set_title(f"Unloading {result['configs']} piles of {Path(result['data']).name} in the simulator")
     axis.legend()
     figure.tight_layout()

@@ -99,19 +99,28 @@ def _share_within(points: np.ndarray, low: np.ndarray, high: np.ndarray, enough:
 
 def _boxes_in_cloud(points: np.ndarray, bounds: np.ndarray) -> float:
     """Share of the boxes (their axis-aligned ``bounds``, rows ``low, high``) with
-    :data:`FACE_POINTS` points or more within :data:`FACE_GAP` of them.
+    :data:`FACE_POINTS` points or more within :data:`FACE_GAP` of their sides or top (not under
+    them: the floor under a box detected where nothing is shows no face of it).
 
     Examples
     --------
     >>> points = np.array([[0.0, 0.0, 0.21]] * 10)
     >>> _boxes_in_cloud(points, np.array([[-0.2, -0.2, 0.0, 0.2, 0.2, 0.2], [5.0, 5.0, 0.0, 5.4, 5.4, 0.4]]))
     0.5
+    >>> floor = np.array([[0.0, 0.0, 0.0]] * 10)
+    >>> _boxes_in_cloud(floor, np.array([[-0.2, -0.2, 0.0, 0.2, 0.2, 0.2]]))
+    0.0
     """
+    if len(bounds) == 0:
+        return 0.0
+    lows, highs = bounds[:, :3] - FACE_GAP, bounds[:, 3:] + FACE_GAP
+    lows[:, 2] = bounds[:, 2] + FACE_GAP  # above the bottom: not the surface the box stands on
+    near = points[np.all((points >= lows.min(axis=0)) & (points <= highs.max(axis=0)), axis=1)]
     shown = [
-        np.count_nonzero(np.all((points >= low - FACE_GAP) & (points <= high + FACE_GAP), axis=1)) >= FACE_POINTS
-        for low, high in zip(bounds[:, :3], bounds[:, 3:], strict=True)
+        np.count_nonzero(np.all((near >= low) & (near <= high), axis=1)) >= FACE_POINTS
+        for low, high in zip(lows, highs, strict=True)
     ]
-    return float(np.mean(shown)) if shown else 0.0
+    return float(np.mean(shown))
 
 
 def _floating(scene: Scene, bounds: np.ndarray, index: int) -> float | None:
