@@ -327,3 +327,30 @@ def test_lines_kept_on_request_are_found_by_line_labels(tmp_path: Path) -> None:
     masks = load_label_masks(tmp_path / "labels.npy", lines=True)
     assert sorted(masks) == [10, 15, 20]
     assert line_labels(masks) == [15]
+
+
+@pytest.mark.parametrize(
+    ("matrix", "message"),
+    [
+        (np.eye(4).astype(str), r"\$: expected a 4 x 4 matrix of finite numbers, got text"),
+        (np.eye(4, dtype=bool), r"\$: expected a 4 x 4 matrix of finite numbers, got true or false"),
+        (np.eye(4, dtype=complex), r"\$: expected a 4 x 4 matrix of finite numbers, got complex numbers"),
+        (np.ma.masked_array(np.eye(4), mask=np.eye(4, dtype=bool)), r"\$: expected a plain array, got a masked array"),
+        ([[10**400, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], r"\$\[0\]\[0\]: expected a finite number"),
+        ("pose", r"\$: expected a 4 x 4 matrix of finite numbers, got text"),
+    ],
+    ids=["text", "bool", "complex", "masked", "huge-integer", "a-string"],
+)
+def test_a_library_pose_of_no_numbers_is_refused_by_its_path(matrix: object, message: str) -> None:
+    from unstack.camera import check_pose
+    from unstack.errors import InvalidFile
+
+    with pytest.raises(InvalidFile, match=rf"^<camera_to_world>: {message}"):
+        check_pose(matrix)
+
+
+def test_a_library_pose_of_whole_numbers_or_nested_lists_is_taken_as_float64() -> None:
+    from unstack.camera import check_pose
+
+    assert check_pose(np.eye(4, dtype=int)).dtype == np.float64
+    np.testing.assert_array_equal(check_pose(np.eye(4).tolist()), np.eye(4))
