@@ -1013,3 +1013,35 @@ def test_without_a_floor_plane_the_largest_level_above_the_lowest_readings_is_na
     [doubt] = [doubt for doubt in built.doubts() if doubt.startswith("no floor plane was seen")]
     largest = max(built.frame.plane_heights, key=lambda plane: plane[1])
     assert largest[0] > 0.1 and f"lies {largest[0]:.2f} m above it: if that is the floor" in doubt
+
+
+def test_a_box_seen_in_part_says_how_far_a_second_draw_of_its_planes_moves_it(example_frame) -> None:
+    # the example's b32 (89 points, a top seen in part): its fit hangs on RANSAC's draws
+    from unstack.camera.boxes import UNSURE_FIT_M
+
+    depth, intrinsics, pose, masks, ids = example_frame
+    built = scene_from_depth(depth, intrinsics, pose, masks, ids=ids, known_sizes=SIZES)
+    by_id = {item.box.id: item for item in built.fitted}
+    assert all(item.unsure_m == 0.0 for item in built.fitted if not item.partial)
+    assert [item.box.id for item in built.fitted if item.unsure_m > UNSURE_FIT_M] == ["b32"]
+    [doubt] = [doubt for doubt in built.doubts() if "do not settle" in doubt]
+    assert f"(b32 by {by_id['b32'].unsure_m:.2f} m)" in doubt
+    reported = {entry["id"]: entry["unsure_m"] for entry in built.report()["boxes"]}
+    assert reported == {item.box.id: item.unsure_m for item in built.fitted}
+
+
+def test_the_unsure_doubt_names_every_box_over_the_bound_and_no_other(three_cartons) -> None:
+    import dataclasses
+
+    from unstack.camera.boxes import UNSURE_FIT_M
+
+    depth, masks, pose = render_tops(three_cartons)
+    built = scene_from_depth(depth, INTRINSICS, pose, masks, known_sizes=SIZES)
+    assert not [doubt for doubt in built.doubts() if "do not settle" in doubt]  # tops seen whole: 0
+    marked = tuple(
+        dataclasses.replace(item, unsure_m=value)
+        for item, value in zip(built.fitted, [UNSURE_FIT_M / 2, 2 * UNSURE_FIT_M, 0.3], strict=True)
+    )
+    [doubt] = [doubt for doubt in dataclasses.replace(built, fitted=marked).doubts() if "do not settle" in doubt]
+    assert doubt.startswith("2 boxes seen in part with a pose its points do not settle")
+    assert f"({marked[1].box.id} by 0.10 m, {marked[2].box.id} by 0.30 m)" in doubt

@@ -41,6 +41,7 @@ Examples
 
 from __future__ import annotations
 
+import dataclasses
 import zlib
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -102,6 +103,9 @@ EDGE_BIN_M = 0.005
 #: A point whose third nearest neighbour is this many times further than the median is a stray
 #: (a flying pixel), left out of a top's rectangle and of a tilted box's extents.
 STRAY_SPREAD = 3.0
+#: A box seen in part whose centre moves more than this (metres) between two random draws of its
+#: points' planes is not settled by them (:attr:`FittedBox.unsure_m`).
+UNSURE_FIT_M = 0.05
 #: Where no viewpoint is given, faces are taken to look this way (out through the door and up).
 DEFAULT_VIEW = (-1.0, 0.0, 1.0)
 
@@ -130,6 +134,11 @@ class FittedBox:
         The face was seen in part (it covers less than :data:`PARTIAL_FILL` of its rectangle,
         or the matched size reaches more than :data:`PARTIAL_EDGE` beyond what was seen): the
         centre is placed from the part seen and may be off by up to the missing length.
+    unsure_m : float
+        For a box seen in part: how far its centre moves when its points are fitted again with
+        other random draws (RANSAC's planes; :func:`boxes_from_masks`), or its longest edge when
+        the second fit finds no box; 0 for a box seen whole. Over :data:`UNSURE_FIT_M` the points
+        do not settle the box's pose.
     """
 
     box: Box
@@ -139,6 +148,7 @@ class FittedBox:
     size_error_m: float
     points: int
     partial: bool = False
+    unsure_m: float = 0.0
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -149,6 +159,7 @@ class FittedBox:
             "size_error_m": self.size_error_m,
             "points": self.points,
             "partial": self.partial,
+            "unsure_m": self.unsure_m,
         }
 
 
@@ -710,9 +721,9 @@ class _Containment:
         return bool(shared >= DUPLICATE_SHARE * self.areas[k]) and self.areas[k] > 0
 
 
-def content_rng(seed: int, values: np.ndarray) -> np.random.Generator:
+def content_rng(seed: int, values: np.ndarray, stream: int = 0) -> np.random.Generator:
     """A generator seeded by ``seed`` and the bytes of ``values``: the same values draw the same
-    numbers wherever they stand among others.
+    numbers wherever they stand among others (``stream`` > 0: another, independent generator of them).
 
     Examples
     --------
@@ -723,7 +734,24 @@ def content_rng(seed: int, values: np.ndarray) -> np.random.Generator:
     False
     """
     key = zlib.crc32(np.ascontiguousarray(values).tobytes())
-    return np.random.default_rng([int(seed), key])
+    return np.random.default_rng([int(seed), key] if stream == 0 else [int(seed), key, int(stream)])
+
+
+def _moved_by_redraw(
+    fit: FittedBox,
+    points: np.ndarray,
+    known_sizes: Sequence[Sequence[float]] | None,
+    surfaces: Sequence[float],
+    rng: np.random.Generator,
+    viewpoint: Sequence[float] | None,
+) -> float:
+    """How far ``fit``'s centre moves when ``points`` are fitted again from ``rng`` (its longest
+    edge when that fit finds no box)."""
+    try:
+        again = fit_box(fit.box.id, points, known_sizes=known_sizes, surfaces=surfaces, rng=rng, viewpoint=viewpoint)
+    except (UnstackError, InvalidFile):
+        return float(np.max(fit.box.size))
+    return float(np.linalg.norm(again.box.position - fit.box.position))
 
 
 def boxes_from_masks(
@@ -754,9 +782,13 @@ def boxes_from_masks(
         surfaces = [0.0, *(top for j, top in enumerate(tops) if j != k), *levels]
         try:
             rng = content_rng(seed, points)
-            fitted.append(
-                fit_box(box_id, points, known_sizes=known_sizes, surfaces=surfaces, rng=rng, viewpoint=viewpoint)
-            )
+            fit = fit_box(box_id, points, known_sizes=known_sizes, surfaces=surfaces, rng=rng, viewpoint=viewpoint)
+            if fit.partial:  # a face seen in part: does another draw of its planes give the same box?
+                again = content_rng(seed, points, stream=1)
+                fit = dataclasses.replace(
+                    fit, unsure_m=_moved_by_redraw(fit, points, known_sizes, surfaces, again, viewpoint)
+                )
+            fitted.append(fit)
         except InvalidFile as error:  # a box no carton is: say so of the fit, not of an array
             unfitted[box_id] = f"the fitted box's {error.json_path[2:]}: {error.message}"
         except UnstackError as error:

@@ -22,7 +22,14 @@ from typing import Any
 
 import numpy as np
 
-from unstack.camera.boxes import FittedBox, boxes_from_masks, content_rng, duplicate_masks, merged_masks
+from unstack.camera.boxes import (
+    UNSURE_FIT_M,
+    FittedBox,
+    boxes_from_masks,
+    content_rng,
+    duplicate_masks,
+    merged_masks,
+)
 from unstack.camera.files import Intrinsics, check_pose
 from unstack.camera.planes import (
     HORIZONTAL_TOLERANCE_DEG,
@@ -32,6 +39,7 @@ from unstack.camera.planes import (
     depth_points,
     gravity_frame,
 )
+from unstack.checks import counted
 from unstack.errors import UnstackError
 from unstack.geometry import points_in_box
 from unstack.scene import Box, Scene
@@ -260,6 +268,14 @@ class CameraScene:
                 f"gravity is the pose's z, as asked, but the cloud's level planes lean {lean:.1f} degrees from it: "
                 "check the pose's calibration; where the pile's tops and the floor are level, let the planes "
                 "correct it (gravity from the planes)"
+            )
+        unsure = sorted((item for item in self.fitted if item.unsure_m > UNSURE_FIT_M), key=lambda item: item.box.id)
+        if unsure:
+            named = ", ".join(f"{item.box.id} by {item.unsure_m:.2f} m" for item in unsure)
+            doubts.append(
+                f"{counted(len(unsure), 'box', 'boxes')} seen in part with a pose its points do not settle: fitted "
+                f"again with other random draws of the planes, the centre moves ({named}); a view that shows more "
+                "of it settles it"
             )
         if self.frame.floor_inliers == 0:
             floor = _floor_above(self.scene, self.frame.plane_heights)
