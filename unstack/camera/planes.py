@@ -720,9 +720,8 @@ def _plane_in_cone(
 def _steep(direction: np.ndarray, up: np.ndarray) -> bool:
     """Whether a door's ``direction`` rises or falls more than :data:`MAX_DOOR_RISE_DEG` against ``up``
     (a zero vector is steep: it points nowhere)."""
-    return bool(abs(direction @ up) > np.sin(np.radians(MAX_DOOR_RISE_DEG)) * np.linalg.norm(direction)) or not bool(
-        np.linalg.norm(direction) > 0
-    )
+    length = float(np.linalg.norm(direction))
+    return not length > 0 or bool(abs(direction @ up) > np.sin(np.radians(MAX_DOOR_RISE_DEG)) * length)
 
 
 def _planes_tilt_deg(points: np.ndarray, seed: int) -> float | None:
